@@ -1,0 +1,32 @@
+# All dependencies come from Debian 12 packages; nothing is downloaded at configure time.
+find_package(Eigen3 3.4 REQUIRED CONFIG)
+find_package(fmt REQUIRED CONFIG)
+find_package(nlohmann_json 3 REQUIRED CONFIG)
+find_package(CLI11 REQUIRED CONFIG)
+find_package(yaml-cpp REQUIRED CONFIG)
+find_package(CGAL 5.5 REQUIRED)
+find_package(VTK 9 REQUIRED COMPONENTS CommonCore CommonDataModel IOXML IOImage FiltersCore
+             FiltersSources FiltersModeling RenderingCore RenderingOpenGL2
+             RenderingAnnotation RenderingFreeType)
+
+# SuiteSparse: newer releases ship SuiteSparse::CHOLMOD / UMFPACK config packages;
+# Debian 12's 5.12 ships none, so we wrap the libraries ourselves.
+find_package(CHOLMOD CONFIG QUIET)
+find_package(UMFPACK CONFIG QUIET)
+if(TARGET SuiteSparse::CHOLMOD AND TARGET SuiteSparse::UMFPACK)
+  add_library(sf_suitesparse INTERFACE)
+  target_link_libraries(sf_suitesparse INTERFACE SuiteSparse::CHOLMOD SuiteSparse::UMFPACK)
+else()
+  find_path(SF_CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+  find_library(SF_CHOLMOD_LIBRARY cholmod REQUIRED)
+  find_library(SF_UMFPACK_LIBRARY umfpack REQUIRED)
+  add_library(sf_suitesparse INTERFACE)
+  target_include_directories(sf_suitesparse SYSTEM INTERFACE ${SF_CHOLMOD_INCLUDE_DIR})
+  target_link_libraries(sf_suitesparse INTERFACE ${SF_CHOLMOD_LIBRARY} ${SF_UMFPACK_LIBRARY})
+endif()
+
+find_package(Threads REQUIRED)
+if(SF_BUILD_TESTS)
+  find_package(GTest REQUIRED CONFIG)
+  include(GoogleTest)
+endif()

@@ -1,0 +1,9 @@
+// simform: thin executable over the sf_forming library.
+#include "common/cli/app.hpp"
+#include "forming/commands.hpp"
+
+int main(int argc, char** argv) {
+  sf::cli::Program program("simform", "simform — see docs/ for usage");
+  sf::forming::register_commands(program);
+  return program.main(argc, argv);
+}

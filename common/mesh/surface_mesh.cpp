@@ -290,3 +290,28 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
 }
 
 }  // namespace sf::mesh
+
+namespace sf::mesh {
+SurfaceMesh extract_elements(const SurfaceMesh& mesh, const std::vector<bool>& keep,
+                             std::vector<Index>* element_map_out) {
+  std::vector<Index> node_map(mesh.n_nodes(), -1);
+  std::vector<Index> element_map(mesh.n_elements(), -1);
+  SurfaceMesh out;
+  for (Index e = 0; e < mesh.n_elements(); ++e) {
+    if (!keep[e]) continue;
+    Element el = mesh.element(e);
+    for (Index& n : el.nodes) {
+      if (node_map[n] < 0) {
+        node_map[n] = out.add_node();
+        out.geometry().middleRows(SurfaceMesh::dof(node_map[n], 0), kParamsPerNode) =
+            mesh.geometry().middleRows(SurfaceMesh::dof(n, 0), kParamsPerNode);
+      }
+      n = node_map[n];
+    }
+    element_map[e] = out.add_element(el);
+  }
+  out.build_topology();
+  if (element_map_out) *element_map_out = std::move(element_map);
+  return out;
+}
+}  // namespace sf::mesh

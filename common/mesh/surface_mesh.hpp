@@ -147,3 +147,11 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
                            int n_rings, int n_sectors);
 
 }  // namespace sf::mesh
+
+namespace sf::mesh {
+// The sub-mesh of the elements with keep[e] true (nodes renumbered, unused nodes
+// dropped, geometry and scale factors kept). `element_map_out` (optional) receives
+// old element -> new element (-1 when dropped).
+SurfaceMesh extract_elements(const SurfaceMesh& mesh, const std::vector<bool>& keep,
+                             std::vector<Index>* element_map_out = nullptr);
+}  // namespace sf::mesh

@@ -1,0 +1,460 @@
+#include "common/linalg/solver.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <utility>
+
+#include "common/core/error.hpp"
+
+// SuiteSparse is linked privately into sf_common; without it the kAuto choice
+// falls back to Eigen's own solvers.
+#if __has_include(<cholmod.h>) && __has_include(<umfpack.h>)
+#define SF_LINALG_HAVE_SUITESPARSE 1
+#include <Eigen/CholmodSupport>
+#include <Eigen/UmfPackSupport>
+#else
+#define SF_LINALG_HAVE_SUITESPARSE 0
+#endif
+
+namespace sf::linalg {
+
+namespace {
+
+using Status = SolveReport::Status;
+
+struct NamedKind {
+  SolverKind kind;
+  const char* name;
+};
+constexpr NamedKind kSolverNames[] = {
+    {SolverKind::kAuto, "auto"},
+    {SolverKind::kCholmod, "cholmod"},
+    {SolverKind::kUmfpack, "umfpack"},
+    {SolverKind::kEigenLDLT, "eigen-ldlt"},
+    {SolverKind::kEigenLU, "eigen-lu"},
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Result of one back-end step.
+struct Outcome {
+  Status status = Status::kOk;
+  std::string message;
+};
+
+// One factorisation library. analyze() and factorize() get the solver's own
+// compressed copy of A, which outlives the factorisation (UMFPACK's solve
+// reads A again for iterative refinement).
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual Outcome analyze(const SparseMatrix& a) = 0;
+  virtual Outcome factorize(const SparseMatrix& a) = 0;
+  // x = A^-1 b; false when the library reports a failure.
+  virtual bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const = 0;
+};
+
+#if SF_LINALG_HAVE_SUITESPARSE
+
+// Eigen's wrapper keeps the CHOLMOD factor protected; the failing column
+// (factor->minor) makes the "not positive definite" message useful.
+class CholmodLlt : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+ public:
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+};
+
+class CholmodBackend final : public Backend {
+ public:
+  CholmodBackend() { llt_.cholmod().print = 0; }  // report through SolveReport, never print
+
+  Outcome analyze(const SparseMatrix& a) override {
+    llt_.analyzePattern(a);
+    const int status = llt_.cholmod().status;
+    if (llt_.factor() == nullptr || status < CHOLMOD_OK) {
+      return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis failed (status {})", status)};
+    }
+    return {};
+  }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    llt_.factorize(a);
+    if (llt_.info() == Eigen::Success) return {};
+    const int status = llt_.cholmod().status;
+    if (status < CHOLMOD_OK) {
+      return {Status::kFailed,
+              fmt::format("CHOLMOD numeric factorisation failed (status {}{})", status,
+                          status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "")};
+    }
+    const cholmod_factor* f = llt_.factor();
+    return {Status::kSingular,
+            fmt::format("matrix is not positive definite: Cholesky broke down at pivot {} of {} "
+                        "in elimination order; a symmetric indefinite matrix needs "
+                        "MatrixProperty::kSymmetricIndefinite",
+                        f->minor + 1, f->n)};
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    x = llt_.solve(b);
+    return llt_.info() == Eigen::Success;
+  }
+
+ private:
+  CholmodLlt llt_;
+};
+
+class UmfpackBackend final : public Backend {
+ public:
+  Outcome analyze(const SparseMatrix& a) override {
+    lu_.analyzePattern(a);
+    if (lu_.info() != Eigen::Success) {
+      return {Status::kFailed, "UMFPACK symbolic analysis failed"};
+    }
+    return {};
+  }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    lu_.factorize(a);
+    const int code = lu_.umfpackFactorizeReturncode();
+    // Determinant under/overflow warnings do not affect the factors.
+    if (code == UMFPACK_OK || code == UMFPACK_WARNING_determinant_underflow ||
+        code == UMFPACK_WARNING_determinant_overflow) {
+      return {};
+    }
+    if (code == UMFPACK_WARNING_singular_matrix) {
+      return {Status::kSingular, "matrix is singular: UMFPACK found a zero pivot"};
+    }
+    return {Status::kFailed,
+            fmt::format("UMFPACK numeric factorisation failed (status {}{})", code,
+                        code == UMFPACK_ERROR_out_of_memory ? ", out of memory" : "")};
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    x = lu_.solve(b);
+    return lu_.info() == Eigen::Success;
+  }
+
+ private:
+  Eigen::UmfPackLU<SparseMatrix> lu_;
+};
+
+#endif  // SF_LINALG_HAVE_SUITESPARSE
+
+class EigenLdltBackend final : public Backend {
+ public:
+  Outcome analyze(const SparseMatrix& a) override {
+    ldlt_.analyzePattern(a);
+    if (ldlt_.info() != Eigen::Success) return {Status::kFailed, "LDL^T symbolic analysis failed"};
+    return {};
+  }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    ldlt_.factorize(a);
+    if (ldlt_.info() == Eigen::Success) return {};
+    return {Status::kSingular,
+            "zero pivot in LDL^T: matrix is singular or needs pivoting, try umfpack"};
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    x = ldlt_.solve(b);
+    return ldlt_.info() == Eigen::Success;
+  }
+
+ private:
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+};
+
+class EigenLuBackend final : public Backend {
+ public:
+  Outcome analyze(const SparseMatrix& a) override {
+    // SparseLU's analysis (COLAMD ordering) reports nothing and leaves info()
+    // from the previous factorisation in place, so there is nothing to check.
+    lu_.analyzePattern(a);
+    return {};
+  }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    lu_.factorize(a);
+    switch (lu_.info()) {
+      case Eigen::Success:
+        return {};
+      case Eigen::NumericalIssue:
+        return {Status::kSingular, "matrix is singular: SparseLU: " + lu_.lastErrorMessage()};
+      default:
+        return {Status::kFailed, "SparseLU factorisation failed: " + lu_.lastErrorMessage()};
+    }
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    x = lu_.solve(b);
+    return lu_.info() == Eigen::Success;
+  }
+
+ private:
+  Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu_;
+};
+
+SolverKind resolve_auto(MatrixProperty property) {
+  switch (property) {
+    case MatrixProperty::kSymmetricPositiveDefinite:
+      return SF_LINALG_HAVE_SUITESPARSE ? SolverKind::kCholmod : SolverKind::kEigenLDLT;
+    case MatrixProperty::kSymmetricIndefinite:
+      return SF_LINALG_HAVE_SUITESPARSE ? SolverKind::kUmfpack : SolverKind::kEigenLDLT;
+    case MatrixProperty::kUnsymmetric:
+      return SF_LINALG_HAVE_SUITESPARSE ? SolverKind::kUmfpack : SolverKind::kEigenLU;
+  }
+  return SolverKind::kEigenLU;
+}
+
+std::unique_ptr<Backend> make_backend(SolverKind kind) {
+  switch (kind) {
+#if SF_LINALG_HAVE_SUITESPARSE
+    case SolverKind::kCholmod:
+      return std::make_unique<CholmodBackend>();
+    case SolverKind::kUmfpack:
+      return std::make_unique<UmfpackBackend>();
+#endif
+    case SolverKind::kEigenLDLT:
+      return std::make_unique<EigenLdltBackend>();
+    case SolverKind::kEigenLU:
+      return std::make_unique<EigenLuBackend>();
+    default:
+      break;
+  }
+  SF_ASSERT(false, "make_backend: kind must be resolved and available");
+  return std::make_unique<EigenLuBackend>();
+}
+
+// Same size and same compressed pattern (both arguments compressed).
+bool same_pattern(const SparseMatrix& a, const SparseMatrix& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+  const int* a_outer = a.outerIndexPtr();
+  const int* b_outer = b.outerIndexPtr();
+  if (!std::equal(a_outer, a_outer + a.outerSize() + 1, b_outer)) return false;
+  const int* a_inner = a.innerIndexPtr();
+  return std::equal(a_inner, a_inner + a.nonZeros(), b.innerIndexPtr());
+}
+
+Eigen::MatrixXd nan_matrix(Eigen::Index rows, Eigen::Index cols) {
+  return Eigen::MatrixXd::Constant(rows, cols, std::numeric_limits<double>::quiet_NaN());
+}
+
+}  // namespace
+
+std::string to_string(SolverKind kind) {
+  for (const NamedKind& named : kSolverNames) {
+    if (named.kind == kind) return named.name;
+  }
+  return "unknown";
+}
+
+SolverKind parse_solver_kind(const std::string& name, const std::string& where) {
+  std::string expected;
+  for (const NamedKind& named : kSolverNames) {
+    if (name == named.name) return named.kind;
+    expected += expected.empty() ? "" : ", ";
+    expected += named.name;
+  }
+  std::string message =
+      fmt::format("unknown linear solver '{}' (expected one of: {})", name, expected);
+  if (!where.empty()) message = where + ": " + message;
+  throw InputError(message);
+}
+
+bool solver_available(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kCholmod:
+    case SolverKind::kUmfpack:
+      return SF_LINALG_HAVE_SUITESPARSE != 0;
+    default:
+      return true;
+  }
+}
+
+std::string to_string(MatrixProperty property) {
+  switch (property) {
+    case MatrixProperty::kSymmetricPositiveDefinite:
+      return "spd";
+    case MatrixProperty::kSymmetricIndefinite:
+      return "symmetric-indefinite";
+    case MatrixProperty::kUnsymmetric:
+      return "unsymmetric";
+  }
+  return "unknown";
+}
+
+std::string to_string(SolveReport::Status status) {
+  switch (status) {
+    case Status::kOk:
+      return "ok";
+    case Status::kSingular:
+      return "singular";
+    case Status::kNotFactorized:
+      return "not-factorized";
+    case Status::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+std::string SolveReport::brief() const {
+  std::string out =
+      fmt::format("{} n={} nnz={}: {}", to_string(used), n_rows, n_nonzeros, to_string(status));
+  if (!message.empty()) out += " (" + message + ")";
+  out += reused_analysis ? fmt::format("; analysis reused")
+                         : fmt::format("; analyse {:.3g} s", analyze_seconds);
+  out += fmt::format(", factor {:.3g} s, solve {:.3g} s", factor_seconds, solve_seconds);
+  return out;
+}
+
+struct LinearSolver::Impl {
+  SolverKind kind = SolverKind::kAuto;
+  MatrixProperty property = MatrixProperty::kSymmetricPositiveDefinite;
+  std::unique_ptr<Backend> backend;
+  // Own compressed copy of the last analysed/factorised A: the pattern to
+  // compare against, and the matrix UMFPACK reads during solve().
+  SparseMatrix matrix;
+  bool analysed = false;
+  SolveReport report;
+
+  // Starts a fresh report for `a`; false (and a kFailed report) if a is not square.
+  bool begin_report(const SparseMatrix& a) {
+    report = SolveReport{};
+    report.used = kind;
+    report.n_rows = a.rows();
+    report.n_nonzeros = a.nonZeros();
+    if (a.rows() != a.cols()) {
+      report.status = Status::kFailed;
+      report.message = fmt::format("matrix is not square ({} x {})", a.rows(), a.cols());
+      analysed = false;
+      return false;
+    }
+    return true;
+  }
+
+  // Analyses `matrix` and fills the report's analysis fields; false on failure.
+  bool analyse() {
+    const auto start = std::chrono::steady_clock::now();
+    Outcome outcome = backend->analyze(matrix);
+    report.analyze_seconds = seconds_since(start);
+    analysed = outcome.status == Status::kOk;
+    if (!analysed) {
+      report.status = outcome.status;
+      report.message = std::move(outcome.message);
+    }
+    return analysed;
+  }
+};
+
+LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property)
+    : impl_(std::make_unique<Impl>()) {
+  const bool needs_symmetry = kind == SolverKind::kCholmod || kind == SolverKind::kEigenLDLT;
+  if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
+    throw InputError(
+        fmt::format("linear solver '{}' needs a symmetric matrix, but this system is unsymmetric "
+                    "(use 'umfpack', 'eigen-lu' or 'auto')",
+                    to_string(kind)));
+  }
+  if (!solver_available(kind)) {
+    throw InputError(
+        fmt::format("linear solver '{}' is not available: this build has no SuiteSparse "
+                    "(use 'eigen-ldlt', 'eigen-lu' or 'auto')",
+                    to_string(kind)));
+  }
+  impl_->kind = kind == SolverKind::kAuto ? resolve_auto(property) : kind;
+  impl_->property = property;
+  impl_->backend = make_backend(impl_->kind);
+  impl_->report.used = impl_->kind;
+  impl_->report.message = "nothing factorised yet";
+}
+
+LinearSolver::~LinearSolver() = default;
+LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
+LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
+
+const SolveReport& LinearSolver::analyze_pattern(const SparseMatrix& a) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  Impl& im = *impl_;
+  if (!im.begin_report(a)) return im.report;
+  im.matrix = a;
+  im.matrix.makeCompressed();
+  im.analysed = false;
+  if (im.matrix.rows() == 0 || im.analyse()) {
+    im.report.status = Status::kNotFactorized;
+    im.report.message = "pattern analysed; not factorised yet";
+  }
+  return im.report;
+}
+
+const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  Impl& im = *impl_;
+  if (!im.begin_report(a)) return im.report;
+
+  SparseMatrix copy = a;
+  copy.makeCompressed();
+  const bool reuse = im.analysed && same_pattern(copy, im.matrix);
+  im.matrix = std::move(copy);
+  if (im.matrix.rows() == 0) {  // nothing to factorise; solve() returns 0 x n_rhs
+    im.analysed = false;
+    im.report.status = Status::kOk;
+    return im.report;
+  }
+
+  im.report.reused_analysis = reuse;
+  if (!reuse && !im.analyse()) return im.report;
+
+  const auto start = std::chrono::steady_clock::now();
+  Outcome outcome = im.backend->factorize(im.matrix);
+  im.report.factor_seconds = seconds_since(start);
+  im.report.status = outcome.status;
+  im.report.message = std::move(outcome.message);
+  return im.report;
+}
+
+Eigen::MatrixXd LinearSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  Impl& im = *impl_;
+  SF_ASSERT(im.report.ok(), "LinearSolver::solve() needs a successful factorize()");
+  SF_ASSERT(b.rows() == im.matrix.rows(), "right-hand side has the wrong number of rows");
+  if (!im.report.ok() || b.rows() != im.matrix.rows()) {
+    return nan_matrix(im.matrix.rows(), b.cols());
+  }
+  if (im.matrix.rows() == 0 || b.cols() == 0) return Eigen::MatrixXd(im.matrix.rows(), b.cols());
+
+  const auto start = std::chrono::steady_clock::now();
+  const Eigen::MatrixXd rhs = b;  // contiguous column-major, as the libraries expect
+  Eigen::MatrixXd x;
+  const bool solved = im.backend->solve(rhs, x);
+  im.report.solve_seconds = seconds_since(start);
+  if (!solved) {
+    im.report.status = Status::kFailed;
+    im.report.message = fmt::format("{} reported an error while solving", to_string(im.kind));
+    return nan_matrix(im.matrix.rows(), b.cols());
+  }
+  return x;
+}
+
+const SolveReport& LinearSolver::last_report() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->report;
+}
+
+SolverKind LinearSolver::kind() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->kind;
+}
+
+MatrixProperty LinearSolver::property() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->property;
+}
+
+}  // namespace sf::linalg

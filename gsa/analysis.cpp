@@ -1,0 +1,313 @@
+#include "gsa/analysis.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "common/cli/progress.hpp"
+#include "common/core/error.hpp"
+#include "common/fe/surface_field.hpp"
+#include "common/mesh/projection.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+// Calibration constants of the automatic smoothing (docs/theory/strain.md).
+constexpr double kAutoGamma = 500.0;
+constexpr double kAutoBeta = 200.0;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+struct Frame {
+  Vec3 centroid, a1, a2, normal;
+  double spread1 = 0, spread2 = 0, spread_normal = 0;
+};
+
+// Best-fit plane of the rows of `pts` (PCA), axes oriented towards +X / +Z.
+Frame best_fit_plane(const Points3& pts) {
+  Frame f;
+  f.centroid = pts.colwise().mean().transpose();
+  const MatX c = pts.rowwise() - f.centroid.transpose();
+  const Mat3 cov = (c.transpose() * c) / static_cast<double>(pts.rows());
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  f.a1 = es.eigenvectors().col(2);
+  f.a2 = es.eigenvectors().col(1);
+  f.spread1 = std::sqrt(std::max(0.0, es.eigenvalues()[2]));
+  f.spread2 = std::sqrt(std::max(0.0, es.eigenvalues()[1]));
+  f.spread_normal = std::sqrt(std::max(0.0, es.eigenvalues()[0]));
+  // Deterministic, intuitive orientation: a1 towards +X (else +Y), normal towards +Z.
+  const Vec3 ref = std::abs(f.a1.x()) > 1e-3 ? Vec3::UnitX() : Vec3::UnitY();
+  if (f.a1.dot(ref) < 0) f.a1 = -f.a1;
+  f.normal = f.a1.cross(f.a2);
+  if (f.normal.z() < 0 || (std::abs(f.normal.z()) < 1e-12 && f.normal.y() < 0)) {
+    f.a2 = -f.a2;
+    f.normal = -f.normal;
+  }
+  return f;
+}
+
+// Marks per element: ~9 for a few hundred marks, growing slowly for dense grids
+// (fit-feasibility study: 21x21 marks -> 6-9 elements a side; 1e5 marks -> 20-50).
+void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int& n2) {
+  const double per_element = 9.0 * std::pow(std::max(1.0, n_marks / 441.0), 0.27);
+  const double total = std::max(1.0, n_marks / per_element);
+  n1 = std::max(1, static_cast<int>(std::lround(std::sqrt(total * len1 / len2))));
+  n2 = std::max(1, static_cast<int>(std::lround(total / n1)));
+  n1 = std::min(n1, 300);
+  n2 = std::min(n2, 300);
+}
+
+}  // namespace
+
+void AnalyseOptions::validate() const {
+  if (elements1 < 0 || elements2 < 0) throw UsageError("--elements: expected NxM with positive counts");
+  for (const auto* v : {&alpha, &beta, &gamma})
+    if (*v && !(**v >= 0.0)) throw UsageError("--alpha/--beta/--gamma: smoothing weights must be >= 0");
+  if (!(smoothing_scale > 0.0)) throw UsageError("--smoothing-scale: must be > 0");
+  if (!(outlier_sigma > 0.0)) throw UsageError("--outlier-sigma: must be > 0");
+  if (sample < 0 || sample > 50) throw UsageError("--sample: expected 0..50 points per element side");
+  if (fibre_angles.size() == 1 || fibre_angles.size() > 2)
+    throw UsageError("--fibres: expected two angles in degrees, e.g. --fibres 0,90");
+}
+
+AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
+  options.validate();
+  if (options.method == Method::kTriangles) return analyse_triangles(grid, options);
+  AnalysisResult res;
+  res.method = Method::kSurface;
+  res.penalty_kind = options.penalty;
+  const Index n = grid.n_points();
+  res.points.resize(n);
+
+  // --- Marks usable for the undeformed fit.
+  std::vector<Index> used;
+  for (Index p = 0; p < n; ++p) {
+    if (grid.has_undeformed(p))
+      used.push_back(p);
+    else
+      res.points[p].status = kStatusMissingUndeformed;
+  }
+  if (used.size() < 6)
+    throw InputError(grid.sources.front() + ": only " + std::to_string(used.size()) +
+                     " points have an undeformed position; at least 6 are needed for a surface fit");
+  const Index m = static_cast<Index>(used.size());
+  Points3 X(m, 3);
+  for (Index k = 0; k < m; ++k) X.row(k) = grid.undeformed.row(used[k]);
+
+  // --- Frame and automatic mesh.
+  auto t0 = Clock::now();
+  const Frame frame = best_fit_plane(X);
+  if (!(frame.spread2 > 1e-6 * frame.spread1))
+    throw InputError(grid.sources.front() +
+                     ": the undeformed points lie on a line (or coincide); a surface cannot be fitted");
+  Eigen::MatrixX2d st(m, 2);
+  for (Index k = 0; k < m; ++k) {
+    const Vec3 d = X.row(k).transpose() - frame.centroid;
+    st(k, 0) = d.dot(frame.a1);
+    st(k, 1) = d.dot(frame.a2);
+  }
+  const Eigen::Vector2d lo = st.colwise().minCoeff(), hi = st.colwise().maxCoeff();
+  const double margin = 1e-6 * (hi - lo).maxCoeff();
+  const Eigen::Vector2d lo_m = lo.array() - margin, len = (hi - lo).array() + 2 * margin;
+  int n1 = options.elements1, n2 = options.elements2;
+  if (n1 == 0 || n2 == 0) choose_element_counts(m, len[0], len[1], n1, n2);
+  res.elements1 = n1;
+  res.elements2 = n2;
+  res.centroid = frame.centroid;
+  res.axis1 = frame.a1;
+  res.axis2 = frame.a2;
+  const Vec3 origin = frame.centroid + lo_m[0] * frame.a1 + lo_m[1] * frame.a2;
+  const mesh::SurfaceMesh full =
+      mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2);
+  std::vector<MeshLocation> loc_full(m);
+  std::vector<bool> keep(full.n_elements(), false);
+  for (Index k = 0; k < m; ++k) {
+    const double u = (st(k, 0) - lo_m[0]) / len[0] * n1, v = (st(k, 1) - lo_m[1]) / len[1] * n2;
+    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
+    const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
+    loc_full[k].element = static_cast<Index>(j) * n1 + i;
+    loc_full[k].xi = Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0));
+    keep[loc_full[k].element] = true;
+  }
+  std::vector<Index> emap;
+  res.mesh = mesh::extract_elements(full, keep, &emap);
+  std::vector<MeshLocation> loc(m);
+  for (Index k = 0; k < m; ++k) loc[k] = {emap[loc_full[k].element], loc_full[k].xi};
+  const mesh::SurfaceMesh& mesh = res.mesh;
+  res.mark_spacing = std::sqrt(len[0] * len[1] * static_cast<double>(mesh.n_elements()) /
+                               (static_cast<double>(n1) * n2) / static_cast<double>(m));
+  const PenaltyMatrices penalties = assemble_penalties(mesh);
+  res.times.mesh = seconds_since(t0);
+
+  // --- Smoothing weights. Automatic: from the estimated noise (see docs/theory/strain.md).
+  const double d = res.mark_spacing;
+  auto penalty_for_noise = [&](double sigma) {
+    Penalty p;
+    const double ratio = std::max(sigma / d, 1e-6);
+    if (options.penalty == PenaltyKind::kThirdOrder) {
+      p.gamma = options.smoothing_scale * kAutoGamma * std::pow(d, 4) * std::pow(ratio, 1.2) + 1e-8 * std::pow(d, 4);
+      p.beta = 0.0;
+    } else {
+      p.beta = options.smoothing_scale * kAutoBeta * std::pow(d, 2) * ratio + 1e-8 * d * d;
+    }
+    return p;
+  };
+  auto explicit_penalty = [&](Penalty p) {
+    if (options.alpha) p.alpha = *options.alpha;
+    if (options.beta) p.beta = *options.beta;
+    if (options.gamma) p.gamma = *options.gamma;
+    return p;
+  };
+  const bool automatic = !options.alpha && !options.beta && !options.gamma;
+  res.smoothing_automatic = automatic;
+
+  // --- Undeformed fit alternating with projection; outliers flagged.
+  VecX w_u = VecX::Ones(m);
+  FitResult fit_u;
+  Penalty pen_u = automatic ? penalty_for_noise(0.0) : explicit_penalty(Penalty{});
+  double fit_time = 0.0, project_time = 0.0;
+  for (int outer = 0; outer < 2; ++outer) {
+    for (int it = 0; it < std::max(1, options.max_projection_iterations); ++it) {
+      auto tf = Clock::now();
+      const linalg::SparseMatrix phi = collocation_matrix(mesh, loc);
+      fit_u = fit_field(mesh, phi, X, w_u, penalties.combined(pen_u), mesh.geometry());
+      fit_time += seconds_since(tf);
+      if (!fit_u.ok) throw InputError(grid.sources.front() + ": " + fit_u.message);
+      res.projection_iterations = it + 1;
+      auto tp = Clock::now();
+      const mesh::SurfaceProjector projector(mesh, fit_u.parameters);
+      const std::vector<mesh::Projection> proj = projector.project_all(X);
+      double max_dxi = 0.0;
+      for (Index k = 0; k < m; ++k) {
+        if (!proj[k].ok()) continue;
+        if (proj[k].element == loc[k].element) max_dxi = std::max(max_dxi, (proj[k].xi - loc[k].xi).norm());
+        else max_dxi = 1.0;
+        loc[k] = {proj[k].element, proj[k].xi};
+      }
+      project_time += seconds_since(tp);
+      if (max_dxi < 1e-7) break;
+    }
+    // Outliers of the undeformed fit.
+    std::vector<double> r;
+    for (Index k = 0; k < m; ++k)
+      if (w_u[k] > 0) r.push_back(fit_u.residual[k]);
+    const double sigma = median(r) / 1.54;  // median of a 3-D Gaussian residual norm ~ 1.54 sigma
+    bool changed = false;
+    for (Index k = 0; k < m; ++k)
+      if (w_u[k] > 0 && fit_u.residual[k] > std::max(options.outlier_sigma * sigma, 0.02 * d)) {
+        w_u[k] = 0.0;
+        changed = true;
+      }
+    if (automatic) {
+      // Noise estimate from the light fit, corrected for the fitted degrees of freedom.
+      const double n_used = w_u.sum();
+      const double dofs = static_cast<double>(mesh.n_dofs());
+      double rss = 0.0;
+      for (Index k = 0; k < m; ++k)
+        if (w_u[k] > 0) rss += fit_u.residual[k] * fit_u.residual[k];
+      if (outer == 0 && n_used > 1.2 * dofs) {
+        res.noise_estimate = std::sqrt(rss / (3.0 * (n_used - dofs)));
+        pen_u = penalty_for_noise(res.noise_estimate);
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  for (Index k = 0; k < m; ++k)
+    if (w_u[k] <= 0) res.points[used[k]].status = kStatusOutlierUndeformed;
+  res.undeformed_parameters = fit_u.parameters;
+  res.rms_undeformed = fit_u.rms;
+  res.max_undeformed = fit_u.max;
+  res.penalty_undeformed = pen_u;
+
+  // --- Deformed fit on the same xi, smoothing the displacement.
+  Points3 x(m, 3);
+  VecX w_d = VecX::Zero(m);
+  for (Index k = 0; k < m; ++k) {
+    const Index p = used[k];
+    x.row(k) = grid.deformed.row(p);
+    if (w_u[k] > 0 && grid.has_deformed(p)) w_d[k] = 1.0;
+    if (!grid.has_deformed(p) && w_u[k] > 0) res.points[p].status = kStatusMissingDeformed;
+  }
+  if (w_d.sum() < 6)
+    throw InputError(grid.sources.front() + ": only " + std::to_string(static_cast<long>(w_d.sum())) +
+                     " points have both positions; at least 6 are needed");
+  Penalty pen_d = automatic ? penalty_for_noise(res.noise_estimate) : explicit_penalty(Penalty{});
+  res.penalty_deformed = pen_d;
+  auto tf = Clock::now();
+  const linalg::SparseMatrix phi = collocation_matrix(mesh, loc);
+  const linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
+  FitResult fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
+  if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
+  {
+    std::vector<double> r;
+    for (Index k = 0; k < m; ++k)
+      if (w_d[k] > 0) r.push_back(fit_d.residual[k]);
+    const double sigma = median(r) / 1.54;
+    bool changed = false;
+    for (Index k = 0; k < m; ++k)
+      if (w_d[k] > 0 && fit_d.residual[k] > std::max(options.outlier_sigma * sigma, 0.02 * d)) {
+        w_d[k] = 0.0;
+        res.points[used[k]].status = kStatusOutlierDeformed;
+        changed = true;
+      }
+    if (changed) fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
+    if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
+  }
+  fit_time += seconds_since(tf);
+  res.deformed_parameters = fit_d.parameters;
+  res.rms_deformed = fit_d.rms;
+  res.max_deformed = fit_d.max;
+  res.times.fit = fit_time;
+  res.times.project = project_time;
+  const double rho = 1.0 / (d * d);
+  res.gauge_length = options.penalty == PenaltyKind::kThirdOrder
+                         ? std::pow(std::max(pen_d.gamma, 0.0) / rho, 1.0 / 6.0)
+                         : std::pow(std::max(pen_d.beta, 0.0) / rho, 0.25);
+
+  // --- Strains at the marks.
+  auto ts = Clock::now();
+  const fe::SurfaceField fu(mesh, res.undeformed_parameters), fd(mesh, res.deformed_parameters);
+  for (Index k = 0; k < m; ++k) {
+    PointResult& pr = res.points[used[k]];
+    pr.element = loc[k].element;
+    pr.xi = loc[k].xi;
+    pr.residual_undeformed = fit_u.residual[k];
+    if (pr.status != kStatusOk) continue;
+    pr.residual = fit_d.residual[k];
+    const auto b = basis::BicubicHermite::evaluate(loc[k].xi, basis::kFirst);
+    const fe::SurfacePoint pu = fu.evaluate3(loc[k].element, b), pd = fd.evaluate3(loc[k].element, b);
+    pr.strain = surface_strain(pu.dx, pd.dx);
+    if (!pr.strain) {
+      pr.status = kStatusDegenerate;
+      continue;
+    }
+    if (options.fibre_angles.size() == 2) {
+      for (double angle : options.fibre_angles) {
+        const auto a0 = tangent_at_angle(pu.dx, Vec3::UnitX(), angle);
+        const auto fs = a0 ? fibre_state(pu.dx, pd.dx, *a0) : std::nullopt;
+        pr.fibres.push_back(fs ? FibreResult{fs->direction_deformed, fs->stretch} : FibreResult{});
+      }
+      const double initial = std::abs(options.fibre_angles[1] - options.fibre_angles[0]);
+      const double c = std::clamp(pr.fibres[0].direction.dot(pr.fibres[1].direction), -1.0, 1.0);
+      pr.shear_angle_deg = initial - std::acos(c) * 180.0 / 3.14159265358979323846;
+    }
+  }
+  res.times.strain = seconds_since(ts);
+  return res;
+}
+
+}  // namespace sf::gsa

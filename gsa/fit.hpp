@@ -1,0 +1,82 @@
+#pragma once
+// Penalised least-squares fit of a field on a bicubic Hermite surface mesh
+// (BRIEF.md §1, "Fitting by penalised least squares").
+//
+// For data points d at fixed locations (element e_d, xi_d) with values z_d
+// (n_points x n_components) the fit minimises, per component,
+//
+//   sum_d w_d (u(xi_d) - z_d)^2  +  (U - U_ref)^T P (U - U_ref)
+//
+// where P is the assembled smoothing penalty and U_ref a reference field (the
+// smoothing acts on the DEVIATION from U_ref: the displacement when U_ref is the
+// fitted undeformed surface, so the smoothing does not shrink the part).
+//
+// Penalty, in PHYSICAL units (derivatives by arc length, approximated on each
+// element by xi-derivatives divided by the element's sizes h1, h2 = its mean
+// scale factors), so the weights mean the same after mesh refinement:
+//
+//   alpha * int |u,s|^2            (first derivatives; stretches the surface)
+// + beta  * int |u,s1s1|^2 + 2|u,s1s2|^2 + |u,s2s2|^2          (curvature, the brief's)
+// + gamma * [ int |u,sss|^2 (1, 3, 3, 1 weights)
+//             + sum over interior edges int_edge [u,nn]^2 ds / h_n ]   (third order)
+//
+// The third-order term leaves quadratic fields unpenalised, so it does not force
+// zero curvature at free edges (the boundary bias of the beta term); the edge
+// term penalises the jump of the normal second derivative across element edges,
+// which bicubic C1 elements allow. 4x4 Gauss points per element (exact in xi).
+// Units: with lengths in mm, alpha is dimensionless * mm^0, beta mm^2,
+// gamma mm^4 per unit data weight (all relative to the data term per point).
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/linalg/sparse.hpp"
+#include "common/mesh/surface_mesh.hpp"
+
+namespace sf::gsa {
+
+struct Penalty {
+  double alpha = 0.0;
+  double beta = 0.0;
+  double gamma = 0.0;
+};
+
+// Location of a data point on the mesh.
+struct MeshLocation {
+  Index element = -1;
+  Vec2 xi = Vec2::Zero();
+};
+
+// Penalty matrices of each order (n_dofs x n_dofs, symmetric PSD), assembled once
+// and combined with weights later (automatic smoothing tries several).
+struct PenaltyMatrices {
+  linalg::SparseMatrix first, second, third;
+  linalg::SparseMatrix combined(const Penalty& p) const;
+};
+PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
+
+// Sparse collocation matrix Phi (n_points x n_dofs): row d holds the global basis
+// at (e_d, xi_d), so u(xi_d) = Phi U.
+linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
+                                        const std::vector<MeshLocation>& locations);
+
+struct FitResult {
+  MatX parameters;   // n_dofs x n_components
+  MatX fitted;       // n_points x n_components: u(xi_d)
+  VecX residual;     // n_points: |u(xi_d) - z_d|
+  double rms = 0.0;  // RMS of residual over points with weight > 0
+  double max = 0.0;
+  bool ok = false;
+  std::string message;
+};
+
+// Solves the fit. `weights` (n_points, >= 0; 0 excludes a point) may be empty
+// (all 1). `reference` is U_ref (n_dofs x n_components). Dofs no element uses are
+// pinned to the reference.
+FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
+                    const Eigen::Ref<const MatX>& values, const VecX& weights,
+                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference);
+
+}  // namespace sf::gsa

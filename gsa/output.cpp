@@ -1,0 +1,289 @@
+#include "gsa/output.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include "common/core/error.hpp"
+#include "common/fe/surface_field.hpp"
+#include "common/io/atomic_file.hpp"
+#include "common/io/csv.hpp"
+#include "common/io/json.hpp"
+#include "common/io/vtk_xml.hpp"
+
+namespace sf::gsa {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const char* method_name(Method m) { return m == Method::kSurface ? "surface" : "triangles"; }
+
+// All per-point scalar fields derived from a strain (NaN when absent).
+struct Fields {
+  double lambda1 = kNaN, lambda2 = kNaN, e1 = kNaN, e2 = kNaN, eng1 = kNaN, eng2 = kNaN, true1 = kNaN,
+         true2 = kNaN, thick = kNaN;
+  Vec3 dir1 = Vec3::Constant(kNaN), dir2 = Vec3::Constant(kNaN), dir1u = Vec3::Constant(kNaN),
+       dir2u = Vec3::Constant(kNaN);
+};
+Fields fields_of(const std::optional<SurfaceStrain>& s) {
+  Fields f;
+  if (!s) return f;
+  f.lambda1 = s->lambda1;
+  f.lambda2 = s->lambda2;
+  f.e1 = s->green(0);
+  f.e2 = s->green(1);
+  f.eng1 = s->engineering(0);
+  f.eng2 = s->engineering(1);
+  f.true1 = s->true_strain(0);
+  f.true2 = s->true_strain(1);
+  f.thick = s->thickness_change_pct();
+  f.dir1 = s->dir1_deformed;
+  f.dir2 = s->dir2_deformed;
+  f.dir1u = s->dir1_undeformed;
+  f.dir2u = s->dir2_undeformed;
+  return f;
+}
+
+nlohmann::json range_of(const std::vector<double>& v) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double x : v)
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  if (!std::isfinite(lo)) return nullptr;
+  return {{"min", lo}, {"max", hi}};
+}
+}  // namespace
+
+std::vector<std::string> strain_columns(const AnalyseOptions& options) {
+  std::vector<std::string> c = {"id",      "status",  "element", "xi1",    "xi2",    "lambda1", "lambda2",
+                                "E1",      "E2",      "eng1",    "eng2",   "true1",  "true2",
+                                "thickness_change_pct", "dir1_x", "dir1_y", "dir1_z", "dir2_x", "dir2_y",
+                                "dir2_z",  "dir1u_x", "dir1u_y", "dir1u_z", "residual", "residual_undeformed",
+                                "X_fit",   "Y_fit",   "Z_fit"};
+  if (options.fibre_angles.size() == 2) {
+    for (const char* f : {"fibre1", "fibre2"})
+      for (const char* s : {"_x", "_y", "_z", "_stretch"}) c.push_back(std::string(f) + s);
+    c.push_back("shear_angle_deg");
+  }
+  return c;
+}
+
+void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
+                       const AnalyseOptions& options) {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write");
+  out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
+      << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
+      << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
+      << options.units << "); thickness by incompressibility; method " << method_name(result.method) << "\n";
+  io::CsvWriter w(out, strain_columns(options));
+  std::unique_ptr<fe::SurfaceField> fu;
+  if (result.method == Method::kSurface) fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
+  for (Index p = 0; p < grid.n_points(); ++p) {
+    const PointResult& pr = result.points[p];
+    const Fields f = fields_of(pr.strain);
+    w.begin_row().add(grid.ids[p]).add(pr.status);
+    if (pr.element >= 0) w.add(pr.element).add(pr.xi[0]).add(pr.xi[1]);
+    else w.add(kNaN).add(kNaN).add(kNaN);
+    w.add(f.lambda1).add(f.lambda2).add(f.e1).add(f.e2).add(f.eng1).add(f.eng2).add(f.true1).add(f.true2).add(f.thick);
+    for (const Vec3* v : {&f.dir1, &f.dir2, &f.dir1u}) w.add((*v)[0]).add((*v)[1]).add((*v)[2]);
+    w.add(pr.residual).add(pr.residual_undeformed);
+    Vec3 xf = Vec3::Constant(kNaN);
+    if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
+    w.add(xf[0]).add(xf[1]).add(xf[2]);
+    if (options.fibre_angles.size() == 2) {
+      for (int k = 0; k < 2; ++k) {
+        if (pr.fibres.size() == 2 && pr.strain)
+          w.add(pr.fibres[k].direction[0]).add(pr.fibres[k].direction[1]).add(pr.fibres[k].direction[2]).add(pr.fibres[k].stretch);
+        else
+          w.add(kNaN).add(kNaN).add(kNaN).add(kNaN);
+      }
+      w.add(pr.strain ? pr.shear_angle_deg : kNaN);
+    }
+    w.end_row();
+  }
+  if (!out) throw Error(path + ": write failed");
+}
+
+nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const AnalyseOptions& options,
+                            const RunInfo& info) {
+  nlohmann::json j;
+  j["tool"] = "gsa analyse";
+  j["version"] = SF_VERSION;
+  j["command_line"] = info.command_line;
+  j["inputs"] = info.inputs;
+  j["units"] = {{"length", options.units}, {"strain", "dimensionless"}, {"thickness_change", "percent"},
+                {"angles", "degrees"}};
+  std::map<std::string, Index> counts;
+  std::vector<double> e1, e2, th, eng1, eng2, shear;
+  for (const PointResult& p : r.points) {
+    ++counts[p.status];
+    if (!p.strain) continue;
+    e1.push_back(p.strain->green(0));
+    e2.push_back(p.strain->green(1));
+    eng1.push_back(p.strain->engineering(0));
+    eng2.push_back(p.strain->engineering(1));
+    th.push_back(p.strain->thickness_change_pct());
+    shear.push_back(p.shear_angle_deg);
+  }
+  j["counts"] = {{"points", grid.n_points()}, {"by_status", counts}};
+  nlohmann::json params;
+  params["method"] = method_name(r.method);
+  if (r.method == Method::kSurface) {
+    params["mesh"] = {{"elements", r.mesh.n_elements()},
+                      {"grid", std::to_string(r.elements1) + "x" + std::to_string(r.elements2)},
+                      {"nodes", r.mesh.n_nodes()},
+                      {"unknowns_per_coordinate", r.mesh.n_dofs()},
+                      {"element_type", "bicubic Hermite, arc-length scale factors"},
+                      {"plane_origin", {r.centroid[0], r.centroid[1], r.centroid[2]}},
+                      {"plane_axis1", {r.axis1[0], r.axis1[1], r.axis1[2]}},
+                      {"plane_axis2", {r.axis2[0], r.axis2[1], r.axis2[2]}}};
+    params["penalty"] = r.penalty_kind == PenaltyKind::kThirdOrder ? "third-order (gamma) with edge jumps"
+                                                                   : "sobolev (alpha, beta)";
+    params["smoothing_automatic"] = r.smoothing_automatic;
+    params["undeformed"] = {{"alpha", r.penalty_undeformed.alpha}, {"beta", r.penalty_undeformed.beta},
+                            {"gamma", r.penalty_undeformed.gamma}};
+    params["deformed"] = {{"alpha", r.penalty_deformed.alpha}, {"beta", r.penalty_deformed.beta},
+                          {"gamma", r.penalty_deformed.gamma}, {"smooths", "displacement"}};
+    params["noise_estimate"] = r.noise_estimate;
+    params["mark_spacing"] = r.mark_spacing;
+    params["gauge_length"] = r.gauge_length;
+    params["projection_iterations"] = r.projection_iterations;
+    params["outlier_sigma"] = options.outlier_sigma;
+    j["fit"] = {{"undeformed", {{"rms_residual", r.rms_undeformed}, {"max_residual", r.max_undeformed}}},
+                {"deformed", {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}}}};
+  } else {
+    params["triangles"] = r.n_triangles;
+  }
+  if (!options.fibre_angles.empty()) params["fibre_angles_deg"] = options.fibre_angles;
+  j["parameters"] = params;
+  j["strain_ranges"] = {{"E1", range_of(e1)}, {"E2", range_of(e2)}, {"eng1", range_of(eng1)},
+                        {"eng2", range_of(eng2)}, {"thickness_change_pct", range_of(th)}};
+  if (options.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
+  j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh}, {"project", r.times.project},
+                    {"fit", r.times.fit}, {"strain", r.times.strain}, {"write", r.times.write}};
+  j["warnings"] = r.warnings;
+  return j;
+}
+
+void write_surface_vtp(const std::string& path, const AnalysisResult& r, const AnalyseOptions& options,
+                       bool deformed, int subdiv) {
+  io::PolyMesh pm;
+  const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
+  const Index ne = r.mesh.n_elements();
+  const int np = subdiv + 1;
+  pm.points.resize(ne * np * np, 3);
+  std::vector<std::string> names = {"E1", "E2", "eng1", "eng2", "true1", "true2", "thickness_change_pct",
+                                    "lambda1", "lambda2"};
+  std::vector<io::FieldArray> scalars(names.size());
+  for (std::size_t k = 0; k < names.size(); ++k) scalars[k] = {names[k], 1, {}};
+  io::FieldArray dir1{"dir1", 3, {}}, dir2{"dir2", 3, {}}, disp{"displacement", 3, {}}, shear{"shear_angle_deg", 1, {}};
+  io::FieldArray f1{"fibre1", 3, {}}, f2{"fibre2", 3, {}}, s1{"fibre1_stretch", 1, {}}, s2{"fibre2_stretch", 1, {}};
+  const bool fibres = options.fibre_angles.size() == 2;
+  Index pt = 0;
+  for (Index e = 0; e < ne; ++e) {
+    for (int j = 0; j < np; ++j)
+      for (int i = 0; i < np; ++i, ++pt) {
+        const Vec2 xi(static_cast<double>(i) / subdiv, static_cast<double>(j) / subdiv);
+        const auto b = basis::BicubicHermite::evaluate(xi, basis::kValues | basis::kFirst);
+        const fe::SurfacePoint pu = fu.evaluate3(e, b), pd = fd.evaluate3(e, b);
+        pm.points.row(pt) = (deformed ? pd.x : pu.x).transpose();
+        const auto s = surface_strain(pu.dx, pd.dx);
+        const Fields f = fields_of(s);
+        const double vals[] = {f.e1, f.e2, f.eng1, f.eng2, f.true1, f.true2, f.thick, f.lambda1, f.lambda2};
+        for (std::size_t k = 0; k < names.size(); ++k) scalars[k].values.push_back(vals[k]);
+        const Vec3& d1 = deformed ? f.dir1 : f.dir1u;
+        const Vec3& d2 = deformed ? f.dir2 : f.dir2u;
+        for (int c = 0; c < 3; ++c) {
+          dir1.values.push_back(d1[c]);
+          dir2.values.push_back(d2[c]);
+          disp.values.push_back(pd.x[c] - pu.x[c]);
+        }
+        if (fibres) {
+          Vec3 a[2] = {Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
+          double st[2] = {kNaN, kNaN};
+          for (int k = 0; k < 2; ++k) {
+            const auto a0 = tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[k]);
+            const auto fs = a0 ? fibre_state(pu.dx, pd.dx, *a0) : std::nullopt;
+            if (fs) {
+              a[k] = deformed ? fs->direction_deformed : *a0;
+              st[k] = fs->stretch;
+              if (!deformed) a[k] = *a0;
+              if (deformed) a[k] = fs->direction_deformed;
+            }
+          }
+          double ang = kNaN;
+          if (a[0].allFinite() && a[1].allFinite()) {
+            const auto fs0 = fibre_state(pu.dx, pd.dx, *tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[0]));
+            const auto fs1 = fibre_state(pu.dx, pd.dx, *tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[1]));
+            if (fs0 && fs1)
+              ang = std::abs(options.fibre_angles[1] - options.fibre_angles[0]) -
+                    std::acos(std::clamp(fs0->direction_deformed.dot(fs1->direction_deformed), -1.0, 1.0)) * 180.0 /
+                        3.14159265358979323846;
+          }
+          for (int c = 0; c < 3; ++c) {
+            f1.values.push_back(a[0][c]);
+            f2.values.push_back(a[1][c]);
+          }
+          s1.values.push_back(st[0]);
+          s2.values.push_back(st[1]);
+          shear.values.push_back(ang);
+        }
+      }
+    const Index base = e * np * np;
+    for (int j = 0; j < subdiv; ++j)
+      for (int i = 0; i < subdiv; ++i) {
+        const Index a = base + j * np + i;
+        pm.polygons.push_back({a, a + 1, a + np + 1, a + np});
+      }
+  }
+  for (auto& s : scalars) pm.point_data.push_back(std::move(s));
+  pm.point_data.push_back(std::move(dir1));
+  pm.point_data.push_back(std::move(dir2));
+  pm.point_data.push_back(std::move(disp));
+  if (fibres) {
+    for (auto* f : {&f1, &f2, &s1, &s2, &shear}) pm.point_data.push_back(std::move(*f));
+  }
+  io::FieldArray elem{"element", 1, {}};
+  for (Index e = 0; e < ne; ++e)
+    for (int k = 0; k < subdiv * subdiv; ++k) elem.values.push_back(static_cast<double>(e));
+  pm.cell_data.push_back(std::move(elem));
+  io::write_vtp(path, pm);
+}
+
+void write_samples_csv(const std::string& path, const AnalysisResult& r, const AnalyseOptions& options) {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot write");
+  out << "# gsa fields on a regular xi sampling (" << options.sample << " x " << options.sample
+      << " per element); positions in " << options.units << "\n";
+  io::CsvWriter w(out, {"element", "xi1", "xi2", "X", "Y", "Z", "x", "y", "z", "E1", "E2", "thickness_change_pct",
+                        "dir1_x", "dir1_y", "dir1_z"});
+  const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
+  const int ns = options.sample;
+  for (Index e = 0; e < r.mesh.n_elements(); ++e)
+    for (int j = 0; j < ns; ++j)
+      for (int i = 0; i < ns; ++i) {
+        const Vec2 xi((i + 0.5) / ns, (j + 0.5) / ns);
+        const auto b = basis::BicubicHermite::evaluate(xi, basis::kValues | basis::kFirst);
+        const fe::SurfacePoint pu = fu.evaluate3(e, b), pd = fd.evaluate3(e, b);
+        const Fields f = fields_of(surface_strain(pu.dx, pd.dx));
+        w.begin_row().add(e).add(xi[0]).add(xi[1]).add(pu.x[0]).add(pu.x[1]).add(pu.x[2]).add(pd.x[0]).add(pd.x[1]).add(pd.x[2]);
+        w.add(f.e1).add(f.e2).add(f.thick).add(f.dir1[0]).add(f.dir1[1]).add(f.dir1[2]);
+        w.end_row();
+      }
+}
+
+void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
+                   const AnalyseOptions& options, const RunInfo& info) {
+  const auto t0 = std::chrono::steady_clock::now();
+  write_strains_csv(out.path("strains.csv"), grid, result, options);
+  if (result.method == Method::kSurface) {
+    write_surface_vtp(out.path("undeformed.vtp"), result, options, false);
+    write_surface_vtp(out.path("deformed.vtp"), result, options, true);
+    if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
+  }
+  result.times.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  io::write_json(out.path("summary.json"), make_summary(grid, result, options, info));
+}
+
+}  // namespace sf::gsa

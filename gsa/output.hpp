@@ -1,0 +1,40 @@
+#pragma once
+// Writing the results of `gsa analyse` (CONTRACT.md): strains.csv, summary.json,
+// undeformed.vtp, deformed.vtp and, with --sample, samples.csv. Everything is
+// written into a temporary folder and moved into place only when all succeeded.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "gsa/analysis.hpp"
+#include "gsa/grid.hpp"
+
+namespace sf::io {
+class AtomicOutputDir;
+}
+
+namespace sf::gsa {
+
+struct RunInfo {
+  std::string command_line;
+  std::vector<std::string> inputs;
+};
+
+// Column names of strains.csv, in order.
+std::vector<std::string> strain_columns(const AnalyseOptions& options);
+
+void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
+                       const AnalyseOptions& options);
+nlohmann::json make_summary(const GridData& grid, const AnalysisResult& result, const AnalyseOptions& options,
+                            const RunInfo& info);
+// Tessellated fitted surfaces (subdiv x subdiv quads per element) with the strain
+// fields as point data; `deformed` selects the surface.
+void write_surface_vtp(const std::string& path, const AnalysisResult& result, const AnalyseOptions& options,
+                       bool deformed, int subdiv = 8);
+void write_samples_csv(const std::string& path, const AnalysisResult& result, const AnalyseOptions& options);
+
+// Writes everything into `out` (not committed here).
+void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
+                   const AnalyseOptions& options, const RunInfo& info);
+
+}  // namespace sf::gsa

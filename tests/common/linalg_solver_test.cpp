@@ -1,0 +1,430 @@
+// Tests for common/linalg: TripletAssembler, empty_rows and LinearSolver on
+// every back end. Systems: the 5-point Laplacian on an m x m grid (SPD when
+// shifted by +s, indefinite for s = -1) and a central-difference
+// convection-diffusion operator (unsymmetric M-matrix).
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/core/error.hpp"
+#include "common/linalg/solver.hpp"
+#include "common/linalg/sparse.hpp"
+
+namespace sf::linalg {
+namespace {
+
+constexpr double kResidualTolerance = 1e-10;  // ||A x - b|| / ||b|| per column
+constexpr int kGridSize = 30;                 // 30 x 30 grid -> n = 900
+constexpr int kNumRhs = 4;
+constexpr unsigned kSeed = 20240611;
+
+const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto, SolverKind::kCholmod,
+                                           SolverKind::kUmfpack, SolverKind::kEigenLDLT,
+                                           SolverKind::kEigenLU};
+const std::vector<SolverKind> kLuKinds = {SolverKind::kAuto, SolverKind::kUmfpack,
+                                          SolverKind::kEigenLU};
+
+// Grid node (ix, iy) -> row; -1 outside the grid (Dirichlet boundary) or for
+// the node `skip` (a DOF no element touches).
+Index grid_dof(int m, int ix, int iy, Index skip = -1) {
+  if (ix < 0 || iy < 0 || ix >= m || iy >= m) return -1;
+  const Index dof = static_cast<Index>(iy) * m + ix;
+  return dof == skip ? -1 : dof;
+}
+
+// 5-point stencil on an m x m grid (scaled by h^2): diagonal 4 + shift, and
+// -1 - c_d to the neighbour in direction d. c = 0 gives the symmetric
+// Laplacian; c_east = -c_west != 0 gives convection. Assembled per node with
+// add_block so negative (boundary) columns are skipped by the assembler.
+SparseMatrix stencil_2d(int m, double shift, double c_x = 0.0, double c_y = 0.0, Index skip = -1) {
+  const Index n = static_cast<Index>(m) * m;
+  TripletAssembler assembler(n, n);
+  assembler.reserve(5 * n);
+  for (int iy = 0; iy < m; ++iy) {
+    for (int ix = 0; ix < m; ++ix) {
+      const std::vector<Index> row = {grid_dof(m, ix, iy, skip)};
+      const std::vector<Index> cols = {grid_dof(m, ix, iy, skip), grid_dof(m, ix + 1, iy, skip),
+                                       grid_dof(m, ix - 1, iy, skip), grid_dof(m, ix, iy + 1, skip),
+                                       grid_dof(m, ix, iy - 1, skip)};
+      Eigen::RowVectorXd values(5);
+      values << 4.0 + shift, -1.0 + c_x, -1.0 - c_x, -1.0 + c_y, -1.0 - c_y;
+      assembler.add_block(row, cols, values);
+    }
+  }
+  return assembler.compress();
+}
+
+SparseMatrix laplacian_2d(int m, double shift) { return stencil_2d(m, shift); }
+
+// -Laplace(u) + (b_x, b_y) . grad(u) with central differences, h = 1/(m+1);
+// cell Peclet number below 1 keeps it an M-matrix (nonsingular).
+SparseMatrix convection_diffusion_2d(int m, double b_x, double b_y) {
+  const double h = 1.0 / (m + 1);
+  return stencil_2d(m, 0.0, 0.5 * h * b_x, 0.5 * h * b_y);
+}
+
+Eigen::MatrixXd random_rhs(Index n, int n_rhs, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> dist(-1.0, 1.0);
+  Eigen::MatrixXd b(n, n_rhs);
+  for (Eigen::Index j = 0; j < b.cols(); ++j) {
+    for (Eigen::Index i = 0; i < b.rows(); ++i) b(i, j) = dist(gen);
+  }
+  return b;
+}
+
+// Largest ||A x_j - b_j|| / ||b_j|| over the columns.
+double max_relative_residual(const SparseMatrix& a, const Eigen::MatrixXd& x,
+                             const Eigen::MatrixXd& b) {
+  const Eigen::MatrixXd r = a * x - b;
+  double worst = 0.0;
+  for (Eigen::Index j = 0; j < b.cols(); ++j) {
+    worst = std::max(worst, r.col(j).norm() / b.col(j).norm());
+  }
+  return worst;
+}
+
+// Factorises a, solves kNumRhs right-hand sides at once, checks the residual
+// and records it (console and XML) under `label`.
+void expect_solves(LinearSolver& solver, const SparseMatrix& a, const std::string& label) {
+  const SolveReport& report = solver.factorize(a);
+  ASSERT_TRUE(report.ok()) << label << ": " << report.brief();
+  const Eigen::MatrixXd b = random_rhs(a.rows(), kNumRhs, kSeed);
+  const Eigen::MatrixXd x = solver.solve(b);
+  ASSERT_EQ(x.rows(), a.rows());
+  ASSERT_EQ(x.cols(), kNumRhs);
+  const double residual = max_relative_residual(a, x, b);
+  EXPECT_LT(residual, kResidualTolerance) << label << ": " << solver.last_report().brief();
+  std::printf("[ residual ] %-40s %.3e\n", label.c_str(), residual);
+  ::testing::Test::RecordProperty("residual " + label, fmt::format("{:.3e}", residual));
+}
+
+// ---------------------------------------------------------------------------
+// TripletAssembler and empty_rows
+
+TEST(SparseAssembler, SumsDuplicateEntries) {
+  TripletAssembler assembler(3, 3);
+  assembler.add(0, 0, 1.0);
+  assembler.add(0, 0, 2.5);
+  assembler.add(2, 1, -1.0);
+  assembler.add(2, 1, 4.0);
+  assembler.add(1, 2, 7.0);
+  EXPECT_EQ(assembler.n_triplets(), 5);
+  const SparseMatrix m = assembler.compress();
+  EXPECT_TRUE(m.isCompressed());
+  EXPECT_EQ(m.nonZeros(), 3);
+  EXPECT_DOUBLE_EQ(m.coeff(0, 0), 3.5);
+  EXPECT_DOUBLE_EQ(m.coeff(2, 1), 3.0);
+  EXPECT_DOUBLE_EQ(m.coeff(1, 2), 7.0);
+  EXPECT_DOUBLE_EQ(m.coeff(1, 1), 0.0);
+}
+
+TEST(SparseAssembler, AddBlockSkipsNegativeIndicesAndMatchesDense) {
+  // Two overlapping 3 x 3 "elements" on 4 DOFs; DOF -1 is constrained.
+  Eigen::Matrix3d k1;
+  k1 << 2, -1, 0.5, -1, 3, 0, 0.5, 0, 1;
+  Eigen::Matrix3d k2;
+  k2 << 5, 1, -2, 1, 6, 0.25, -2, 0.25, 7;
+  const std::vector<Index> dofs1 = {0, 1, -1};
+  const std::vector<Index> dofs2 = {1, 3, 2};
+
+  TripletAssembler assembler(4, 4);
+  assembler.reserve(18);
+  assembler.add_block(dofs1, dofs1, k1);
+  assembler.add_block(dofs2, dofs2, k2);
+  assembler.add(-1, 2, 100.0);  // skipped
+  assembler.add(3, -5, 100.0);  // skipped
+  EXPECT_EQ(assembler.n_triplets(), 4 + 9);
+
+  Eigen::Matrix4d expected = Eigen::Matrix4d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      if (dofs1[a] >= 0 && dofs1[b] >= 0) expected(dofs1[a], dofs1[b]) += k1(a, b);
+      expected(dofs2[a], dofs2[b]) += k2(a, b);
+    }
+  }
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(assembler.compress());
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      EXPECT_DOUBLE_EQ(dense(i, j), expected(i, j)) << "entry (" << i << ", " << j << ")";
+    }
+  }
+}
+
+TEST(SparseAssembler, RectangularCompressTwiceAndClear) {
+  TripletAssembler assembler(2, 5);
+  assembler.add(1, 4, 2.0);
+  const SparseMatrix first = assembler.compress();
+  assembler.add(1, 4, 3.0);
+  const SparseMatrix second = assembler.compress();
+  EXPECT_EQ(first.rows(), 2);
+  EXPECT_EQ(first.cols(), 5);
+  EXPECT_DOUBLE_EQ(first.coeff(1, 4), 2.0);
+  EXPECT_DOUBLE_EQ(second.coeff(1, 4), 5.0);
+  assembler.clear();
+  EXPECT_EQ(assembler.n_triplets(), 0);
+  EXPECT_EQ(assembler.compress().nonZeros(), 0);
+  EXPECT_EQ(assembler.n_rows(), 2);
+}
+
+TEST(SparseAssembler, KeepsExplicitZerosSoThePatternIsValueIndependent) {
+  TripletAssembler assembler(2, 2);
+  assembler.add(0, 1, 1.0);
+  assembler.add(0, 1, -1.0);  // sums to an explicit zero, kept in the pattern
+  assembler.add(1, 1, 0.0);
+  const SparseMatrix m = assembler.compress();
+  EXPECT_EQ(m.nonZeros(), 2);
+  // Rows holding only zeros count as empty.
+  EXPECT_EQ(empty_rows(m), (std::vector<Index>{0, 1}));
+}
+
+TEST(SparseEmptyRows, FindsDofsNoElementTouches) {
+  const SparseMatrix full = laplacian_2d(5, 0.0);
+  EXPECT_TRUE(empty_rows(full).empty());
+  const Index skipped = 12;
+  const SparseMatrix holed = stencil_2d(5, 0.0, 0.0, 0.0, skipped);
+  EXPECT_EQ(empty_rows(holed), (std::vector<Index>{skipped}));
+  EXPECT_TRUE(empty_rows(SparseMatrix(0, 0)).empty());
+  EXPECT_EQ(empty_rows(SparseMatrix(3, 2)), (std::vector<Index>{0, 1, 2}));
+}
+
+// ---------------------------------------------------------------------------
+// Solver names
+
+TEST(LinalgSolverKind, ToStringAndParseRoundTrip) {
+  for (const SolverKind kind : kAllKinds) {
+    EXPECT_EQ(parse_solver_kind(to_string(kind)), kind) << to_string(kind);
+    EXPECT_TRUE(solver_available(kind)) << to_string(kind);
+  }
+  EXPECT_EQ(to_string(SolverKind::kEigenLDLT), "eigen-ldlt");
+  EXPECT_EQ(to_string(SolverKind::kEigenLU), "eigen-lu");
+  EXPECT_EQ(parse_solver_kind("umfpack"), SolverKind::kUmfpack);
+  EXPECT_EQ(to_string(MatrixProperty::kSymmetricIndefinite), "symmetric-indefinite");
+  EXPECT_EQ(to_string(SolveReport::Status::kSingular), "singular");
+}
+
+TEST(LinalgSolverKind, UnknownNameThrowsInputErrorNamingWhere) {
+  EXPECT_THROW(parse_solver_kind("pardiso"), InputError);
+  EXPECT_THROW(parse_solver_kind("CHOLMOD"), InputError);  // names are exact, lower case
+  EXPECT_THROW(parse_solver_kind(""), InputError);
+  try {
+    parse_solver_kind("superlu", "--solver");
+    FAIL() << "expected sf::InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("--solver: ", 0), 0u) << what;
+    EXPECT_NE(what.find("'superlu'"), std::string::npos) << what;
+    EXPECT_NE(what.find("eigen-ldlt"), std::string::npos) << what;
+  }
+}
+
+TEST(LinalgSolverKind, SymmetricBackendsRejectUnsymmetricProperty) {
+  EXPECT_THROW(LinearSolver(SolverKind::kCholmod, MatrixProperty::kUnsymmetric), InputError);
+  EXPECT_THROW(LinearSolver(SolverKind::kEigenLDLT, MatrixProperty::kUnsymmetric), InputError);
+  EXPECT_NO_THROW(LinearSolver(SolverKind::kUmfpack, MatrixProperty::kUnsymmetric));
+  EXPECT_NO_THROW(LinearSolver(SolverKind::kEigenLU, MatrixProperty::kSymmetricPositiveDefinite));
+}
+
+TEST(LinalgSolverKind, AutoResolvesFromMatrixProperty) {
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricPositiveDefinite).kind(),
+            SolverKind::kCholmod);
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricIndefinite).kind(),
+            SolverKind::kUmfpack);
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kUnsymmetric).kind(),
+            SolverKind::kUmfpack);
+  EXPECT_EQ(LinearSolver(SolverKind::kEigenLU).kind(), SolverKind::kEigenLU);
+}
+
+// ---------------------------------------------------------------------------
+// Solving
+
+TEST(LinalgSolver, EveryBackendSolvesSpdSystemWithSeveralRhs) {
+  const SparseMatrix a = laplacian_2d(kGridSize, 1.0);  // spectrum in (1, 9)
+  ASSERT_EQ(a.rows(), kGridSize * kGridSize);
+  for (const SolverKind kind : kAllKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind, MatrixProperty::kSymmetricPositiveDefinite);
+    expect_solves(solver, a, "spd " + to_string(kind));
+    EXPECT_EQ(solver.last_report().used, solver.kind());
+    EXPECT_EQ(solver.last_report().n_rows, a.rows());
+    EXPECT_EQ(solver.last_report().n_nonzeros, a.nonZeros());
+    EXPECT_FALSE(solver.last_report().reused_analysis);
+  }
+}
+
+TEST(LinalgSolver, LuBackendsSolveUnsymmetricConvectionDiffusion) {
+  const SparseMatrix a = convection_diffusion_2d(kGridSize, 40.0, -25.0);
+  const double asymmetry = (a - SparseMatrix(a.transpose())).norm() / a.norm();
+  ASSERT_GT(asymmetry, 0.1);
+  for (const SolverKind kind : kLuKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind, MatrixProperty::kUnsymmetric);
+    expect_solves(solver, a, "unsymmetric " + to_string(kind));
+  }
+}
+
+TEST(LinalgSolver, IndefiniteSymmetricSolvedByPivotingBackends) {
+  // 73 of 900 eigenvalues negative; min |lambda| = 0.017.
+  const SparseMatrix a = laplacian_2d(kGridSize, -1.0);
+  for (const SolverKind kind :
+       {SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLDLT, SolverKind::kEigenLU}) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind, MatrixProperty::kSymmetricIndefinite);
+    expect_solves(solver, a, "indefinite " + to_string(kind));
+  }
+}
+
+TEST(LinalgSolver, RefactorizeReusesAnalysisOnlyForTheSamePattern) {
+  const SparseMatrix a1 = laplacian_2d(kGridSize, 0.5);
+  const SparseMatrix a2 = laplacian_2d(kGridSize, 3.0) * 0.25;  // same pattern, new values
+  const SparseMatrix a3 = laplacian_2d(kGridSize - 7, 1.0);     // new size and pattern
+  for (const SolverKind kind : kAllKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind);
+    expect_solves(solver, a1, "refactorize a1 " + to_string(kind));
+    EXPECT_FALSE(solver.last_report().reused_analysis);
+    expect_solves(solver, a2, "refactorize a2 " + to_string(kind));
+    EXPECT_TRUE(solver.last_report().reused_analysis);
+    EXPECT_EQ(solver.last_report().analyze_seconds, 0.0);
+    expect_solves(solver, a3, "refactorize a3 " + to_string(kind));
+    EXPECT_FALSE(solver.last_report().reused_analysis);
+  }
+}
+
+TEST(LinalgSolver, AnalyzePatternThenFactorizeReusesIt) {
+  const SparseMatrix a = laplacian_2d(kGridSize, 2.0);
+  for (const SolverKind kind : kAllKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind);
+    const SolveReport& analysed = solver.analyze_pattern(a);
+    EXPECT_EQ(analysed.status, SolveReport::Status::kNotFactorized) << analysed.brief();
+    EXPECT_FALSE(solver.is_factorized());
+    expect_solves(solver, a, "analyse+factorize " + to_string(kind));
+    EXPECT_TRUE(solver.last_report().reused_analysis);
+  }
+}
+
+TEST(LinalgSolver, CholmodReportsIndefiniteMatrixAsSingularWithoutThrowing) {
+  const SparseMatrix indefinite = laplacian_2d(kGridSize, -1.0);
+  for (const SolverKind kind : {SolverKind::kCholmod, SolverKind::kAuto}) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind, MatrixProperty::kSymmetricPositiveDefinite);
+    SolveReport report;
+    EXPECT_NO_THROW(report = solver.factorize(indefinite));
+    EXPECT_EQ(report.status, SolveReport::Status::kSingular) << report.brief();
+    EXPECT_FALSE(report.ok());
+    EXPECT_FALSE(solver.is_factorized());
+    EXPECT_NE(report.message.find("not positive definite"), std::string::npos) << report.message;
+    EXPECT_NE(report.brief().find("singular"), std::string::npos) << report.brief();
+    // The same solver recovers once the values are positive definite again.
+    expect_solves(solver, laplacian_2d(kGridSize, 1.0), "after indefinite " + to_string(kind));
+    EXPECT_TRUE(solver.last_report().reused_analysis);
+  }
+}
+
+TEST(LinalgSolver, UnpinnedDofIsSingularUntilPinned) {
+  // DOF 17 is touched by no element: an empty row and column.
+  const Index skipped = 17;
+  const SparseMatrix holed = stencil_2d(10, 1.0, 0.0, 0.0, skipped);
+  const std::vector<Index> empty = empty_rows(holed);
+  ASSERT_EQ(empty, (std::vector<Index>{skipped}));
+
+  // Pin the empty rows with a unit diagonal.
+  TripletAssembler pin(holed.rows(), holed.cols());
+  for (const Index row : empty) pin.add(row, row, 1.0);
+  const SparseMatrix pinned = holed + pin.compress();
+
+  for (const SolverKind kind : kAllKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver solver(kind);
+    SolveReport report;
+    EXPECT_NO_THROW(report = solver.factorize(holed));
+    EXPECT_EQ(report.status, SolveReport::Status::kSingular) << report.brief();
+    EXPECT_FALSE(report.message.empty());
+    expect_solves(solver, pinned, "pinned " + to_string(kind));
+  }
+}
+
+TEST(LinalgSolver, ReportsBeforeFactorizationAndForNonSquareInput) {
+  LinearSolver solver(SolverKind::kUmfpack, MatrixProperty::kUnsymmetric);
+  EXPECT_EQ(solver.last_report().status, SolveReport::Status::kNotFactorized);
+  EXPECT_EQ(solver.last_report().used, SolverKind::kUmfpack);
+  EXPECT_FALSE(solver.is_factorized());
+#ifdef NDEBUG
+  // Release builds: solve() before factorize() returns NaNs of the right shape.
+  const Eigen::MatrixXd x = solver.solve(Eigen::MatrixXd::Ones(0, 2));
+  EXPECT_EQ(x.cols(), 2);
+#endif
+  SparseMatrix rectangular(4, 3);
+  rectangular.insert(0, 0) = 1.0;
+  const SolveReport& report = solver.factorize(rectangular);
+  EXPECT_EQ(report.status, SolveReport::Status::kFailed);
+  EXPECT_NE(report.message.find("not square"), std::string::npos) << report.message;
+}
+
+TEST(LinalgSolver, EmptySystemIsTriviallyOk) {
+  LinearSolver solver;
+  EXPECT_TRUE(solver.factorize(SparseMatrix(0, 0)).ok());
+  const Eigen::MatrixXd x = solver.solve(Eigen::MatrixXd(0, 3));
+  EXPECT_EQ(x.rows(), 0);
+  EXPECT_EQ(x.cols(), 3);
+}
+
+TEST(LinalgSolver, FactorisationOwnsItsMatrixAndSurvivesMoves) {
+  // UMFPACK's solve reads A again; the solver must not point into the caller's
+  // (here temporary, uncompressed) matrix, and must survive being moved.
+  for (const SolverKind kind : kAllKinds) {
+    SCOPED_TRACE(to_string(kind));
+    LinearSolver original(kind);
+    {
+      SparseMatrix temporary = laplacian_2d(kGridSize, 1.0);
+      temporary.uncompress();
+      ASSERT_TRUE(original.factorize(temporary).ok());
+      temporary.setZero();  // clobber the caller's copy
+    }
+    LinearSolver moved(std::move(original));
+    LinearSolver assigned(SolverKind::kEigenLU);
+    assigned = std::move(moved);
+    ASSERT_TRUE(assigned.is_factorized());
+
+    const SparseMatrix a = laplacian_2d(kGridSize, 1.0);
+    const Eigen::MatrixXd b = random_rhs(a.rows(), kNumRhs, kSeed + 1);
+    const double residual = max_relative_residual(a, assigned.solve(b), b);
+    EXPECT_LT(residual, kResidualTolerance);
+    std::printf("[ residual ] %-40s %.3e\n", ("moved " + to_string(kind)).c_str(), residual);
+  }
+}
+
+TEST(LinalgSolver, SolveAcceptsBlocksAndVectorsAndRecordsTiming) {
+  const SparseMatrix a = laplacian_2d(kGridSize, 1.0);
+  LinearSolver solver(SolverKind::kCholmod);
+  ASSERT_TRUE(solver.factorize(a).ok());
+  const Eigen::MatrixXd b = random_rhs(a.rows(), 6, kSeed + 2);
+  // A non-contiguous block of columns and a single vector give the same answers
+  // as solving all columns at once.
+  const Eigen::MatrixXd x_all = solver.solve(b);
+  const Eigen::MatrixXd x_block = solver.solve(b.middleCols(2, 3));
+  const Eigen::VectorXd b_vec = b.col(5);
+  const Eigen::MatrixXd x_vec = solver.solve(b_vec);
+  EXPECT_LT((x_block - x_all.middleCols(2, 3)).norm(), 1e-12 * x_all.norm());
+  EXPECT_LT((x_vec - x_all.col(5)).norm(), 1e-12 * x_all.norm());
+  EXPECT_LT(max_relative_residual(a, x_all, b), kResidualTolerance);
+
+  const SolveReport& report = solver.last_report();
+  EXPECT_GE(report.factor_seconds, 0.0);
+  EXPECT_GE(report.solve_seconds, 0.0);
+  const std::string brief = report.brief();
+  EXPECT_EQ(brief.find('\n'), std::string::npos);
+  EXPECT_EQ(brief.rfind("cholmod n=900 ", 0), 0u) << brief;
+  EXPECT_NE(brief.find(": ok"), std::string::npos) << brief;
+}
+
+}  // namespace
+}  // namespace sf::linalg

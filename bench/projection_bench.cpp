@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <random>
 #include <thread>
@@ -98,8 +99,10 @@ void run(int n_elements_per_side, const std::vector<Index>& sizes, int threads) 
   for (Index n : sizes) {
     const Cloud cloud = make_cloud(mesh, n, 20240611u + static_cast<unsigned>(n));
     const auto t0 = Clock::now();
+    const std::clock_t c0 = std::clock();
     const auto result = projector.project_all(cloud.points);
     const double time = seconds_since(t0);
+    const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     double sum = 0.0, worst = 0.0, iterations = 0.0;
     Index counts[4] = {0, 0, 0, 0};
     for (std::size_t i = 0; i < result.size(); ++i) {
@@ -109,9 +112,10 @@ void run(int n_elements_per_side, const std::vector<Index>& sizes, int threads) 
       iterations += result[i].iterations;
       ++counts[static_cast<int>(result[i].status)];
     }
-    std::printf("%2dx%-2d %8lld %7lld %3d %8.3f %8.3f %11.0f %10.2e %10.2e %6.2f %lld/%lld/%lld/%lld\n",
+    std::printf("%2dx%-2d %8lld %7lld %3d %7.3f %8.3f %8.3f %10.0f %10.2e %10.2e %6.2f "
+                "%lld/%lld/%lld/%lld\n",
                 n_elements_per_side, n_elements_per_side, static_cast<long long>(n),
-                static_cast<long long>(projector.n_samples()), used_threads, build, time,
+                static_cast<long long>(projector.n_samples()), used_threads, build, time, cpu,
                 static_cast<double>(n) / time, sum / static_cast<double>(n), worst,
                 iterations / static_cast<double>(n), static_cast<long long>(counts[0]),
                 static_cast<long long>(counts[1]), static_cast<long long>(counts[2]),
@@ -129,11 +133,14 @@ int main() {
                 kSize, kSize, kBump, kMaxOffset);
     std::printf("hardware threads: %u; options: candidates 8, samples 6x6 per element\n",
                 std::thread::hardware_concurrency());
-    std::printf("build = element data + kd-tree (s); project = batch projection (s); "
-                "err = |distance - |offset|| (mm)\n");
+    std::printf("build = element data + kd-tree (s); project = batch projection, wall clock (s);\n"
+                "cpu = process CPU time of the projection, all threads (s);\n"
+                "points/s = points / project;\n"
+                "err = |distance - |offset|| (mm); iters = mean Newton iterations\n");
     std::printf("status = converged/on_free_edge/not_converged/failed\n\n");
-    std::printf("%-5s %8s %7s %3s %8s %8s %11s %10s %10s %6s %s\n", "mesh", "points", "samples",
-                "thr", "build", "project", "points/s", "mean err", "max err", "iters", "status");
+    std::printf("%-5s %8s %7s %3s %7s %8s %8s %10s %10s %10s %6s %s\n", "mesh", "points", "samples",
+                "thr", "build", "project", "cpu", "points/s", "mean err", "max err", "iters",
+                "status");
     const std::vector<Index> sizes = {10000, 100000, 1000000};
     run(20, sizes, 0);
     run(60, sizes, 0);

@@ -48,9 +48,18 @@ Frame best_fit_plane(const Points3& pts) {
   f.spread1 = std::sqrt(std::max(0.0, es.eigenvalues()[2]));
   f.spread2 = std::sqrt(std::max(0.0, es.eigenvalues()[1]));
   f.spread_normal = std::sqrt(std::max(0.0, es.eigenvalues()[0]));
-  // Deterministic, intuitive orientation: a1 towards +X (else +Y), normal towards +Z.
+  // In-plane axes: for a clearly elongated part (a strip) the long axis; otherwise
+  // (near-square or round parts, where PCA axes are arbitrary) the X axis projected
+  // onto the plane, so the mesh lines up with the marks. a1 towards +X, normal towards +Z.
+  f.normal = f.a1.cross(f.a2).normalized();
+  if (f.spread1 < 1.5 * f.spread2) {
+    Vec3 x = Vec3::UnitX() - Vec3::UnitX().dot(f.normal) * f.normal;
+    if (x.norm() < 0.3) x = Vec3::UnitY() - Vec3::UnitY().dot(f.normal) * f.normal;
+    f.a1 = x.normalized();
+  }
   const Vec3 ref = std::abs(f.a1.x()) > 1e-3 ? Vec3::UnitX() : Vec3::UnitY();
   if (f.a1.dot(ref) < 0) f.a1 = -f.a1;
+  f.a2 = f.normal.cross(f.a1).normalized();
   f.normal = f.a1.cross(f.a2);
   if (f.normal.z() < 0 || (std::abs(f.normal.z()) < 1e-12 && f.normal.y() < 0)) {
     f.a2 = -f.a2;
@@ -68,6 +77,23 @@ void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int
   n2 = std::max(1, static_cast<int>(std::lround(total / n1)));
   n1 = std::min(n1, 300);
   n2 = std::min(n2, 300);
+}
+
+// Marks whose residual exceeds max(k * robust sigma, floor) and at least half the
+// largest such residual (the worst ones of this round). Robust sigma: the median
+// residual norm / 1.54 (median of a 3-D Gaussian vector's norm is 1.54 sigma).
+std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, double k, double floor) {
+  std::vector<double> r;
+  for (Index i = 0; i < residual.size(); ++i)
+    if (weight[i] > 0) r.push_back(residual[i]);
+  const double threshold = std::max(k * median(r) / 1.54, floor);
+  double worst = 0.0;
+  for (Index i = 0; i < residual.size(); ++i)
+    if (weight[i] > 0 && residual[i] > threshold) worst = std::max(worst, residual[i]);
+  std::vector<Index> out;
+  for (Index i = 0; i < residual.size(); ++i)
+    if (weight[i] > 0 && residual[i] > threshold && residual[i] >= 0.5 * worst) out.push_back(i);
+  return out;
 }
 
 }  // namespace
@@ -179,7 +205,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   FitResult fit_u;
   Penalty pen_u = automatic ? penalty_for_noise(0.0) : explicit_penalty(Penalty{});
   double fit_time = 0.0, project_time = 0.0;
-  for (int outer = 0; outer < 2; ++outer) {
+  for (int outer = 0; outer < 8; ++outer) {
     for (int it = 0; it < std::max(1, options.max_projection_iterations); ++it) {
       auto tf = Clock::now();
       const linalg::SparseMatrix phi = collocation_matrix(mesh, loc);
@@ -198,19 +224,14 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
         loc[k] = {proj[k].element, proj[k].xi};
       }
       project_time += seconds_since(tp);
-      if (max_dxi < 1e-7) break;
+      if (max_dxi < 1e-7) break;  // xi settled
     }
-    // Outliers of the undeformed fit.
-    std::vector<double> r;
-    for (Index k = 0; k < m; ++k)
-      if (w_u[k] > 0) r.push_back(fit_u.residual[k]);
-    const double sigma = median(r) / 1.54;  // median of a 3-D Gaussian residual norm ~ 1.54 sigma
+    // Outliers of the undeformed fit (worst first; see the deformed fit).
     bool changed = false;
-    for (Index k = 0; k < m; ++k)
-      if (w_u[k] > 0 && fit_u.residual[k] > std::max(options.outlier_sigma * sigma, 0.02 * d)) {
-        w_u[k] = 0.0;
-        changed = true;
-      }
+    for (Index k : worst_outliers(fit_u.residual, w_u, options.outlier_sigma, 0.02 * d)) {
+      w_u[k] = 0.0;
+      changed = true;
+    }
     if (automatic) {
       // Noise estimate from the light fit, corrected for the fitted degrees of freedom.
       const double n_used = w_u.sum();
@@ -252,19 +273,16 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   const linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
   FitResult fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
   if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
-  {
-    std::vector<double> r;
-    for (Index k = 0; k < m; ++k)
-      if (w_d[k] > 0) r.push_back(fit_d.residual[k]);
-    const double sigma = median(r) / 1.54;
-    bool changed = false;
-    for (Index k = 0; k < m; ++k)
-      if (w_d[k] > 0 && fit_d.residual[k] > std::max(options.outlier_sigma * sigma, 0.02 * d)) {
-        w_d[k] = 0.0;
-        res.points[used[k]].status = kStatusOutlierDeformed;
-        changed = true;
-      }
-    if (changed) fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
+  // Outliers: flag the worst marks beyond the threshold and refit, a few rounds
+  // (one bad mark drags its neighbours' residuals up until it is removed).
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<Index> bad = worst_outliers(fit_d.residual, w_d, options.outlier_sigma, 0.02 * d);
+    if (bad.empty()) break;
+    for (Index k : bad) {
+      w_d[k] = 0.0;
+      res.points[used[k]].status = kStatusOutlierDeformed;
+    }
+    fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
     if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
   }
   fit_time += seconds_since(tf);

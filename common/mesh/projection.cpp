@@ -43,7 +43,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Element data in tensor form: x(xi) = sum_{i1,i2} c[i1 + 4 i2] H_i1(xi1) H_i2(xi2).
 struct ElementData {
   std::array<Vec3, 16> c{};
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // bounding box of the Bezier control net (contains the patch)
+  // Bounding box of the Bezier control net, which contains the patch.
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
   std::array<EdgeNeighbour, 4> neighbour;
   bool collapsed = false;
   Index fan = -1;  // collapsed: index of the apex fan (collapsed elements around the apex)
@@ -147,7 +148,8 @@ inline double step1(double h, double gn, double g) {
   return -g / a;
 }
 
-// Local edge at a bound of xi component i: xi1 = 0 is edge 3, xi1 = 1 edge 1, xi2 = 0 edge 0, xi2 = 1 edge 2.
+// Local edge at a bound of xi component i:
+// xi1 = 0 is edge 3, xi1 = 1 edge 1, xi2 = 0 edge 0, xi2 = 1 edge 2.
 inline int bound_edge(int component, bool upper) {
   if (component == 0) return upper ? 1 : 3;
   return upper ? 2 : 0;
@@ -184,7 +186,8 @@ std::vector<Index> locality_order(const Eigen::Ref<const Points3>& points) {
     std::uint64_t code = 0;
     if (p.allFinite()) {
       const Vec3 q = ((p - lo) * scale).cwiseMax(0.0);
-      code = spread(static_cast<std::uint64_t>(q.x())) | spread(static_cast<std::uint64_t>(q.y())) << 1 |
+      code = spread(static_cast<std::uint64_t>(q.x())) |
+             spread(static_cast<std::uint64_t>(q.y())) << 1 |
              spread(static_cast<std::uint64_t>(q.z())) << 2;
     }
     keyed[static_cast<std::size_t>(i)] = {code, i};
@@ -340,13 +343,14 @@ SurfaceProjector::Impl::WalkResult SurfaceProjector::Impl::walk(const Vec3& p, I
                                                                const Vec2& xi_start) const {
   WalkResult w;
   const double p_scale = p.cwiseAbs().maxCoeff();
-  const int max_hops = std::max(4, 2 * options.max_iterations);
   State& s = w.state;
   s.element = element;
   s.xi = xi_start.cwiseMax(0.0).cwiseMin(1.0);
   set_state(s, p, evaluate(elements[element], s.xi));
   int entry_edge = -1;  // edge of the current element the walk came in through
-  for (int hop = 0;; ++hop) {
+  // Every element visited costs at least one iteration, so the iteration budget
+  // also bounds the number of hops.
+  for (;;) {
     if (!newton(p, s, w.iterations)) {
       w.status = Projection::Status::kNotConverged;
       return w;
@@ -354,12 +358,17 @@ SurfaceProjector::Impl::WalkResult SurfaceProjector::Impl::walk(const Vec3& p, I
     w.status = Projection::Status::kConverged;
     const int edge = exit_edge(s, p_scale);
     if (edge < 0 || edge == entry_edge) return w;  // interior minimum, or on the edge just crossed
-    if (hop >= max_hops) {
+    const ElementData& el = elements[s.element];
+    const bool through_apex = el.collapsed && edge == 0;
+    if (!through_apex && el.neighbour[edge].element < 0) {
+      w.status = Projection::Status::kOnFreeEdge;
+      return w;
+    }
+    if (w.iterations >= options.max_iterations) {  // no budget left for the next element
       w.status = Projection::Status::kNotConverged;
       return w;
     }
-    const ElementData& el = elements[s.element];
-    if (el.collapsed && edge == 0) {
+    if (through_apex) {
       // Through the apex: continue in the fan element whose radial direction best
       // matches p - x.
       double best_score = 0.0;
@@ -387,10 +396,6 @@ SurfaceProjector::Impl::WalkResult SurfaceProjector::Impl::walk(const Vec3& p, I
       entry_edge = 0;
     } else {
       const EdgeNeighbour& nb = el.neighbour[edge];
-      if (nb.element < 0) {
-        w.status = Projection::Status::kOnFreeEdge;
-        return w;
-      }
       const double t = (edge == 0 || edge == 2) ? s.xi[0] : s.xi[1];
       s.element = nb.element;
       s.xi = edge_point(nb.edge, nb.reversed ? 1.0 - t : t);
@@ -484,7 +489,8 @@ std::string Projection::brief() const {
   return buf;
 }
 
-SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh, const Eigen::Ref<const MatX>& parameters,
+SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh,
+                                   const Eigen::Ref<const MatX>& parameters,
                                    ProjectionOptions options) {
   options.validate();
   if (parameters.rows() != mesh.n_dofs() || parameters.cols() != 3)
@@ -556,13 +562,15 @@ SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh, const Eigen::Ref<con
 
 Projection SurfaceProjector::project(const Vec3& p) const { return impl_->project(p); }
 
-std::vector<Projection> SurfaceProjector::project_all(const Eigen::Ref<const Points3>& points) const {
+std::vector<Projection> SurfaceProjector::project_all(
+    const Eigen::Ref<const Points3>& points) const {
   const Index n = points.rows();
   std::vector<Projection> out(static_cast<std::size_t>(n));
   const std::vector<Index> order = locality_order(points);
   constexpr Index kBlock = 256;
   int n_threads = impl_->options.threads;
-  if (n_threads == 0) n_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (n_threads == 0)
+    n_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   n_threads = static_cast<int>(std::min<Index>(n_threads, (n + kBlock - 1) / kBlock));
   std::atomic<Index> next{0};
   std::exception_ptr error;

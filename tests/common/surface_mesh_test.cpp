@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>  // cross products
 #include <Eigen/LU>        // 2x2 metric inverse
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -86,7 +87,7 @@ struct Jump {
   double size = 0.0;
   std::string at = "nowhere";
   void update(double s, const std::string& loc) {
-    if (s > size || !(s == s)) {
+    if (s > size || std::isnan(s)) {
       size = s;
       at = loc;
     }
@@ -386,6 +387,52 @@ TEST(SurfaceMeshGraded, InconsistentElementScaleFactorsBreakC1) {
   EXPECT_GT(skewed.gradient.size, kDetectable) << "physical gradient du/dx across the edge";
 }
 
+// Smallest d(s)/dxi1 over element e of a mesh along a1 (s = coordinate along a1),
+// sampled along xi1 at mid-height; negative means the parameterisation folds.
+double min_slope_along_a1(const SurfaceMesh& m, Index e) {
+  const SurfaceField x(m, m.geometry());
+  double slope = 1e300;
+  for (int q = 0; q <= 200; ++q)
+    slope = std::min(slope, x.evaluate3(e, Vec2(q / 200.0, 0.5), basis::kFirst).dx.col(0).x());
+  return slope;
+}
+
+TEST(SurfaceMeshGraded, ModerateGradingIsFoldFreeWithExactArcLengthFactors) {
+  // Two elements of widths 1 and w along a1. The nodal mean factor (1 + w)/2 at
+  // the shared node keeps the narrow element monotone for w <= 7.
+  for (double w : {2.0, 3.0, 6.0}) {
+    const SurfaceMesh m =
+        make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0 + w, 1.0, 2, 1, {0.0, 1.0, 1.0 + w});
+    for (Index e = 0; e < 2; ++e)
+      EXPECT_GT(min_slope_along_a1(m, e), 0.0) << "fold in element " << e << " for widths 1 and " << w;
+    EXPECT_NEAR(m.element(0).scale[0][0], 1.0, kGeometry) << "S1 at the narrow end, widths 1 and " << w;
+    EXPECT_NEAR(m.element(0).scale[1][0], 0.5 * (1.0 + w), kGeometry) << "S1 at the shared node, widths 1 and " << w;
+    EXPECT_NEAR(m.element(1).scale[1][0], w, kGeometry) << "S1 at the wide end, widths 1 and " << w;
+  }
+}
+
+// LIBRARY ISSUE (reported to the lead; disabled until fixed): make_rectangle_mesh
+// with adjacent breakpoint widths in a ratio above 7 folds the narrow element.
+// The nodal mean scale factor (1 + w)/2 exceeds 4x the narrow width, so
+// ds/dxi1 < 0 inside it (widths 1 and 10: min ds/dxi1 = -0.57), the "exact
+// arc-length parameters" of the header no longer hold (S1 at the narrow free end
+// becomes 1.36 instead of 1), and the surface Jacobian vanishes inside the
+// element. Either rejecting such grading (std::invalid_argument) or producing a
+// fold-free mesh passes this test.
+TEST(SurfaceMeshGraded, DISABLED_StrongGradingIsRejectedOrFoldFree) {
+  for (double w : {10.0, 20.0}) {
+    SurfaceMesh m;
+    try {
+      m = make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0 + w, 1.0, 2, 1, {0.0, 1.0, 1.0 + w});
+    } catch (const std::invalid_argument&) {
+      continue;  // rejected: acceptable
+    }
+    for (Index e = 0; e < 2; ++e)
+      EXPECT_GT(min_slope_along_a1(m, e), 0.0) << "fold in element " << e << " for widths 1 and " << w;
+    EXPECT_NEAR(m.element(0).scale[0][0], 1.0, kGeometry) << "S1 at the narrow free end, widths 1 and " << w;
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Arc-length scale factors on a curved strip: 8 elements around a half circle of
 // radius R (xi1), width 0.5 along z (xi2).
@@ -407,7 +454,9 @@ TEST(SurfaceMeshArcLength, CircularArcScaleFactorsApproachTheArcLength) {
     }
   const int max_iterations = 20;
   const int iterations = m.compute_arc_length_scale_factors(max_iterations, 1e-10);
+  // Measured: 6 iterations to 1e-10 (the error shrinks ~50x per iteration).
   EXPECT_LE(iterations, 8) << "fixed-point iteration for the arc-length factors should converge in a few steps";
+  EXPECT_LT(iterations, max_iterations) << "must converge before the iteration limit";
   for (Index e = 0; e < m.n_elements(); ++e)
     for (int n = 0; n < 4; ++n) {
       EXPECT_NEAR(m.element(e).scale[n][0] / arc, 1.0, test::kArcLengthRel)

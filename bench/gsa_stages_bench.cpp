@@ -1,0 +1,77 @@
+// Times each stage of `gsa analyse` (read, mesh, project, fit, strain, write) on
+// the dome case with 1e4, 1e5 and (with argument "1e6") 1e6 marks, and prints the
+// peak resident memory. A program that prints figures, not a timed test.
+//   build/bin/gsa_stages_bench [max_marks=1e5]
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "common/io/atomic_file.hpp"
+#include "common/io/csv.hpp"
+#include "gsa/analysis.hpp"
+#include "gsa/grid.hpp"
+#include "gsa/output.hpp"
+#include "gsa/synthetic.hpp"
+
+using namespace sf;
+using namespace sf::gsa;
+
+static double peak_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;
+}
+
+int main(int argc, char** argv) {
+  const double max_marks = argc > 1 ? std::atof(argv[1]) : 1e5;
+  const auto tmp = std::filesystem::temp_directory_path() / "gsa_stages_bench";
+  std::filesystem::create_directories(tmp);
+  std::printf("%9s %6s %8s %8s %8s %8s %8s %8s %8s %9s %8s\n", "marks", "mesh", "read_s", "mesh_s", "proj_s", "fit_s",
+              "strain_s", "write_s", "total_s", "peak_MB", "rms_E");
+  for (int n : {100, 316, 1000}) {
+    if (static_cast<double>(n) * n > max_marks * 1.01) break;
+    SyntheticGridOptions go;
+    go.n = n;
+    go.spacing = 100.0 / (n - 1);
+    go.noise = 0.002;
+    const GridData g0 = make_synthetic_grid(synthetic_case("dome"), go);
+    // Write the grid so the read stage is measured on a real file.
+    const std::string path = (tmp / "grid.csv").string();
+    {
+      std::ofstream os(path);
+      io::CsvWriter w(os, {"id", "X", "Y", "Z", "x", "y", "z"});
+      for (Index p = 0; p < g0.n_points(); ++p) {
+        w.begin_row().add(g0.ids[p]);
+        for (int k = 0; k < 3; ++k) w.add(g0.undeformed(p, k));
+        for (int k = 0; k < 3; ++k) w.add(g0.deformed(p, k));
+        w.end_row();
+      }
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const GridData g = read_grid(path);
+    const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    AnalyseOptions o;
+    AnalysisResult r = analyse(g, o);
+    r.times.read = read_s;
+    {
+      io::AtomicOutputDir out((tmp / "out").string());
+      write_results(out, g, r, o, RunInfo{});
+      out.commit();
+    }
+    const auto& t = r.times;
+    double s = 0;
+    Index cnt = 0;
+    for (const auto& p : r.points)
+      if (p.strain) s += p.strain->green(0), ++cnt;
+    std::printf("%9ld %3dx%-3d %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %9.1f %8.4f\n", static_cast<long>(g.n_points()),
+                r.elements1, r.elements2, t.read, t.mesh, t.project, t.fit, t.strain, t.write,
+                t.read + t.mesh + t.project + t.fit + t.strain + t.write, peak_mb(), cnt ? s / cnt : 0.0);
+    std::fflush(stdout);
+  }
+  std::filesystem::remove_all(tmp);
+  return 0;
+}

@@ -285,6 +285,23 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
     if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
   }
+  {
+    // Readmit flagged marks that the final surface fits well (good neighbours of a
+    // bad mark can exceed the threshold while the bad mark still pulls the fit).
+    std::vector<double> r;
+    for (Index k = 0; k < m; ++k)
+      if (w_d[k] > 0) r.push_back(fit_d.residual[k]);
+    const double threshold = std::max(options.outlier_sigma * median(r) / 1.54, 0.02 * d);
+    bool readmitted = false;
+    for (Index k = 0; k < m; ++k)
+      if (res.points[used[k]].status == kStatusOutlierDeformed && fit_d.residual[k] < threshold) {
+        w_d[k] = 1.0;
+        res.points[used[k]].status = kStatusOk;
+        readmitted = true;
+      }
+    if (readmitted) fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
+    if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
+  }
   fit_time += seconds_since(tf);
   res.deformed_parameters = fit_d.parameters;
   res.rms_deformed = fit_d.rms;
@@ -292,9 +309,9 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   res.times.fit = fit_time;
   res.times.project = project_time;
   const double rho = 1.0 / (d * d);
-  res.gauge_length = options.penalty == PenaltyKind::kThirdOrder
-                         ? std::pow(std::max(pen_d.gamma, 0.0) / rho, 1.0 / 6.0)
-                         : std::pow(std::max(pen_d.beta, 0.0) / rho, 0.25);
+  // Effective smoothing length of the strongest term actually used.
+  res.gauge_length = std::max(std::pow(std::max(pen_d.gamma, 0.0) / rho, 1.0 / 6.0),
+                              std::pow(std::max(pen_d.beta, 0.0) / rho, 0.25));
 
   // --- Strains at the marks.
   auto ts = Clock::now();

@@ -97,6 +97,7 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
   // Accumulate the embedded right Cauchy-Green tensor C3 = F^T F (3x3, in the
   // undeformed tangent plane) and F per mark.
   std::vector<Mat3> csum(n, Mat3::Zero()), fsum(n, Mat3::Zero());
+  std::vector<Vec3> nsum(n, Vec3::Zero());  // consistently oriented triangle normals
   std::vector<int> count(n, 0);
   for (const auto& t : tris) {
     Mat32 G, gg;
@@ -109,7 +110,9 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
     const Mat2 Minv = M.inverse();
     const Mat3 F = gg * Minv * G.transpose();  // maps undeformed tangents to deformed ones
     const Mat3 C = F.transpose() * F;
+    const Vec3 normal = G.col(0).cross(G.col(1)).normalized();
     for (Index p : t) {
+      nsum[p] += normal;
       csum[p] += C;
       fsum[p] += F;
       ++count[p];
@@ -140,8 +143,9 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
     pr.strain = s;
     if (options.fibre_angles.size() == 2) {
       Mat32 Gp;
+      // Tangent frame oriented by the triangles' normal (eigenvector signs are arbitrary).
       Gp.col(0) = s.dir1_undeformed;
-      Gp.col(1) = s.dir2_undeformed;
+      Gp.col(1) = nsum[p].cross(s.dir1_undeformed).normalized();
       for (double angle : options.fibre_angles) {
         const auto a0 = tangent_at_angle(Gp, Vec3::UnitX(), angle);
         Vec3 a = a0 ? Vec3(F * *a0) : Vec3::Zero();

@@ -80,7 +80,7 @@ struct Projection {
     kConverged,     // local minimum of |p - x| (interior, or on an edge/apex with no exit)
     kOnFreeEdge,    // clamped at a boundary edge: p lies beyond the sheet's edge, and
                     // `distance` has a tangential part
-    kNotConverged,  // iteration or hop budget spent; the best point reached is reported
+    kNotConverged,  // max_iterations spent (over the walk); the last point reached is reported
     kFailed,        // no result: non-finite input, empty mesh, element out of range
   };
 

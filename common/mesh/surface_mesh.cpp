@@ -37,6 +37,14 @@ Index SurfaceMesh::add_node() {
   return id;
 }
 
+Index SurfaceMesh::add_nodes(Index count) {
+  const Index first = n_nodes_;
+  n_nodes_ += count;
+  geometry_.conservativeResize(n_dofs(), 3);
+  geometry_.bottomRows(kParamsPerNode * count).setZero();
+  return first;
+}
+
 Index SurfaceMesh::add_element(const Element& element) {
   for (Index n : element.nodes)
     if (n < 0 || n >= n_nodes_)
@@ -220,9 +228,10 @@ SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& 
   const auto s = breaks_or_uniform(breaks1, length1, n1);
   const auto t = breaks_or_uniform(breaks2, length2, n2);
   SurfaceMesh mesh;
+  Index next = mesh.add_nodes(static_cast<Index>(n1 + 1) * (n2 + 1));
   for (int j = 0; j <= n2; ++j)
     for (int i = 0; i <= n1; ++i) {
-      const Index node = mesh.add_node();
+      const Index node = next++;
       mesh.geometry().row(SurfaceMesh::dof(node, kValue)) = (origin + s[i] * a1 + t[j] * a2).transpose();
       mesh.geometry().row(SurfaceMesh::dof(node, kD1)) = a1.transpose();
       mesh.geometry().row(SurfaceMesh::dof(node, kD2)) = a2.transpose();
@@ -248,7 +257,8 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
   const double dtheta = 2.0 * pi / n_sectors;
   const double dr = radius / n_rings;
   SurfaceMesh mesh;
-  const Index apex = mesh.add_node();
+  const Index apex = mesh.add_nodes(1 + static_cast<Index>(n_rings) * n_sectors);
+  Index next = apex + 1;
   mesh.geometry().row(SurfaceMesh::dof(apex, kValue)) = centre.transpose();
   mesh.geometry().row(SurfaceMesh::dof(apex, kD1)) = a1.transpose();
   mesh.geometry().row(SurfaceMesh::dof(apex, kD2)) = a2.transpose();
@@ -259,7 +269,7 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
       const double th = j * dtheta, r = i * dr;
       const Vec3 radial = std::cos(th) * a1 + std::sin(th) * a2;
       const Vec3 tangent = -std::sin(th) * a1 + std::cos(th) * a2;
-      const Index node = mesh.add_node();
+      const Index node = next++;
       mesh.geometry().row(SurfaceMesh::dof(node, kValue)) = (centre + r * radial).transpose();
       mesh.geometry().row(SurfaceMesh::dof(node, kD1)) = tangent.transpose();
       mesh.geometry().row(SurfaceMesh::dof(node, kD2)) = radial.transpose();
@@ -296,18 +306,23 @@ SurfaceMesh extract_elements(const SurfaceMesh& mesh, const std::vector<bool>& k
                              std::vector<Index>* element_map_out) {
   std::vector<Index> node_map(mesh.n_nodes(), -1);
   std::vector<Index> element_map(mesh.n_elements(), -1);
+  Index n_used = 0;
+  for (Index e = 0; e < mesh.n_elements(); ++e)
+    if (keep[e])
+      for (Index n : mesh.element(e).nodes)
+        if (node_map[n] == -1) node_map[n] = -2 - n_used++;  // mark; numbered below in order
+  for (Index& v : node_map)
+    if (v <= -2) v = -2 - v;
   SurfaceMesh out;
+  out.add_nodes(n_used);
+  for (Index n = 0; n < mesh.n_nodes(); ++n)
+    if (node_map[n] >= 0)
+      out.geometry().middleRows(SurfaceMesh::dof(node_map[n], 0), kParamsPerNode) =
+          mesh.geometry().middleRows(SurfaceMesh::dof(n, 0), kParamsPerNode);
   for (Index e = 0; e < mesh.n_elements(); ++e) {
     if (!keep[e]) continue;
     Element el = mesh.element(e);
-    for (Index& n : el.nodes) {
-      if (node_map[n] < 0) {
-        node_map[n] = out.add_node();
-        out.geometry().middleRows(SurfaceMesh::dof(node_map[n], 0), kParamsPerNode) =
-            mesh.geometry().middleRows(SurfaceMesh::dof(n, 0), kParamsPerNode);
-      }
-      n = node_map[n];
-    }
+    for (Index& n : el.nodes) n = node_map[n];
     element_map[e] = out.add_element(el);
   }
   out.build_topology();

@@ -79,6 +79,8 @@ class SurfaceMesh {
   SurfaceMesh() = default;
 
   Index add_node();
+  // Adds `count` nodes at once (one resize; add_node() in a loop is quadratic). Returns the first id.
+  Index add_nodes(Index count);
   Index add_element(const Element& element);
 
   Index n_nodes() const { return n_nodes_; }

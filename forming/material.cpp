@@ -1,0 +1,23 @@
+#include "forming/material.hpp"
+
+namespace sf::forming {
+
+Vec6 voigt_stress(const Mat3& s) {
+  Vec6 v;
+  v << s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2);
+  return v;
+}
+
+Vec6 voigt_strain(const Mat3& e) {
+  Vec6 v;
+  v << e(0, 0), e(1, 1), e(2, 2), 2.0 * e(0, 1), 2.0 * e(1, 2), 2.0 * e(0, 2);
+  return v;
+}
+
+Mat3 from_voigt_stress(const Vec6& v) {
+  Mat3 s;
+  s << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
+  return s;
+}
+
+}  // namespace sf::forming

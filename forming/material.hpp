@@ -1,0 +1,52 @@
+#pragma once
+// Hyperelastic materials for the forming solver, separate from the element loop
+// (STYLE.md, MFEM-style): a material maps the right Cauchy-Green tensor C (3x3,
+// symmetric) at a quadrature point to the strain energy W (per unit reference
+// volume), the second Piola-Kirchhoff stress S = 2 dW/dC and the material
+// tangent CC = 4 d2W/dCdC (so dS = CC : dE with dE = dC/2).
+//
+// Voigt order for symmetric 3x3 tensors everywhere in forming/: (11, 22, 33, 12, 23, 13);
+// tangents are 6x6 with "tensor" (not engineering-shear) conventions on BOTH
+// sides: dS_I = sum_J CC_IJ dE_J where dE_J for shear entries is E_12 counted
+// twice, i.e. use voigt_strain() (shear doubled) for dE and voigt_stress() for S.
+//
+// Constraints (exact incompressibility J = 1, fibre inextensibility I4 = 1) are
+// NOT part of the material: the element adds -p J C^-1 and T a0 (x) a0 with
+// separately interpolated p and T (mixed formulation). A material reports the
+// fibre direction a0 (unit, reference configuration) it was built with.
+//
+// Units: stresses and moduli in MPa with lengths in mm and forces in N.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "common/core/types.hpp"
+
+namespace sf::forming {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+struct MaterialResponse {
+  double energy = 0.0;        // W, MPa (energy per unit reference volume)
+  Mat3 stress = Mat3::Zero();  // S, second Piola-Kirchhoff, MPa
+  Mat6 tangent = Mat6::Zero(); // CC = 4 d2W/dCdC in Voigt form, MPa
+};
+
+class Material {
+ public:
+  virtual ~Material() = default;
+  // Evaluates W, S and (when want_tangent) CC at right Cauchy-Green tensor C.
+  virtual MaterialResponse evaluate(const Mat3& C, bool want_tangent) const = 0;
+  // Fibre direction in the reference configuration (unit); zero vector for isotropic materials.
+  virtual Vec3 fibre_direction() const { return Vec3::Zero(); }
+  virtual std::string name() const = 0;
+};
+
+// Symmetric 3x3 <-> Voigt (11, 22, 33, 12, 23, 13).
+Vec6 voigt_stress(const Mat3& s);          // plain components
+Vec6 voigt_strain(const Mat3& e);          // shear components doubled
+Mat3 from_voigt_stress(const Vec6& v);
+
+}  // namespace sf::forming

@@ -1,7 +1,7 @@
 // Accuracy of the surface fit against exact strains and against the classical
 // triangle method, on the analytic cases of gsa/synthetic.hpp (21 x 21 marks at
 // 5 mm). Prints RMS errors of the Green strains at interior marks.
-//   build/bin/gsa_accuracy_bench [seeds=3] [smoothing_scale=1] [third|sobolev]
+//   build/bin/gsa_accuracy_bench [seeds=3] [smoothing_scale=1] [third|sobolev|jumps]
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -14,7 +14,7 @@ using namespace sf::gsa;
 int main(int argc, char** argv) {
   const int seeds = argc > 1 ? std::atoi(argv[1]) : 3;
   const double scale = argc > 2 ? std::atof(argv[2]) : 1.0;
-  const bool sobolev = argc > 3 && std::string(argv[3]) == "sobolev";
+  const std::string penalty = argc > 3 ? argv[3] : "jumps";
   const char* cases[] = {"rigid", "stretch", "shear", "cylinder", "dome", "wavy", "trellis"};
   const double noises[] = {0.0, 0.01, 0.03};
   std::printf("%-9s %6s  %12s %12s %12s  %7s  %s\n", "case", "noise", "surface_rms", "triangle_rms", "surf_border3",
@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
         const GridData g = make_synthetic_grid(synthetic_case(name), go, &exact);
         AnalyseOptions o;
         o.smoothing_scale = scale;
-        if (sobolev) o.penalty = PenaltyKind::kSobolev;
+        if (penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
+        if (penalty == "jumps") o.penalty = PenaltyKind::kJumps;
+        if (penalty == "third") o.penalty = PenaltyKind::kThirdOrder;
         if (std::string(name) == "trellis") o.fibre_angles = {0, 90};
         const AnalysisResult rs = analyse(g, o);
         o.method = Method::kTriangles;

@@ -8,6 +8,8 @@ find_package(CGAL 5.5 REQUIRED)
 find_package(VTK 9 REQUIRED COMPONENTS CommonCore CommonDataModel IOXML IOImage FiltersCore
              FiltersSources FiltersModeling RenderingCore RenderingOpenGL2
              RenderingAnnotation RenderingFreeType)
+# Xlib, to test a DISPLAY before VTK opens it (optional: VTK builds without X need none).
+find_package(X11 QUIET)
 
 # SuiteSparse: newer releases ship SuiteSparse::CHOLMOD / UMFPACK config packages;
 # Debian 12's 5.12 ships none, so we wrap the libraries ourselves.

@@ -6,9 +6,10 @@
 // tangent CC = 4 d2W/dCdC (so dS = CC : dE with dE = dC/2).
 //
 // Voigt order for symmetric 3x3 tensors everywhere in forming/: (11, 22, 33, 12, 23, 13);
-// tangents are 6x6 with "tensor" (not engineering-shear) conventions on BOTH
-// sides: dS_I = sum_J CC_IJ dE_J where dE_J for shear entries is E_12 counted
-// twice, i.e. use voigt_strain() (shear doubled) for dE and voigt_stress() for S.
+// tangents are 6x6 holding the plain tensor components CC_IJ = CC_ijkl (I ~ ij,
+// J ~ kl; no factors of 2), so dS_I = sum_J CC_IJ dE_J holds with dE in
+// voigt_strain() form (shear entries doubled: 2 dE_12, 2 dE_23, 2 dE_13) and S in
+// voigt_stress() form (plain components).
 //
 // Constraints (exact incompressibility J = 1, fibre inextensibility I4 = 1) are
 // NOT part of the material: the element adds -p J C^-1 and T a0 (x) a0 with

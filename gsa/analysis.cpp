@@ -18,6 +18,11 @@ namespace {
 // Calibration constants of the automatic smoothing (docs/theory/strain.md).
 constexpr double kAutoGamma = 500.0;
 constexpr double kAutoBeta = 200.0;
+constexpr double kAutoDelta = 20000.0;
+// A whisper of third-order smoothing holds elements the edge jumps alone cannot
+// (a single element, or elements with fewer marks than parameters).
+constexpr double kJumpsGammaFloor = 1e-6;
+constexpr double kGcvStrainFactor = 3.0;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
@@ -100,7 +105,7 @@ std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, doub
 
 void AnalyseOptions::validate() const {
   if (elements1 < 0 || elements2 < 0) throw UsageError("--elements: expected NxM with positive counts");
-  for (const auto* v : {&alpha, &beta, &gamma})
+  for (const auto* v : {&alpha, &beta, &gamma, &delta})
     if (*v && !(**v >= 0.0)) throw UsageError("--alpha/--beta/--gamma: smoothing weights must be >= 0");
   if (!(smoothing_scale > 0.0)) throw UsageError("--smoothing-scale: must be > 0");
   if (!(outlier_sigma > 0.0)) throw UsageError("--outlier-sigma: must be > 0");
@@ -183,7 +188,10 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   auto penalty_for_noise = [&](double sigma) {
     Penalty p;
     const double ratio = std::max(sigma / d, 1e-6);
-    if (options.penalty == PenaltyKind::kThirdOrder) {
+    if (options.penalty == PenaltyKind::kJumps) {
+      p.delta = options.smoothing_scale * kAutoDelta * std::pow(d, 6) * std::pow(ratio, 1.0) + 1e-8 * std::pow(d, 6);
+      p.gamma = kJumpsGammaFloor * std::pow(d, 4);
+    } else if (options.penalty == PenaltyKind::kThirdOrder) {
       p.gamma = options.smoothing_scale * kAutoGamma * std::pow(d, 4) * std::pow(ratio, 1.2) + 1e-8 * std::pow(d, 4);
       p.beta = 0.0;
     } else {
@@ -195,9 +203,10 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     if (options.alpha) p.alpha = *options.alpha;
     if (options.beta) p.beta = *options.beta;
     if (options.gamma) p.gamma = *options.gamma;
+    if (options.delta) p.delta = *options.delta;
     return p;
   };
-  const bool automatic = !options.alpha && !options.beta && !options.gamma;
+  const bool automatic = !options.alpha && !options.beta && !options.gamma && !options.delta;
   res.smoothing_automatic = automatic;
 
   // --- Undeformed fit alternating with projection; outliers flagged.
@@ -270,7 +279,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   res.penalty_deformed = pen_d;
   auto tf = Clock::now();
   const linalg::SparseMatrix phi = collocation_matrix(mesh, loc);
-  const linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
+  linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
   FitResult fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
   if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
   // Outliers: flag the worst marks beyond the threshold and refit, a few rounds
@@ -282,6 +291,45 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       w_d[k] = 0.0;
       res.points[used[k]].status = kStatusOutlierDeformed;
     }
+    fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
+    if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
+  }
+  if (automatic && options.penalty == PenaltyKind::kJumps) {
+    // Smoothing by generalised cross-validation on the deformed positions, then
+    // scaled up: GCV balances position errors, and strains (derivatives) want
+    // more smoothing (docs/theory/strain.md). Golden-section search on log10(delta).
+    const double n_used = w_d.sum();
+    auto gcv = [&](double log_delta) {
+      Penalty p;
+      p.gamma = kJumpsGammaFloor * std::pow(d, 4);
+      p.delta = std::pow(10.0, log_delta) * std::pow(d, 6);
+      const FitResult f = fit_field(mesh, phi, x, w_d, penalties.combined(p), res.undeformed_parameters, 16);
+      if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
+      double rss = 0.0;
+      for (Index k = 0; k < m; ++k)
+        if (w_d[k] > 0) rss += f.residual[k] * f.residual[k];
+      const double a = 1.0 - f.edf / n_used;
+      return rss / (3.0 * n_used) / (a * a);
+    };
+    double left = -6.0, right = 6.0;
+    const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
+    double c1 = right - golden * (right - left), c2 = left + golden * (right - left);
+    double g1 = gcv(c1), g2 = gcv(c2);
+    for (int it = 0; it < 14 && right - left > 0.1; ++it) {
+      if (g1 <= g2) {
+        right = c2, c2 = c1, g2 = g1;
+        c1 = right - golden * (right - left), g1 = gcv(c1);
+      } else {
+        left = c1, c1 = c2, g1 = g2;
+        c2 = left + golden * (right - left), g2 = gcv(c2);
+      }
+    }
+    res.gcv_log10_delta = 0.5 * (left + right);
+    pen_d = Penalty{};
+    pen_d.gamma = kJumpsGammaFloor * std::pow(d, 4);
+    pen_d.delta = options.smoothing_scale * kGcvStrainFactor * std::pow(10.0, res.gcv_log10_delta) * std::pow(d, 6);
+    pen_mat = penalties.combined(pen_d);
+    res.penalty_deformed = pen_d;
     fit_d = fit_field(mesh, phi, x, w_d, pen_mat, res.undeformed_parameters);
     if (!fit_d.ok) throw InputError(grid.sources.front() + ": " + fit_d.message);
   }
@@ -310,8 +358,9 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   res.times.project = project_time;
   const double rho = 1.0 / (d * d);
   // Effective smoothing length of the strongest term actually used.
-  res.gauge_length = std::max(std::pow(std::max(pen_d.gamma, 0.0) / rho, 1.0 / 6.0),
-                              std::pow(std::max(pen_d.beta, 0.0) / rho, 0.25));
+  res.gauge_length = std::max({std::pow(std::max(pen_d.gamma, 0.0) / rho, 1.0 / 6.0),
+                               std::pow(std::max(pen_d.beta, 0.0) / rho, 0.25),
+                               std::pow(std::max(pen_d.delta, 0.0) / rho, 0.125)});
 
   // --- Strains at the marks.
   auto ts = Clock::now();

@@ -12,6 +12,7 @@
 //  4. deformed fit on the same mesh and xi, smoothing the displacement;
 //  5. strains from the two surfaces' metrics at every mark (and on a sampling).
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,13 +26,13 @@
 namespace sf::gsa {
 
 enum class Method { kSurface, kTriangles };
-enum class PenaltyKind { kThirdOrder, kSobolev };
+enum class PenaltyKind { kThirdOrder, kSobolev, kJumps };
 
 struct AnalyseOptions {
   Method method = Method::kSurface;
-  PenaltyKind penalty = PenaltyKind::kThirdOrder;
+  PenaltyKind penalty = PenaltyKind::kJumps;
   int elements1 = 0, elements2 = 0;  // 0 = automatic (--elements NxM)
-  std::optional<double> alpha, beta, gamma;  // unset = automatic
+  std::optional<double> alpha, beta, gamma, delta;  // unset = automatic
   std::vector<double> fibre_angles;          // degrees from the X axis on the undeformed sheet
   std::string units = "mm";
   double smoothing_scale = 1.0;  // multiplies the automatic smoothing weights
@@ -85,6 +86,7 @@ struct AnalysisResult {
   double noise_estimate = 0.0;   // estimated digitisation noise (units), per coordinate
   double mark_spacing = 0.0;     // mean spacing of marks (units)
   double gauge_length = 0.0;     // effective smoothing length (units)
+  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // GCV optimum, log10(delta / spacing^6)
   double rms_undeformed = 0, max_undeformed = 0, rms_deformed = 0, max_deformed = 0;
   int projection_iterations = 0;
   Index n_triangles = 0;  // triangles method

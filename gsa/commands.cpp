@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <iostream>
 #include <sstream>
 
@@ -21,10 +23,12 @@ namespace sf::gsa {
 
 namespace {
 
+constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
+
 struct AnalyseArgs {
-  std::string grid, undeformed, deformed, out, method = "surface", penalty = "third", elements, columns,
+  std::string grid, undeformed, deformed, out, method = "surface", penalty = "jumps", elements, columns,
       delimiter = ",", fibres, units = "mm";
-  double alpha = -1, beta = -1, gamma = -1, outlier_sigma = 6.0, smoothing_scale = 1.0;
+  double alpha = kUnset, beta = kUnset, gamma = kUnset, delta = kUnset, outlier_sigma = 6.0, smoothing_scale = 1.0;
   int sample = 0;
   bool no_plots = false;
   std::string command_line;
@@ -53,7 +57,8 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   else throw UsageError("--method: expected 'surface' or 'triangles', found '" + a.method + "'");
   if (a.penalty == "third") o.penalty = PenaltyKind::kThirdOrder;
   else if (a.penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
-  else throw UsageError("--penalty: expected 'third' or 'sobolev', found '" + a.penalty + "'");
+  else if (a.penalty == "jumps") o.penalty = PenaltyKind::kJumps;
+  else throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + a.penalty + "'");
   if (!a.elements.empty()) {
     const auto x = a.elements.find('x');
     try {
@@ -65,9 +70,15 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
     }
     if (o.elements1 < 1 || o.elements2 < 1) throw UsageError("--elements: counts must be >= 1");
   }
-  if (a.alpha >= 0) o.alpha = a.alpha;
-  if (a.beta >= 0) o.beta = a.beta;
-  if (a.gamma >= 0) o.gamma = a.gamma;
+  const std::pair<const char*, double> weights[] = {
+      {"--alpha", a.alpha}, {"--beta", a.beta}, {"--gamma", a.gamma}, {"--delta", a.delta}};
+  for (const auto& [name, value] : weights)
+    if (!std::isnan(value) && !(value >= 0.0))
+      throw UsageError(std::string(name) + ": a smoothing weight must be >= 0, found " + std::to_string(value));
+  if (!std::isnan(a.alpha)) o.alpha = a.alpha;
+  if (!std::isnan(a.beta)) o.beta = a.beta;
+  if (!std::isnan(a.gamma)) o.gamma = a.gamma;
+  if (!std::isnan(a.delta)) o.delta = a.delta;
   if (!a.fibres.empty()) o.fibre_angles = parse_angles(a.fibres);
   o.units = a.units;
   o.outlier_sigma = a.outlier_sigma;
@@ -174,11 +185,12 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--deformed", args->deformed, "Deformed grid file (id,x,y,z), with --undeformed");
         app.add_option("-o,--out", args->out, "Output folder (created; files replaced only on success)")->required();
         app.add_option("--method", args->method, "surface (default) or triangles (classical, for comparison)");
-        app.add_option("--penalty", args->penalty, "Smoothing: third (default; third-order + edge jumps) or sobolev (alpha/beta of the brief)");
+        app.add_option("--penalty", args->penalty, "Smoothing: jumps (default; fourth order, C3 edge jumps, weight by cross-validation), third (third-order + edge jumps) or sobolev (alpha/beta of the brief)");
         app.add_option("--elements", args->elements, "Mesh size NxM (default: from the number of marks)");
         app.add_option("--alpha", args->alpha, "First-derivative smoothing weight (default 0)");
         app.add_option("--beta", args->beta, "Second-derivative (curvature) smoothing weight, units^2 (default: automatic)");
         app.add_option("--gamma", args->gamma, "Third-derivative smoothing weight, units^4 (default: automatic)");
+        app.add_option("--delta", args->delta, "Fourth-order (edge-jump) smoothing weight, units^6, with --penalty jumps");
         app.add_option("--fibres", args->fibres, "Fibre mode: two fibre angles in degrees from the X axis on the undeformed sheet, e.g. 0,90");
         app.add_option("--units", args->units, "Length unit of the coordinates, written into every output (default mm)");
         app.add_option("--columns", args->columns, "Map column names, e.g. X=x0,Y=y0,Z=z0,u=u,v=v,w=w (u,v,w = displacements)");

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <random>
 
 #include "common/basis/hermite.hpp"
 #include "common/fe/surface_field.hpp"
@@ -47,14 +48,14 @@ void add_element_block(linalg::TripletAssembler& asm_, const fe::ElementDofMap& 
 }  // namespace
 
 linalg::SparseMatrix PenaltyMatrices::combined(const Penalty& p) const {
-  linalg::SparseMatrix out = p.alpha * first + p.beta * second + p.gamma * third;
+  linalg::SparseMatrix out = p.alpha * first + p.beta * second + p.gamma * third + p.delta * fourth;
   out.prune(0.0);
   return out;
 }
 
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
   const Index n = mesh.n_dofs();
-  linalg::TripletAssembler k1(n, n), k2(n, n), k3(n, n);
+  linalg::TripletAssembler k1(n, n), k2(n, n), k3(n, n), k4(n, n);
   const auto rule = quadrature::gauss_2d(4, 4);
   // Precompute basis derivatives at the Gauss points.
   struct Orders {
@@ -114,6 +115,7 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
       for (std::size_t j = 0; j < dmn.dofs.size(); ++j)
         tn.col(std::find(dofs.begin(), dofs.end(), dmn.dofs[j]) - dofs.begin()) = dmn.t.col(j);
       Eigen::MatrixXd kj = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
+      Eigen::MatrixXd k4j = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
       for (std::size_t g = 0; g < line.points.size(); ++g) {
         const double t = line.points[g];
         const double tn_ = nb.reversed ? 1.0 - t : t;
@@ -122,11 +124,23 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const Eigen::Matrix<double, 16, 1> vn = bicubic_derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
         const Eigen::VectorXd j = te.transpose() * ve - tn.transpose() * vn;
         kj.noalias() += (line.weights[g] * edge_len / h_normal) * j * j.transpose();
+        k4j.noalias() += (line.weights[g] * edge_len / (h_normal * h_normal * h_normal)) * j * j.transpose();
+        // Jump of the third normal derivative. The sign of an odd derivative flips
+        // with the direction of xi: the outward normal of e is +xi at edges 1, 2.
+        const double se = (edge == 1 || edge == 2) ? 1.0 : -1.0;
+        const double sn = (nb.edge == 1 || nb.edge == 2) ? -1.0 : 1.0;  // same physical direction
+        const Eigen::Matrix<double, 16, 1> we =
+            bicubic_derivative(xe, dir_e == 0 ? 3 : 0, dir_e == 0 ? 0 : 3) * (se / std::pow(he[dir_e], 3));
+        const Eigen::Matrix<double, 16, 1> wn =
+            bicubic_derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) * (sn / std::pow(hn[dir_n], 3));
+        const Eigen::VectorXd j3 = te.transpose() * we - tn.transpose() * wn;
+        k4j.noalias() += (line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
       }
       k3.add_block(dofs, dofs, kj);
+      k4.add_block(dofs, dofs, k4j);
     }
   }
-  return {k1.compress(), k2.compress(), k3.compress()};
+  return {k1.compress(), k2.compress(), k3.compress(), k4.compress()};
 }
 
 linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
@@ -148,7 +162,8 @@ linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
 
 FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
                     const Eigen::Ref<const MatX>& values, const VecX& weights,
-                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference) {
+                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
+                    int trace_probes) {
   FitResult out;
   const Index n = mesh.n_dofs();
   const VecX w = weights.size() ? weights : VecX::Ones(phi.rows());
@@ -182,6 +197,17 @@ FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& p
     return out;
   }
   out.parameters = solver.solve(rhs);
+  if (trace_probes > 0) {
+    std::mt19937 rng(12345);
+    std::bernoulli_distribution coin(0.5);
+    MatX z(phi.rows(), trace_probes);
+    for (Index c = 0; c < z.cols(); ++c)
+      for (Index r = 0; r < z.rows(); ++r) z(r, c) = (w[r] > 0.0) ? (coin(rng) ? 1.0 : -1.0) : 0.0;
+    MatX b = wphi.transpose() * z;
+    for (Index i : pinned) b.row(i).setZero();
+    const MatX hz = phi * solver.solve(b);
+    out.edf = (z.array() * hz.array()).sum() / trace_probes;
+  }
   out.fitted = phi * out.parameters;
   out.residual = (out.fitted - values).rowwise().norm();
   double sum = 0.0;

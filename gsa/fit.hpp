@@ -20,6 +20,12 @@
 // + gamma * [ int |u,sss|^2 (1, 3, 3, 1 weights)
 //             + sum over interior edges int_edge [u,nn]^2 ds / h_n ]   (third order)
 //
+// + delta * sum over interior edges int_edge ( [u,nn]^2 / h_n^3 + [u,nnn]^2 / h_n ) ds
+//                                                             (fourth order, "jumps")
+// The fourth-order (jump) term has no interior integral: it only asks the fitted
+// displacement to be C3 across element edges, so its null space is the bicubic
+// polynomials and smooth non-polynomial shapes (a bent sheet's displacement) are
+// biased far less than by the third-order interior integral.
 // The third-order term leaves quadratic fields unpenalised, so it does not force
 // zero curvature at free edges (the boundary bias of the beta term); the edge
 // term penalises the jump of the normal second derivative across element edges,
@@ -28,6 +34,7 @@
 // gamma mm^4 per unit data weight (all relative to the data term per point).
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,6 +48,7 @@ struct Penalty {
   double alpha = 0.0;
   double beta = 0.0;
   double gamma = 0.0;
+  double delta = 0.0;  // fourth order (edge jumps of u,nn and u,nnn), units^6
 };
 
 // Location of a data point on the mesh.
@@ -52,7 +60,7 @@ struct MeshLocation {
 // Penalty matrices of each order (n_dofs x n_dofs, symmetric PSD), assembled once
 // and combined with weights later (automatic smoothing tries several).
 struct PenaltyMatrices {
-  linalg::SparseMatrix first, second, third;
+  linalg::SparseMatrix first, second, third, fourth;
   linalg::SparseMatrix combined(const Penalty& p) const;
 };
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
@@ -68,15 +76,19 @@ struct FitResult {
   VecX residual;     // n_points: |u(xi_d) - z_d|
   double rms = 0.0;  // RMS of residual over points with weight > 0
   double max = 0.0;
+  double edf = std::numeric_limits<double>::quiet_NaN();  // trace of the hat matrix (estimated)
   bool ok = false;
   std::string message;
 };
 
 // Solves the fit. `weights` (n_points, >= 0; 0 excludes a point) may be empty
 // (all 1). `reference` is U_ref (n_dofs x n_components). Dofs no element uses are
-// pinned to the reference.
+// pinned to the reference. With trace_probes > 0 the effective degrees of freedom
+// (trace of the hat matrix Phi K^-1 Phi^T W, per component) are estimated with that
+// many Rademacher probes (Hutchinson; fixed seed) from the same factorisation.
 FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
                     const Eigen::Ref<const MatX>& values, const VecX& weights,
-                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference);
+                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
+                    int trace_probes = 0);
 
 }  // namespace sf::gsa

@@ -70,11 +70,11 @@ std::map<std::string, std::string> parse_column_map(const std::string& text) {
     const std::string item = text.substr(start, end - start);
     const std::size_t eq = item.find('=');
     if (item.empty() || eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      throw InputError("--columns: expected NAME=COLUMN pairs separated by commas (e.g. X=x0,u=disp_x), found '" +
+      throw UsageError("--columns: expected NAME=COLUMN pairs separated by commas (e.g. X=x0,u=disp_x), found '" +
                        item + "'");
     const std::string key = item.substr(0, eq);
     if (!known_keys().count(key))
-      throw InputError("--columns: unknown name '" + key + "' (expected one of id X Y Z x y z u v w i j)");
+      throw UsageError("--columns: unknown name '" + key + "' (expected one of id X Y Z x y z u v w i j)");
     out[key] = item.substr(eq + 1);
     start = end + 1;
   }
@@ -87,7 +87,7 @@ char parse_delimiter(const std::string& text) {
   if (text == "semicolon") return ';';
   if (text == "space") return ' ';
   if (text.size() == 1) return text[0];
-  throw InputError("--delimiter: expected one character or tab/comma/semicolon/space, found '" + text + "'");
+  throw UsageError("--delimiter: expected one character or tab/comma/semicolon/space, found '" + text + "'");
 }
 
 GridData read_grid(const std::string& path, const GridReadOptions& options) {

@@ -21,7 +21,7 @@ struct GridReadOptions {
   std::map<std::string, std::string> columns;
 };
 
-// Parses "--columns" text "X=x0,Y=y0" (throws sf::InputError naming --columns).
+// Parses "--columns" text "X=x0,Y=y0" (throws sf::UsageError naming --columns).
 std::map<std::string, std::string> parse_column_map(const std::string& text);
 // Parses a delimiter option: one character, or "tab", "comma", "semicolon", "space".
 char parse_delimiter(const std::string& text);

@@ -139,12 +139,14 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                       {"plane_axis1", {r.axis1[0], r.axis1[1], r.axis1[2]}},
                       {"plane_axis2", {r.axis2[0], r.axis2[1], r.axis2[2]}}};
     params["penalty"] = r.penalty_kind == PenaltyKind::kThirdOrder ? "third-order (gamma) with edge jumps"
+                        : r.penalty_kind == PenaltyKind::kJumps    ? "fourth-order edge jumps (delta)"
                                                                    : "sobolev (alpha, beta)";
     params["smoothing_automatic"] = r.smoothing_automatic;
     params["undeformed"] = {{"alpha", r.penalty_undeformed.alpha}, {"beta", r.penalty_undeformed.beta},
-                            {"gamma", r.penalty_undeformed.gamma}};
+                            {"gamma", r.penalty_undeformed.gamma}, {"delta", r.penalty_undeformed.delta}};
     params["deformed"] = {{"alpha", r.penalty_deformed.alpha}, {"beta", r.penalty_deformed.beta},
-                          {"gamma", r.penalty_deformed.gamma}, {"smooths", "displacement"}};
+                          {"gamma", r.penalty_deformed.gamma}, {"delta", r.penalty_deformed.delta},
+                          {"smooths", "displacement"}};
     params["noise_estimate"] = r.noise_estimate;
     params["mark_spacing"] = r.mark_spacing;
     params["gauge_length"] = r.gauge_length;

@@ -118,6 +118,13 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
       ++count[p];
     }
   }
+  // One orientation for the whole part, as in the surface method: the normal
+  // towards +Z (triangle lists are consistently oriented, but either way round).
+  Vec3 total = Vec3::Zero();
+  for (const Vec3& v : nsum) total += v;
+  const double scale_n = total.norm();
+  if (total.z() < -1e-9 * scale_n || (std::abs(total.z()) <= 1e-9 * scale_n && total.y() < 0))
+    for (Vec3& v : nsum) v = -v;
   for (Index p : usable) {
     PointResult& pr = r.points[p];
     if (count[p] == 0) {

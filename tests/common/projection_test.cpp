@@ -72,6 +72,29 @@ SurfaceMesh half_cylinder_mesh(double r) {
   return mesh;
 }
 
+// Spherical cap (a hemisphere of radius r about the origin, pole at (0, 0, r)) made
+// from a disk mesh: disk radius rho -> polar angle pi/2 rho; collapsed elements at the pole.
+SurfaceMesh dome_mesh(double r, int n_rings, int n_sectors) {
+  SurfaceMesh mesh =
+      make_disk_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0, n_rings, n_sectors);
+  for (Index node = 0; node < mesh.n_nodes(); ++node) {
+    const Vec3 q = mesh.node_position(node);
+    const double phi = 0.5 * kPi * q.norm(), th = std::atan2(q.y(), q.x());
+    const Vec3 x = r * Vec3(std::sin(phi) * std::cos(th), std::sin(phi) * std::sin(th),
+                            std::cos(phi));
+    mesh.geometry().row(SurfaceMesh::dof(node, kValue)) = x.transpose();
+    if (node == 0) continue;  // apex: value only changes; D1, D2 stay x, y (tangent plane)
+    const Vec3 t1(-std::sin(th), std::cos(th), 0.0);
+    const Vec3 t2(std::cos(phi) * std::cos(th), std::cos(phi) * std::sin(th), -std::sin(phi));
+    mesh.geometry().row(SurfaceMesh::dof(node, kD1)) = t1.transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, kD2)) = t2.transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, kD12)) =
+        (t1 * std::cos(phi) / (r * std::sin(phi))).transpose();
+  }
+  mesh.compute_arc_length_scale_factors();
+  return mesh;
+}
+
 Vec3 unit_normal(const fe::SurfacePoint& s) { return s.dx.col(0).cross(s.dx.col(1)).normalized(); }
 
 // At a converged interior result, p - x is orthogonal to x,1 and x,2.
@@ -347,6 +370,35 @@ TEST(ProjectionTest, DiskApexPointAboveCentre) {
     EXPECT_EQ(w.status, Status::kConverged) << w.brief();
     EXPECT_EQ(w.element, j) << w.brief();
     EXPECT_NEAR(w.distance, 0.2, 1e-9) << w.brief();
+  }
+}
+
+TEST(ProjectionTest, DomeWithCollapsedPoleFindsTheGlobalMinimum) {
+  const double radius = 10.0;
+  const SurfaceMesh mesh = dome_mesh(radius, 4, 8);
+  const fe::SurfaceField field(mesh, mesh.geometry());
+  const SurfaceProjector projector(mesh, mesh.geometry());
+  // Above and below the pole (below: inside the dome, beyond the centre of
+  // curvature for starts away from the pole).
+  for (double z : {14.0, 10.5, 9.0, 6.0}) {
+    const Projection r = projector.project(Vec3(0, 0, z));
+    EXPECT_EQ(r.status, Status::kConverged) << r.brief();
+    EXPECT_TRUE(r.xi.allFinite() && r.point.allFinite());
+    EXPECT_NEAR(r.distance, std::abs(z - radius), 1e-9) << r.brief();
+    EXPECT_LT((r.point - Vec3(0, 0, radius)).norm(), 1e-8) << r.brief();
+  }
+  // Random points around the dome, including near the pole and inside.
+  const std::vector<Vec3> sample = dense_sample(field, 40);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> uxy(-13.0, 13.0), uz(-3.0, 14.0), upole(-0.5, 0.5);
+  for (int k = 0; k < 80; ++k) {
+    const Vec3 p = k < 20 ? Vec3(upole(rng), upole(rng), radius + 4.0 * upole(rng))
+                          : Vec3(uxy(rng), uxy(rng), uz(rng));
+    const Projection r = projector.project(p);
+    ASSERT_TRUE(r.ok()) << r.brief() << " p=" << p.transpose();
+    EXPECT_TRUE(r.xi.allFinite() && std::isfinite(r.distance));
+    EXPECT_LE(r.distance, min_distance(sample, p) + 1e-12) << r.brief() << " p=" << p.transpose();
+    if (r.status == Status::kConverged && r.xi[1] > 1e-6) expect_residual_normal(field, p, r);
   }
 }
 

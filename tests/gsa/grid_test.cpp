@@ -162,9 +162,9 @@ TEST(GsaGrid, ColumnMapRenamesPositions) {
 }
 
 TEST(GsaGrid, BadColumnMapTextIsRejectedNamingTheOption) {
-  EXPECT_THAT(message_of<InputError>([] { parse_column_map("X=x0,Y"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Y'")));
-  EXPECT_THAT(message_of<InputError>([] { parse_column_map("Q=x0"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Q'")));
-  EXPECT_THAT(message_of<InputError>([] { parse_column_map("X="); }), HasSubstr("--columns"));
+  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X=x0,Y"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Y'")));
+  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("Q=x0"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Q'")));
+  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X="); }), HasSubstr("--columns"));
 }
 
 TEST(GsaGrid, DelimiterNames) {
@@ -173,7 +173,7 @@ TEST(GsaGrid, DelimiterNames) {
   EXPECT_EQ(parse_delimiter("comma"), ',');
   EXPECT_EQ(parse_delimiter("space"), ' ');
   EXPECT_EQ(parse_delimiter("|"), '|');
-  EXPECT_THAT(message_of<InputError>([] { parse_delimiter("ab"); }), HasSubstr("--delimiter"));
+  EXPECT_THAT(message_of<UsageError>([] { parse_delimiter("ab"); }), HasSubstr("--delimiter"));
   ScratchDir dir;
   const std::string path = dir.file("grid.csv");
   write_text(path, "id;X;Y;Z;x;y;z\nk1;1,5;2;3;4;5;6\n");  // decimal commas are not numbers

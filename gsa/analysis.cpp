@@ -215,7 +215,9 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   Penalty pen_u = automatic ? penalty_for_noise(0.0) : explicit_penalty(Penalty{});
   double fit_time = 0.0, project_time = 0.0;
   for (int outer = 0; outer < 8; ++outer) {
-    for (int it = 0; it < std::max(1, options.max_projection_iterations); ++it) {
+    // The first round only estimates the noise: one projection is enough there.
+    const int iterations = (automatic && outer == 0) ? 1 : std::max(1, options.max_projection_iterations);
+    for (int it = 0; it < iterations; ++it) {
       auto tf = Clock::now();
       const linalg::SparseMatrix phi = collocation_matrix(mesh, loc);
       fit_u = fit_field(mesh, phi, X, w_u, penalties.combined(pen_u), mesh.geometry());
@@ -299,11 +301,12 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     // scaled up: GCV balances position errors, and strains (derivatives) want
     // more smoothing (docs/theory/strain.md). Golden-section search on log10(delta).
     const double n_used = w_d.sum();
+    FitSystem system(mesh, phi, w_d);
     auto gcv = [&](double log_delta) {
       Penalty p;
       p.gamma = kJumpsGammaFloor * std::pow(d, 4);
       p.delta = std::pow(10.0, log_delta) * std::pow(d, 6);
-      const FitResult f = fit_field(mesh, phi, x, w_d, penalties.combined(p), res.undeformed_parameters, 16);
+      const FitResult f = system.solve(x, penalties.combined(p), res.undeformed_parameters, 12);
       if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
       double rss = 0.0;
       for (Index k = 0; k < m; ++k)
@@ -315,7 +318,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
     double c1 = right - golden * (right - left), c2 = left + golden * (right - left);
     double g1 = gcv(c1), g2 = gcv(c2);
-    for (int it = 0; it < 14 && right - left > 0.1; ++it) {
+    for (int it = 0; it < 14 && right - left > 0.2; ++it) {
       if (g1 <= g2) {
         right = c2, c2 = c1, g2 = g1;
         c1 = right - golden * (right - left), g1 = gcv(c1);

@@ -14,6 +14,7 @@
 #include "gsa/analysis.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/output.hpp"
+#include "gsa/plots.hpp"
 #include "gsa/synthetic.hpp"
 #include "common/io/csv.hpp"
 #include <filesystem>
@@ -31,8 +32,34 @@ struct AnalyseArgs {
   double alpha = kUnset, beta = kUnset, gamma = kUnset, delta = kUnset, outlier_sigma = 6.0, smoothing_scale = 1.0;
   int sample = 0;
   bool no_plots = false;
+  std::string measure = "true", size = "1200x900", view = "auto", flc;
   std::string command_line;
 };
+
+// Picture options shared by `analyse` and `plot`; usage errors name the option.
+PlotOptions make_plot_options(const std::string& measure, const std::string& size, const std::string& view,
+                              const std::string& flc, bool quiet) {
+  PlotOptions po;
+  po.measure = parse_measure(measure, "--measure");
+  po.size = render::parse_size(size, "--size");
+  po.view = render::parse_view(view, "--view");
+  po.flc_path = flc;
+  po.quiet = quiet;
+  if (!flc.empty()) read_flc(flc);  // bad curve files fail before any work
+  return po;
+}
+
+void add_plot_options(CLI::App& app, std::string& measure, std::string& size, std::string& view,
+                      std::string& flc) {
+  app.add_option("--measure", measure, "Strain measure of the pictures: true (default), engineering or lagrangian");
+  app.add_option("--size", size, "Picture size WxH in pixels (default 1200x900)");
+  app.add_option("--view", view,
+                 "View of the formed part: auto (along its mean normal, default), top, iso, front, side, "
+                 "or a direction x,y,z from the part to the eye");
+  app.add_option("--flc", flc,
+                 "Forming limit curve CSV (columns minor,major, in the --measure strain): drawn in the "
+                 "principal strain plot; strains.csv gets flc_margin");
+}
 
 std::vector<double> parse_angles(const std::string& text) {
   std::vector<double> out;
@@ -86,6 +113,8 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   o.sample = a.sample;
   o.quiet = quiet;
   o.validate();
+  PlotOptions po;
+  if (!a.no_plots) po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
 
   GridReadOptions ro;
   ro.delimiter = parse_delimiter(a.delimiter);
@@ -113,6 +142,10 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   result.times.read = read_s;
   io::AtomicOutputDir out(a.out);
   write_results(out, grid, result, o, info);
+  if (!a.no_plots) {
+    cli::status(quiet, "gsa: drawing pictures");
+    write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
+  }
   out.commit();
   Index ok = 0;
   for (const auto& p : result.points) ok += p.strain ? 1 : 0;
@@ -122,6 +155,26 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
     msg << " (mesh " << result.elements1 << "x" << result.elements2 << ", " << result.mesh.n_elements()
         << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
         << ")";
+  cli::status(quiet, msg.str());
+  return cli::kExitOk;
+}
+
+struct PlotArgs {
+  std::string dir, measure = "true", size = "1200x900", view = "auto", flc;
+};
+
+int run_plot(const PlotArgs& a, bool quiet) {
+  const PlotOptions po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+  if (!std::filesystem::is_directory(a.dir))
+    throw InputError(a.dir + ": no such folder; give a results folder written by `gsa analyse`");
+  io::AtomicOutputDir out(a.dir);
+  const PlotSummary s = write_pictures(a.dir, [&out](const std::string& name) { return out.path(name); }, po);
+  out.commit();
+  std::ostringstream msg;
+  msg << "gsa: " << s.pictures.size() << " pictures and report.html in " << a.dir;
+  if (s.flc)
+    msg << "; " << s.n_beyond_flc << " of " << s.n_marks << " marks beyond the forming limit curve"
+        << " (flc_margin in strains.csv)";
   cli::status(quiet, msg.str());
   return cli::kExitOk;
 }
@@ -198,12 +251,21 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--smoothing-scale", args->smoothing_scale, "Multiply the automatic smoothing weights (default 1; >1 smoother)");
         app.add_option("--outlier-sigma", args->outlier_sigma, "Flag marks whose fit residual exceeds this many robust noise sigmas (default 6)");
         app.add_option("--sample", args->sample, "Also write samples.csv with fields on N x N points per element");
-        app.add_flag("--no-plots", args->no_plots, "Do not draw pictures");
+        app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
+        add_plot_options(app, args->measure, args->size, args->view, args->flc);
       },
       [args, prog] {
         args->command_line = "gsa analyse";
         return run_analyse(*args, prog->common().quiet);
       });
+  auto plot = std::make_shared<PlotArgs>();
+  program.add_command(
+      "plot", "Redraw the pictures and report.html of a results folder (other measure, size, view, FLC)",
+      [plot](CLI::App& app) {
+        app.add_option("results", plot->dir, "Results folder written by gsa analyse")->required();
+        add_plot_options(app, plot->measure, plot->size, plot->view, plot->flc);
+      },
+      [plot, prog] { return run_plot(*plot, prog->common().quiet); });
   auto synth = std::make_shared<SynthArgs>();
   program.add_command(
       "synth", "Write a synthetic grid file from an analytic deformation with exact strains",

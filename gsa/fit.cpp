@@ -160,59 +160,74 @@ linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
   return phi.compress();
 }
 
-FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
-                    const Eigen::Ref<const MatX>& values, const VecX& weights,
-                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
-                    int trace_probes) {
+struct FitSystem::Impl {
+  const mesh::SurfaceMesh* mesh;
+  linalg::SparseMatrix phi, wphi, normal;
+  VecX w;
+  std::vector<bool> used;
+  linalg::LinearSolver solver{linalg::SolverKind::kAuto, linalg::MatrixProperty::kSymmetricPositiveDefinite};
+};
+
+FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi, const VecX& weights)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->mesh = &mesh;
+  impl_->phi = phi;
+  impl_->w = weights.size() ? weights : VecX::Ones(phi.rows());
+  impl_->wphi = impl_->w.asDiagonal() * phi;
+  impl_->normal = linalg::SparseMatrix(phi.transpose()) * impl_->wphi;
+  impl_->used = mesh.used_dofs();
+}
+
+FitSystem::~FitSystem() = default;
+
+FitResult FitSystem::solve(const Eigen::Ref<const MatX>& values, const linalg::SparseMatrix& penalty,
+                           const Eigen::Ref<const MatX>& reference, int trace_probes) {
+  Impl& s = *impl_;
   FitResult out;
-  const Index n = mesh.n_dofs();
-  const VecX w = weights.size() ? weights : VecX::Ones(phi.rows());
-  linalg::SparseMatrix wphi = w.asDiagonal() * phi;
-  linalg::SparseMatrix k = linalg::SparseMatrix(phi.transpose()) * wphi + penalty;
+  const Index n = s.mesh->n_dofs();
+  const VecX& w = s.w;
+  linalg::SparseMatrix k = s.normal + penalty;
   MatX clean = values;  // points with weight 0 may be NaN (not digitised)
   for (Index d = 0; d < clean.rows(); ++d)
     if (!(w[d] > 0.0)) clean.row(d).setZero();
-  MatX rhs = wphi.transpose() * clean + penalty * reference;
+  MatX rhs = s.wphi.transpose() * clean + penalty * reference;
   // Pin dofs nothing determines (unused by every element, or with an empty row).
-  const std::vector<bool> used = mesh.used_dofs();
   std::vector<Index> pinned;
   for (Index i = 0; i < n; ++i)
-    if (!used[i]) pinned.push_back(i);
+    if (!s.used[i]) pinned.push_back(i);
   for (Index i : linalg::empty_rows(k))
-    if (used[i]) pinned.push_back(i);
+    if (s.used[i]) pinned.push_back(i);
   if (!pinned.empty()) {
     linalg::TripletAssembler extra(n, n);
     for (Index i : pinned) {
       extra.add(i, i, 1.0);
       rhs.row(i) = reference.row(i);
     }
-    // Zero the pinned rows/columns first (unused dofs have none; empty rows neither).
     k += extra.compress();
   }
-  linalg::LinearSolver solver(linalg::SolverKind::kAuto, linalg::MatrixProperty::kSymmetricPositiveDefinite);
-  const linalg::SolveReport& rep = solver.factorize(k);
+  const linalg::SolveReport& rep = s.solver.factorize(k);
   if (!rep.ok()) {
     out.message = "surface fit: the smoothed least-squares system is singular (" + rep.brief() +
-                  "); too few points for the mesh, or all points on a line";
+                  "); too few points for the mesh (try fewer elements), or all points on a line";
     return out;
   }
-  out.parameters = solver.solve(rhs);
+  out.parameters = s.solver.solve(rhs);
   if (trace_probes > 0) {
     std::mt19937 rng(12345);
     std::bernoulli_distribution coin(0.5);
-    MatX z(phi.rows(), trace_probes);
+    MatX z(s.phi.rows(), trace_probes);
     for (Index c = 0; c < z.cols(); ++c)
       for (Index r = 0; r < z.rows(); ++r) z(r, c) = (w[r] > 0.0) ? (coin(rng) ? 1.0 : -1.0) : 0.0;
-    MatX b = wphi.transpose() * z;
+    MatX b = s.wphi.transpose() * z;
     for (Index i : pinned) b.row(i).setZero();
-    const MatX hz = phi * solver.solve(b);
+    const MatX hz = s.phi * s.solver.solve(b);
     out.edf = (z.array() * hz.array()).sum() / trace_probes;
   }
-  out.fitted = phi * out.parameters;
+  out.fitted = s.phi * out.parameters;
   out.residual = (out.fitted - values).rowwise().norm();
   double sum = 0.0;
   Index count = 0;
-  for (Index d = 0; d < phi.rows(); ++d) {
+  for (Index d = 0; d < s.phi.rows(); ++d) {
     if (w[d] <= 0.0) continue;
     sum += out.residual[d] * out.residual[d];
     out.max = std::max(out.max, out.residual[d]);
@@ -222,6 +237,14 @@ FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& p
   out.ok = out.parameters.allFinite();
   if (!out.ok) out.message = "surface fit: the solution is not finite";
   return out;
+}
+
+FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
+                    const Eigen::Ref<const MatX>& values, const VecX& weights,
+                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
+                    int trace_probes) {
+  FitSystem system(mesh, phi, weights);
+  return system.solve(values, penalty, reference, trace_probes);
 }
 
 }  // namespace sf::gsa

@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,24 @@ struct FitResult {
   double edf = std::numeric_limits<double>::quiet_NaN();  // trace of the hat matrix (estimated)
   bool ok = false;
   std::string message;
+};
+
+// A least-squares system (collocation and weights fixed) solved for several
+// penalties in turn: the normal matrix Phi^T W Phi is formed once and the sparse
+// factorisation's symbolic analysis is reused while the pattern stays the same.
+class FitSystem {
+ public:
+  FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi, const VecX& weights);
+  ~FitSystem();
+  FitSystem(const FitSystem&) = delete;
+  FitSystem& operator=(const FitSystem&) = delete;
+  // As fit_field() below, with this system's collocation and weights.
+  FitResult solve(const Eigen::Ref<const MatX>& values, const linalg::SparseMatrix& penalty,
+                  const Eigen::Ref<const MatX>& reference, int trace_probes = 0);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Solves the fit. `weights` (n_points, >= 0; 0 excludes a point) may be empty

@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopencv-dev libcgal-dev libvtk9-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libyaml-cpp-dev libfmt-dev xvfb xauth
-  libopenblas0-pthread  # optimised BLAS under CHOLMOD (Debian's reference BLAS is ~10x slower)
+  libopenblas0-serial  # optimised BLAS under CHOLMOD (reference BLAS is ~10x slower; serial: no spinning threads)
 )
 
 missing=()

@@ -1,0 +1,679 @@
+#include "gsa/plots.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+
+#include "common/cli/progress.hpp"
+#include "common/core/error.hpp"
+#include "common/io/csv.hpp"
+#include "common/io/json.hpp"
+#include "common/io/vtk_xml.hpp"
+#include "common/render/chart.hpp"
+#include "common/render/display.hpp"
+#include "gsa/report.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const render::Colour kTension{0.80, 0.11, 0.09};
+const render::Colour kCompression{0.09, 0.31, 0.78};
+const render::Colour kScaleArrow{0.2, 0.2, 0.2};
+const render::Colour kFibre1{0.90, 0.42, 0.0};
+const render::Colour kFibre2{0.16, 0.16, 0.62};
+
+// Marks per sample spacing across the part: about this many sample points along the
+// longer side of a square mesh.
+constexpr double kSamplesAcross = 12.0;
+
+const io::FieldArray* find_field(const io::PolyMesh& m, const std::string& name, int n_components) {
+  for (const auto& f : m.point_data)
+    if (f.name == name && f.n_components == n_components &&
+        static_cast<Index>(f.n_tuples()) == m.n_points())
+      return &f;
+  return nullptr;
+}
+
+const io::FieldArray& require_field(const io::PolyMesh& m, const std::string& name, int n_components,
+                                    const std::string& file) {
+  const io::FieldArray* f = find_field(m, name, n_components);
+  if (!f)
+    throw InputError(file + ": missing point data array '" + name + "' (" + std::to_string(n_components) +
+                     " component" + (n_components > 1 ? "s" : "") + "); was it written by gsa analyse?");
+  return *f;
+}
+
+Vec3 vec_of(const io::FieldArray& f, Index i) {
+  const auto k = static_cast<std::size_t>(i) * 3;
+  return {f.values[k], f.values[k + 1], f.values[k + 2]};
+}
+
+double polygon_area(const io::PolyMesh& m, const std::vector<Index>& poly) {
+  Vec3 n = Vec3::Zero();
+  for (std::size_t k = 0; k < poly.size(); ++k)
+    n += m.points.row(poly[k]).transpose().cross(m.points.row(poly[(k + 1) % poly.size()]).transpose());
+  return 0.5 * n.norm();
+}
+
+double surface_area(const io::PolyMesh& m) {
+  double a = 0;
+  for (const auto& p : m.polygons) a += polygon_area(m, p);
+  return a;
+}
+
+std::array<std::string, 2> measure_fields(StrainMeasure m) {
+  switch (m) {
+    case StrainMeasure::kTrue: return {"true1", "true2"};
+    case StrainMeasure::kEngineering: return {"eng1", "eng2"};
+    case StrainMeasure::kLagrangian: return {"E1", "E2"};
+  }
+  return {"true1", "true2"};
+}
+
+// Short label of a measure for titles: "true", "engineering", "Green".
+std::string measure_word(StrainMeasure m) {
+  switch (m) {
+    case StrainMeasure::kTrue: return "true";
+    case StrainMeasure::kEngineering: return "engineering";
+    case StrainMeasure::kLagrangian: return "Green";
+  }
+  return "true";
+}
+
+// ---------------------------------------------------------------------------------------
+// The results folder
+
+struct Results {
+  std::string dir;
+  nlohmann::json summary;
+  std::string units = "mm";
+  std::string case_name;
+  std::vector<double> fibre_angles;
+  bool has_surfaces = false;
+  io::PolyMesh undeformed, deformed;
+  io::CsvTable strains;
+};
+
+std::string case_name_of(const nlohmann::json& summary, const std::string& dir) {
+  if (summary.contains("inputs") && summary["inputs"].is_array() && !summary["inputs"].empty() &&
+      summary["inputs"][0].is_string()) {
+    const fs::path p = summary["inputs"][0].get<std::string>();
+    const std::string parent = p.parent_path().filename().string();
+    return parent.empty() ? p.filename().string() : parent + "/" + p.filename().string();
+  }
+  return fs::path(dir).filename().string();
+}
+
+Results read_results(const std::string& dir) {
+  Results r;
+  r.dir = dir;
+  const fs::path d(dir);
+  const std::string strains = (d / "strains.csv").string();
+  if (!fs::exists(strains))
+    throw InputError(dir + ": no strains.csv here; give a folder written by `gsa analyse`");
+  r.strains = io::read_csv(strains);
+  const std::string summary = (d / "summary.json").string();
+  if (fs::exists(summary)) {
+    r.summary = io::read_json(summary);
+    if (r.summary.contains("units") && r.summary["units"].contains("length") &&
+        r.summary["units"]["length"].is_string())
+      r.units = r.summary["units"]["length"].get<std::string>();
+    const auto& params = r.summary.contains("parameters") ? r.summary["parameters"] : nlohmann::json();
+    if (params.is_object() && params.contains("fibre_angles_deg") && params["fibre_angles_deg"].is_array())
+      for (const auto& a : params["fibre_angles_deg"])
+        if (a.is_number()) r.fibre_angles.push_back(a.get<double>());
+  }
+  r.case_name = case_name_of(r.summary, dir);
+  const std::string u = (d / "undeformed.vtp").string(), v = (d / "deformed.vtp").string();
+  if (fs::exists(u) && fs::exists(v)) {
+    r.undeformed = io::read_vtp(u);
+    r.deformed = io::read_vtp(v);
+    if (r.undeformed.n_points() != r.deformed.n_points() ||
+        r.undeformed.polygons.size() != r.deformed.polygons.size())
+      throw InputError(v + ": does not match " + u + " point for point; rerun gsa analyse");
+    r.has_surfaces = r.undeformed.n_points() > 0 && !r.undeformed.polygons.empty();
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------
+// Sampling points for arrows and fibre lines
+
+struct Sampling {
+  std::vector<Index> points;                     // point indices (same on both surfaces)
+  double spacing = 1;                            // model units on the undeformed surface
+  std::vector<std::vector<Index>> element_edges;  // element boundaries as polylines
+};
+
+Sampling sample_surface(const io::PolyMesh& m) {
+  Sampling s;
+  const double area = surface_area(m);
+  // gsa writes each element as (subdiv + 1)^2 points, subdiv^2 quads, cell data "element".
+  const io::FieldArray* element = nullptr;
+  for (const auto& f : m.cell_data)
+    if (f.name == "element" && f.n_components == 1 && f.values.size() == m.n_cells()) element = &f;
+  Index n_el = 0;
+  if (element)
+    for (double e : element->values) n_el = std::max<Index>(n_el, static_cast<Index>(e) + 1);
+  int subdiv = 0;
+  if (n_el > 0 && m.polygons.size() % static_cast<std::size_t>(n_el) == 0) {
+    const auto per = static_cast<double>(m.polygons.size() / static_cast<std::size_t>(n_el));
+    subdiv = static_cast<int>(std::lround(std::sqrt(per)));
+    if (static_cast<double>(subdiv) * subdiv != per ||
+        m.n_points() != n_el * (subdiv + 1) * (subdiv + 1))
+      subdiv = 0;
+  }
+  if (subdiv > 0) {
+    const int np = subdiv + 1;
+    const int k = std::clamp(static_cast<int>(std::lround(kSamplesAcross / std::sqrt(double(n_el)))), 1,
+                             std::max(1, subdiv / 2));
+    std::vector<int> at;
+    for (int q = 0; q < k; ++q) at.push_back(static_cast<int>(std::lround((q + 0.5) * subdiv / k)));
+    for (Index e = 0; e < n_el; ++e) {
+      const Index base = e * np * np;
+      for (int j : at)
+        for (int i : at) s.points.push_back(base + j * np + i);
+      std::vector<Index> b0, b1, b2, b3;
+      for (int t = 0; t < np; ++t) {
+        b0.push_back(base + t);
+        b1.push_back(base + subdiv * np + t);
+        b2.push_back(base + t * np);
+        b3.push_back(base + t * np + subdiv);
+      }
+      s.element_edges.insert(s.element_edges.end(), {b0, b1, b2, b3});
+    }
+  } else {
+    // Any tessellation: the point nearest to the centre of each cell of a square grid over
+    // the surface's bounding box in its two widest coordinates.
+    const Eigen::RowVector3d lo = m.points.colwise().minCoeff(), hi = m.points.colwise().maxCoeff();
+    Eigen::RowVector3d ext = hi - lo;
+    int a = 0, b = 1;
+    if (ext[2] > std::min(ext[0], ext[1])) (ext[0] < ext[1] ? a : b) = 2;
+    const double h = std::max(ext[a], ext[b]) / kSamplesAcross;
+    const int na = std::max(1, static_cast<int>(std::ceil(ext[a] / h))),
+              nb = std::max(1, static_cast<int>(std::ceil(ext[b] / h)));
+    std::vector<Index> best(static_cast<std::size_t>(na * nb), -1);
+    std::vector<double> dist(best.size(), HUGE_VAL);
+    for (Index p = 0; p < m.n_points(); ++p) {
+      const double u = (m.points(p, a) - lo[a]) / h, v = (m.points(p, b) - lo[b]) / h;
+      const int iu = std::min(na - 1, static_cast<int>(u)), iv = std::min(nb - 1, static_cast<int>(v));
+      const double d = std::hypot(u - iu - 0.5, v - iv - 0.5);
+      const auto c = static_cast<std::size_t>(iv * na + iu);
+      if (d < dist[c] && d < 0.35) dist[c] = d, best[c] = p;
+    }
+    for (Index p : best)
+      if (p >= 0) s.points.push_back(p);
+  }
+  s.spacing = s.points.empty() ? 1.0 : std::sqrt(area / static_cast<double>(s.points.size()));
+  if (!(s.spacing > 0)) s.spacing = 1.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// Scene pieces
+
+render::Surface plain_surface(const io::PolyMesh& m) {
+  render::Surface s;
+  s.points = m.points;
+  s.polygons = m.polygons;
+  return s;
+}
+
+// Colour range for a field: round bands over its finite values, at least `min_span` wide
+// (a nearly uniform field shows as one or two bands, not as amplified noise); diverging
+// and centred on 0 when the values take both signs.
+render::ScalarColouring colouring_for(const std::vector<double>& values, const std::string& title,
+                                      const std::string& units, double min_span) {
+  render::ScalarColouring c;
+  c.title = title;
+  c.units = units;
+  c.values = values;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (double v : values)
+    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  if (!(hi >= lo)) lo = 0, hi = 1;
+  if (hi - lo < min_span) {
+    const double mid = 0.5 * (lo + hi);
+    lo = mid - min_span / 2;
+    hi = mid + min_span / 2;
+  }
+  const bool signed_field = lo < 0 && hi > 0;
+  c.map = signed_field ? render::ColourMap::kDiverging : render::ColourMap::kViridis;
+  c.bands = render::nice_bands(lo, hi, 10, signed_field);
+  return c;
+}
+
+std::vector<double> scalar_values(const io::PolyMesh& m, const std::string& name, const std::string& file) {
+  return require_field(m, name, 1, file).values;
+}
+
+std::string range_text(const std::vector<double>& v, int decimals, const std::string& unit) {
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (double x : v)
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  if (!(hi >= lo)) return "no values";
+  return "from " + render::format_fixed(lo, decimals) + unit + " to " + render::format_fixed(hi, decimals) + unit;
+}
+
+// Decimals that show a strain range sensibly (3 significant digits of its largest value).
+int decimals_for(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v)
+    if (std::isfinite(x)) m = std::max(m, std::abs(x));
+  if (m <= 0) return 3;
+  return std::clamp(2 - static_cast<int>(std::floor(std::log10(m))), 0, 6);
+}
+
+// The largest round number (1, 2, 5 x 10^k) not above `x`.
+double round_down_125(double x) {
+  if (!(x > 0)) return 0;
+  const double p = std::pow(10.0, std::floor(std::log10(x)));
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * p <= x * (1 + 1e-9)) return m * p;
+  return p;
+}
+
+struct ArrowScale {
+  double model_per_strain = 0;  // arrow length per unit strain (model units)
+  double reference = 0;         // strain of the legend's scale arrow
+  double spacing = 1;
+};
+
+ArrowScale arrow_scale(const Results& r, const Sampling& s, StrainMeasure m) {
+  const auto names = measure_fields(m);
+  const std::string file = r.dir + "/undeformed.vtp";
+  const auto& e1 = require_field(r.undeformed, names[0], 1, file);
+  const auto& e2 = require_field(r.undeformed, names[1], 1, file);
+  double emax = 0;
+  for (Index p : s.points)
+    for (const auto* f : {&e1, &e2}) {
+      const double v = f->values[static_cast<std::size_t>(p)];
+      if (std::isfinite(v)) emax = std::max(emax, std::abs(v));
+    }
+  ArrowScale a;
+  a.spacing = s.spacing;
+  if (emax <= 0) emax = 1e-3;
+  // The longest arrow reaches 38 % of the spacing from the centre (pairs never touch).
+  a.model_per_strain = 0.34 * s.spacing / emax;
+  a.reference = round_down_125(emax);
+  return a;
+}
+
+render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale& a, bool deformed,
+                          const PlotOptions& o) {
+  const io::PolyMesh& m = deformed ? r.deformed : r.undeformed;
+  const std::string file = r.dir + (deformed ? "/deformed.vtp" : "/undeformed.vtp");
+  const auto names = measure_fields(o.measure);
+  const auto& e1 = require_field(m, names[0], 1, file);
+  const auto& e2 = require_field(m, names[1], 1, file);
+  const auto& d1 = require_field(m, "dir1", 3, file);
+  const auto& d2 = require_field(m, "dir2", 3, file);
+
+  render::Scene scene;
+  scene.title = deformed ? "Principal strains on the formed part" : "Principal strains on the blank";
+  scene.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(o.measure) + " strain  \xC2\xB7  " +
+                   (deformed ? "deformed surface" : "undeformed surface (material directions before forming)");
+  scene.view = deformed ? o.view : render::View{};
+  scene.footnote = "Arrows along the major and minor directions at " + std::to_string(s.points.size()) +
+                   " points; length proportional to the strain, true to scale where the surface faces the "
+                   "viewer. View: " + render::view_name(scene.view) + ". Lengths in " + r.units + ".";
+  render::Surface surf = plain_surface(m);
+  surf.colour = {0.93, 0.93, 0.93};
+  surf.lines = s.element_edges;
+  surf.line_colour = {0.78, 0.78, 0.78};
+  scene.surfaces.push_back(std::move(surf));
+
+  render::GlyphSet tension, compression;
+  tension.colour = kTension;
+  compression.colour = kCompression;
+  for (auto* g : {&tension, &compression}) {
+    g->width = 0.05 * a.spacing;
+    g->head_length = 0.16 * a.spacing;
+    g->head_width = 0.15 * a.spacing;
+  }
+  const double gap = 0.06 * a.spacing;
+  const double min_length = 0.03 * a.spacing;
+  for (Index p : s.points) {
+    const Vec3 x = m.points.row(p).transpose();
+    for (int k = 0; k < 2; ++k) {
+      const double e = (k == 0 ? e1 : e2).values[static_cast<std::size_t>(p)];
+      Vec3 d = vec_of(k == 0 ? d1 : d2, p);
+      if (!std::isfinite(e) || !d.allFinite() || d.norm() < 1e-12) continue;
+      d.normalize();
+      const double len = a.model_per_strain * std::abs(e);
+      if (len < min_length) continue;
+      for (const double sgn : {-1.0, 1.0}) {
+        const Vec3 inner = x + sgn * gap * d, outer = x + sgn * (gap + len) * d;
+        if (e > 0) {
+          tension.tails.push_back(inner);
+          tension.heads.push_back(outer);
+        } else {
+          compression.tails.push_back(outer);
+          compression.heads.push_back(inner);
+        }
+      }
+    }
+  }
+  scene.glyphs = {tension, compression};
+  scene.legend_title = "Arrows";
+  render::LegendEntry t, c, ref;
+  t.kind = c.kind = ref.kind = render::LegendEntry::Kind::kArrow;
+  t.colour = kTension;
+  t.label = "tension (heads out)";
+  t.glyph_set = 0;
+  c.colour = kCompression;
+  c.label = "compression (heads in)";
+  c.glyph_set = 1;
+  ref.colour = kScaleArrow;
+  ref.glyph_set = 0;
+  ref.model_length = a.model_per_strain * a.reference;
+  ref.label = "scale: " + render::format_fixed(a.reference, std::max(0, decimals_for({a.reference}) - 2)) +
+              " " + measure_word(o.measure) + " strain";
+  scene.legend = {t, c, ref};
+  return scene;
+}
+
+render::Scene contour_scene(const Results& r, const std::vector<double>& values, const std::string& title,
+                            const std::string& bar_title, const std::string& units, double min_span,
+                            const std::string& what, const PlotOptions& o) {
+  render::Scene scene;
+  scene.title = title;
+  scene.subtitle = r.case_name + "  \xC2\xB7  " + what;
+  scene.view = o.view;
+  scene.footnote = "Formed part (deformed surface). View: " + render::view_name(o.view) +
+                   ". Bands of equal width; dark lines at the band edges.";
+  render::Surface surf = plain_surface(r.deformed);
+  surf.colouring = colouring_for(values, bar_title, units, min_span);
+  scene.surfaces.push_back(std::move(surf));
+  return scene;
+}
+
+render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions& o) {
+  const std::string file = r.dir + "/deformed.vtp";
+  const auto& f1 = require_field(r.deformed, "fibre1", 3, file);
+  const auto& f2 = require_field(r.deformed, "fibre2", 3, file);
+  render::Scene scene;
+  scene.title = "Fibre directions on the formed part";
+  scene.subtitle = r.case_name + "  \xC2\xB7  both fibre families, current directions";
+  scene.view = o.view;
+  scene.footnote = "Short lines along each fibre family at " + std::to_string(s.points.size()) +
+                   " points of the deformed surface. View: " + render::view_name(o.view) + ".";
+  render::Surface surf = plain_surface(r.deformed);
+  surf.colour = {0.93, 0.93, 0.93};
+  surf.lines = s.element_edges;
+  surf.line_colour = {0.78, 0.78, 0.78};
+  scene.surfaces.push_back(std::move(surf));
+  const double half = 0.36 * s.spacing;
+  render::GlyphSet g1, g2;
+  g1.kind = g2.kind = render::GlyphSet::Kind::kSegment;
+  g1.colour = kFibre1;
+  g2.colour = kFibre2;
+  g1.width = g2.width = 0.06 * s.spacing;
+  for (Index p : s.points) {
+    const Vec3 x = r.deformed.points.row(p).transpose();
+    for (int k = 0; k < 2; ++k) {
+      Vec3 d = vec_of(k == 0 ? f1 : f2, p);
+      if (!d.allFinite() || d.norm() < 1e-12) continue;
+      d.normalize();
+      auto& g = k == 0 ? g1 : g2;
+      g.tails.push_back(x - half * d);
+      g.heads.push_back(x + half * d);
+    }
+  }
+  scene.glyphs = {g1, g2};
+  scene.legend_title = "Fibre families";
+  for (int k = 0; k < 2; ++k) {
+    render::LegendEntry e;
+    e.kind = render::LegendEntry::Kind::kLine;
+    e.colour = k == 0 ? kFibre1 : kFibre2;
+    e.width_px = 4;
+    std::string angle = k < static_cast<int>(r.fibre_angles.size())
+                            ? render::format_fixed(r.fibre_angles[static_cast<std::size_t>(k)], 0) + "\xC2\xB0"
+                            : "";
+    e.label = "family " + std::to_string(k + 1) + (angle.empty() ? "" : " (" + angle + " on the blank)");
+    scene.legend.push_back(e);
+  }
+  return scene;
+}
+
+// ---------------------------------------------------------------------------------------
+// Principal strain plot
+
+struct MarkStrains {
+  std::vector<double> minor, major;
+};
+
+MarkStrains mark_strains(const Results& r, StrainMeasure m) {
+  const auto names = measure_fields(m);
+  const io::CsvTable& t = r.strains;
+  const std::size_t c1 = t.column_index(names[0]), c2 = t.column_index(names[1]);
+  const auto cs = t.find_column("status");
+  MarkStrains out;
+  for (std::size_t row = 0; row < t.n_rows(); ++row) {
+    double e1 = kNaN, e2 = kNaN;
+    if (!cs || t.cell(row, *cs) == "ok") {
+      e1 = t.number(row, c1, true);
+      e2 = t.number(row, c2, true);
+    }
+    out.major.push_back(e1);
+    out.minor.push_back(e2);
+  }
+  return out;
+}
+
+// Reference path lambda2 = lambda1^k for lambda1 >= 1 (both directions for k = 1).
+render::ChartSeries reference_line(double k, StrainMeasure m, const std::string& label,
+                                   const render::Colour& colour, double dash) {
+  render::ChartSeries s;
+  s.style = render::ChartSeries::Style::kLine;
+  s.label = label;
+  s.colour = colour;
+  s.size_px = 2;
+  s.dash_px = dash;
+  s.sets_range = false;
+  const double lmin = k == 1.0 ? 0.2 : 1.0;
+  for (int i = 0; i <= 400; ++i) {
+    const double l1 = lmin * std::pow(5.0 / lmin, i / 400.0);
+    const double l2 = std::pow(l1, k);
+    s.x.push_back(strain_of_stretch(l2, m));
+    s.y.push_back(strain_of_stretch(l1, m));
+  }
+  return s;
+}
+
+render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std::vector<double>& margin,
+                              const FormingLimitCurve* flc, const PlotOptions& o, PlotSummary& summary) {
+  const std::string w = measure_word(o.measure);
+  render::Chart chart;
+  chart.title = "Principal strains";
+  chart.x_label = "minor strain (" + w + ")";
+  chart.y_label = "major strain (" + w + ")";
+  chart.equal_axes = true;
+  chart.legend_title = "Reference lines";
+  const std::string uni = o.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
+  const std::string shear = o.measure == StrainMeasure::kTrue ? "pure shear (major = -minor)" : "pure shear";
+  chart.series.push_back(reference_line(1.0, o.measure, "equibiaxial (major = minor)", {0.85, 0.45, 0.0}, 9));
+  chart.series.push_back(reference_line(0.0, o.measure, "plane strain (minor = 0)", {0.10, 0.55, 0.20}, 0));
+  chart.series.push_back(reference_line(-0.5, o.measure, uni, {0.50, 0.22, 0.68}, 5));
+  chart.series.push_back(reference_line(-1.0, o.measure, shear, {0.45, 0.33, 0.18}, 2.5));
+  render::ChartSeries safe, beyond;
+  safe.colour = {0.10, 0.27, 0.60};
+  beyond.colour = {0.85, 0.08, 0.08};
+  safe.size_px = beyond.size_px = 3.2;
+  safe.opacity = 0.75;
+  Index n = 0;
+  for (std::size_t i = 0; i < ms.major.size(); ++i) {
+    if (!std::isfinite(ms.major[i]) || !std::isfinite(ms.minor[i])) continue;
+    ++n;
+    const bool out = flc && i < margin.size() && std::isfinite(margin[i]) && margin[i] < 0;
+    auto& s = out ? beyond : safe;
+    s.x.push_back(ms.minor[i]);
+    s.y.push_back(ms.major[i]);
+  }
+  summary.n_marks = n;
+  safe.label = "marks (" + std::to_string(safe.x.size()) + ")";
+  chart.series.push_back(safe);
+  if (flc) {
+    render::ChartSeries curve;
+    curve.style = render::ChartSeries::Style::kLine;
+    curve.label = "forming limit curve";
+    curve.colour = {0.85, 0.08, 0.08};
+    curve.size_px = 3;
+    curve.sets_range = true;
+    curve.x = flc->minor;
+    curve.y = flc->major;
+    chart.series.push_back(curve);
+    beyond.label = "beyond the limit (" + std::to_string(beyond.x.size()) + ")";
+    chart.series.push_back(beyond);
+    summary.n_beyond_flc = static_cast<Index>(beyond.x.size());
+  }
+  chart.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(o.measure) + " strain  \xC2\xB7  " +
+                   std::to_string(n) + " marks";
+  chart.footnote = "One dot per analysed mark (strains.csv). Equal axes." +
+                   std::string(flc ? " Forming limit curve from " + fs::path(flc->source).filename().string() +
+                                         ", in " + w + " strain."
+                                   : "");
+  return chart;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+
+StrainMeasure parse_measure(const std::string& text, const std::string& option) {
+  std::string t = text;
+  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (t == "true" || t == "logarithmic" || t == "natural") return StrainMeasure::kTrue;
+  if (t == "engineering") return StrainMeasure::kEngineering;
+  if (t == "lagrangian" || t == "green") return StrainMeasure::kLagrangian;
+  throw UsageError(option + ": expected true, engineering or lagrangian, found '" + text + "'");
+}
+
+std::string measure_name(StrainMeasure m) {
+  switch (m) {
+    case StrainMeasure::kTrue: return "true";
+    case StrainMeasure::kEngineering: return "engineering";
+    case StrainMeasure::kLagrangian: return "Lagrangian (Green)";
+  }
+  return "true";
+}
+
+double strain_of_stretch(double l, StrainMeasure m) {
+  switch (m) {
+    case StrainMeasure::kTrue: return std::log(l);
+    case StrainMeasure::kEngineering: return l - 1;
+    case StrainMeasure::kLagrangian: return 0.5 * (l * l - 1);
+  }
+  return kNaN;
+}
+
+double FormingLimitCurve::major_at(double m) const {
+  if (minor.size() < 2 || !std::isfinite(m) || m < minor.front() || m > minor.back()) return kNaN;
+  const auto it = std::upper_bound(minor.begin(), minor.end(), m);
+  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - minor.begin()), minor.size() - 1);
+  const std::size_t a = i - 1, b = i;
+  if (minor[b] == minor[a]) return std::min(major[a], major[b]);
+  const double t = (m - minor[a]) / (minor[b] - minor[a]);
+  return (1 - t) * major[a] + t * major[b];
+}
+
+FormingLimitCurve read_flc(const std::string& path) {
+  const io::CsvTable t = io::read_csv(path);
+  const std::size_t cm = t.column_index("minor"), cM = t.column_index("major");
+  std::vector<std::pair<double, double>> pts;
+  for (std::size_t r = 0; r < t.n_rows(); ++r) pts.emplace_back(t.number(r, cm), t.number(r, cM));
+  if (pts.size() < 2)
+    throw InputError(path + ": a forming limit curve needs at least 2 rows (minor, major), found " +
+                     std::to_string(pts.size()));
+  std::stable_sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  FormingLimitCurve c;
+  c.source = path;
+  for (const auto& [m, M] : pts) {
+    c.minor.push_back(m);
+    c.major.push_back(M);
+  }
+  return c;
+}
+
+PlotSummary write_pictures(const std::string& in_dir,
+                           const std::function<std::string(const std::string&)>& out_path,
+                           const PlotOptions& o) {
+  const Results r = read_results(in_dir);
+  std::optional<FormingLimitCurve> flc;
+  if (!o.flc_path.empty()) flc = read_flc(o.flc_path);
+  PlotSummary summary;
+  summary.flc = flc.has_value();
+  summary.min_flc_margin = kNaN;
+
+  const MarkStrains ms = mark_strains(r, o.measure);
+  std::vector<double> margin(ms.major.size(), kNaN);
+  if (flc) {
+    for (std::size_t i = 0; i < ms.major.size(); ++i) {
+      margin[i] = flc->major_at(ms.minor[i]) - ms.major[i];
+      if (std::isfinite(margin[i]) &&
+          !(std::isfinite(summary.min_flc_margin) && summary.min_flc_margin <= margin[i]))
+        summary.min_flc_margin = margin[i];
+    }
+  }
+
+  const bool fibres = r.has_surfaces && find_field(r.deformed, "shear_angle_deg", 1) != nullptr;
+  const int n_pictures = r.has_surfaces ? (fibres ? 8 : 6) : 1;
+  const auto display = render::acquire_display();  // one display for all pictures
+  cli::Progress progress("gsa: drawing pictures", n_pictures, o.quiet);
+  int done = 0;
+  auto draw = [&](const std::string& name, const render::Scene& scene) {
+    render::write_png(scene, o.size, out_path(name));
+    summary.pictures.push_back(name);
+    progress.update(++done);
+  };
+
+  if (r.has_surfaces) {
+    const Sampling s = sample_surface(r.undeformed);
+    const ArrowScale a = arrow_scale(r, s, o.measure);
+    draw("arrows_undeformed.png", arrow_scene(r, s, a, false, o));
+    draw("arrows_deformed.png", arrow_scene(r, s, a, true, o));
+    const std::string file = r.dir + "/deformed.vtp";
+    const auto th = scalar_values(r.deformed, "thickness_change_pct", file);
+    draw("thickness.png",
+         contour_scene(r, th, "Thickness change", "Thickness change", "%", 1.0,
+                       "incompressible sheet: 100 (1/(lambda1 lambda2) - 1), " + range_text(th, 1, " %"), o));
+    const auto names = measure_fields(o.measure);
+    const std::string w = measure_word(o.measure);
+    const auto e1 = scalar_values(r.deformed, names[0], file);
+    const auto e2 = scalar_values(r.deformed, names[1], file);
+    draw("major_strain.png", contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
+                                           measure_name(o.measure) + " strain, " + range_text(e1, decimals_for(e1), ""), o));
+    draw("minor_strain.png", contour_scene(r, e2, "Minor strain", "Minor " + w + " strain", "-", 0.01,
+                                           measure_name(o.measure) + " strain, " + range_text(e2, decimals_for(e2), ""), o));
+    if (fibres) {
+      const auto sh = scalar_values(r.deformed, "shear_angle_deg", file);
+      draw("shear_angle.png",
+           contour_scene(r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
+                         "initial angle between the fibre families minus the current one, " +
+                             range_text(sh, 1, "\xC2\xB0"),
+                         o));
+      draw("fibres.png", fibre_scene(r, s, o));
+    }
+  }
+  {
+    const render::Chart chart = principal_chart(r, ms, margin, flc ? &*flc : nullptr, o, summary);
+    render::write_chart_png(chart, o.size, out_path("principal_strains.png"));
+    // The strain plot reads best first after the arrows; keep report order stable.
+    summary.pictures.push_back("principal_strains.png");
+    progress.update(++done);
+  }
+  progress.finish();
+  if (flc) write_strains_with_margin(r.strains, fs::path(in_dir) / "strains.csv", out_path("strains.csv"), margin,
+                                     measure_word(o.measure), o.flc_path);
+  write_report(out_path("report.html"), r.summary, r.case_name, summary, o);
+  return summary;
+}
+
+}  // namespace sf::gsa

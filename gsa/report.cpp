@@ -1,0 +1,254 @@
+#include "gsa/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "common/core/error.hpp"
+#include "common/io/atomic_file.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "&ndash;";
+  char buf[64];
+  if (v != 0 && (std::abs(v) < 1e-3 || std::abs(v) >= 1e6))
+    std::snprintf(buf, sizeof buf, "%.3e", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+// A JSON value as table text.
+std::string text_of(const nlohmann::json& j) {
+  if (j.is_null()) return "&ndash;";
+  if (j.is_number()) return number(j.get<double>());
+  if (j.is_boolean()) return j.get<bool>() ? "yes" : "no";
+  if (j.is_string()) return escape(j.get<std::string>());
+  if (j.is_array()) {
+    std::string s;
+    for (std::size_t i = 0; i < j.size(); ++i) s += (i ? ", " : "") + text_of(j[i]);
+    return s;
+  }
+  return escape(j.dump());
+}
+
+const nlohmann::json& at(const nlohmann::json& j, std::initializer_list<const char*> path) {
+  static const nlohmann::json null;
+  const nlohmann::json* p = &j;
+  for (const char* k : path) {
+    if (!p->is_object() || !p->contains(k)) return null;
+    p = &(*p)[k];
+  }
+  return *p;
+}
+
+struct Table {
+  std::ostringstream html;
+  explicit Table(const std::string& title) { html << "<h2>" << escape(title) << "</h2>\n<table>\n"; }
+  void row(const std::string& key, const std::string& value_html) {
+    if (value_html.empty() || value_html == "&ndash;") return;
+    html << "<tr><th>" << escape(key) << "</th><td>" << value_html << "</td></tr>\n";
+  }
+  std::string str() { return html.str() + "</table>\n"; }
+};
+
+std::string caption_of(const std::string& name, const PlotOptions& o) {
+  const std::string m = measure_name(o.measure);
+  static const std::map<std::string, std::string> captions = {
+      {"arrows_undeformed.png",
+       "Principal strain arrows on the undeformed blank: the material directions that become the "
+       "major and minor directions."},
+      {"arrows_deformed.png", "Principal strain arrows on the formed part."},
+      {"thickness.png", "Thickness change in percent, assuming an incompressible sheet."},
+      {"major_strain.png", "Major principal strain on the formed part."},
+      {"minor_strain.png", "Minor principal strain on the formed part."},
+      {"shear_angle.png", "Trellis shear angle between the fibre families on the formed part."},
+      {"fibres.png", "Current directions of both fibre families on the formed part."},
+      {"principal_strains.png",
+       "Major against minor strain, one dot per analysed mark, with the reference lines of "
+       "equibiaxial, plane-strain, uniaxial-tension and pure-shear deformation."},
+  };
+  const auto it = captions.find(name);
+  std::string c = it == captions.end() ? name : it->second;
+  if (name.find("strain") != std::string::npos || name.find("arrows") != std::string::npos)
+    c += " Strain measure: " + m + ".";
+  return c;
+}
+
+}  // namespace
+
+void write_report(const std::string& path, const nlohmann::json& s, const std::string& case_name,
+                  const PlotSummary& plots, const PlotOptions& o) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+    << "<title>gsa report: " << escape(case_name) << "</title>\n<style>\n"
+    << "body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Arial,sans-serif;margin:0;color:#222;"
+       "background:#fafafa}\n"
+    << "header{padding:14px 24px;background:#fff;border-bottom:1px solid #ddd}\n"
+    << "h1{font-size:1.4em;margin:0 0 4px}h2{font-size:1.05em;margin:18px 0 6px}\n"
+    << ".page{display:flex;gap:24px;padding:16px 24px;align-items:flex-start}\n"
+    << "aside{flex:0 0 360px;position:sticky;top:12px;background:#fff;border:1px solid #ddd;"
+       "padding:4px 14px 14px;font-size:0.9em}\n"
+    << "main{flex:1 1 auto;display:flex;flex-wrap:wrap;gap:18px}\n"
+    << "figure{margin:0;background:#fff;border:1px solid #ddd;padding:8px;flex:1 1 560px;max-width:900px}\n"
+    << "figure img{width:100%;height:auto;display:block}\n"
+    << "figcaption{font-size:0.88em;color:#444;margin-top:6px}\n"
+    << "table{border-collapse:collapse;width:100%}th,td{text-align:left;padding:2px 6px;"
+       "border-bottom:1px solid #eee;vertical-align:top}th{font-weight:600;color:#444;width:45%}\n"
+    << ".files a{margin-right:10px}.warn{color:#a40}\n"
+    << "@media (max-width:1000px){.page{flex-direction:column}aside{position:static;flex:none;width:auto}}\n"
+    << "</style>\n</head>\n<body>\n";
+  h << "<header><h1>Grid strain analysis: " << escape(case_name) << "</h1>\n<div>"
+    << text_of(at(s, {"tool"})) << " " << text_of(at(s, {"version"})) << " &middot; pictures in "
+    << escape(measure_name(o.measure)) << " strain &middot; <span class=\"files\">files: "
+    << "<a href=\"strains.csv\">strains.csv</a><a href=\"summary.json\">summary.json</a>";
+  if (plots.pictures.size() > 1)
+    h << "<a href=\"undeformed.vtp\">undeformed.vtp</a><a href=\"deformed.vtp\">deformed.vtp</a>";
+  h << "</span></div></header>\n<div class=\"page\">\n<aside>\n";
+
+  {
+    Table t("Inputs");
+    t.row("grid file(s)", text_of(at(s, {"inputs"})));
+    t.row("command", text_of(at(s, {"command_line"})));
+    t.row("length unit", text_of(at(s, {"units", "length"})));
+    h << t.str();
+  }
+  {
+    Table t("Parameters");
+    const auto& p = at(s, {"parameters"});
+    t.row("method", text_of(at(p, {"method"})));
+    t.row("mesh", text_of(at(p, {"mesh", "grid"})) +
+                      (at(p, {"mesh", "elements"}).is_null() ? "" : " (" + text_of(at(p, {"mesh", "elements"})) +
+                                                                         " elements)"));
+    t.row("element", text_of(at(p, {"mesh", "element_type"})));
+    t.row("smoothing", text_of(at(p, {"penalty"})));
+    t.row("automatic weights", text_of(at(p, {"smoothing_automatic"})));
+    for (const char* which : {"undeformed", "deformed"}) {
+      const auto& w = at(p, {which});
+      if (w.is_object())
+        t.row(std::string("weights, ") + which + " fit",
+              "&alpha; " + text_of(at(w, {"alpha"})) + ", &beta; " + text_of(at(w, {"beta"})) + ", &gamma; " +
+                  text_of(at(w, {"gamma"})));
+    }
+    const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
+    if (at(p, {"noise_estimate"}).is_number()) t.row("noise estimate", text_of(at(p, {"noise_estimate"})) + unit);
+    if (at(p, {"mark_spacing"}).is_number()) t.row("mark spacing", text_of(at(p, {"mark_spacing"})) + unit);
+    if (at(p, {"gauge_length"}).is_number()) t.row("gauge length", text_of(at(p, {"gauge_length"})) + unit);
+    t.row("outlier threshold (sigmas)", text_of(at(p, {"outlier_sigma"})));
+    t.row("fibre angles (deg)", text_of(at(p, {"fibre_angles_deg"})));
+    t.row("triangles", text_of(at(p, {"triangles"})));
+    h << t.str();
+  }
+  if (at(s, {"fit"}).is_object()) {
+    Table t("Fit residuals");
+    const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
+    for (const char* which : {"undeformed", "deformed"})
+      t.row(std::string(which) + " (RMS / max)", text_of(at(s, {"fit", which, "rms_residual"})) + " / " +
+                                                     text_of(at(s, {"fit", which, "max_residual"})) + unit);
+    h << t.str();
+  }
+  {
+    Table t("Marks");
+    t.row("points", text_of(at(s, {"counts", "points"})));
+    const auto& by = at(s, {"counts", "by_status"});
+    if (by.is_object())
+      for (auto it = by.begin(); it != by.end(); ++it) t.row(it.key(), text_of(it.value()));
+    h << t.str();
+  }
+  {
+    const auto& r = at(s, {"strain_ranges"});
+    if (r.is_object()) {
+      h << "<h2>Strain ranges at the marks</h2>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
+      for (auto it = r.begin(); it != r.end(); ++it)
+        h << "<tr><th>" << escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
+          << text_of(at(it.value(), {"max"})) << "</td></tr>\n";
+      h << "</table>\n";
+    }
+  }
+  if (plots.flc) {
+    Table t("Forming limit");
+    t.row("curve", escape(o.flc_path));
+    t.row("marks beyond the curve", std::to_string(plots.n_beyond_flc) + " of " + std::to_string(plots.n_marks));
+    t.row("smallest margin (" + measure_name(o.measure) + " strain)", number(plots.min_flc_margin));
+    t.row("per mark", "column <code>flc_margin</code> of strains.csv");
+    h << t.str();
+  }
+  {
+    const auto& w = at(s, {"warnings"});
+    if (w.is_array() && !w.empty()) {
+      h << "<h2>Warnings</h2>\n<ul>\n";
+      for (const auto& x : w) h << "<li class=\"warn\">" << text_of(x) << "</li>\n";
+      h << "</ul>\n";
+    }
+  }
+  h << "</aside>\n<main>\n";
+  for (const std::string& name : plots.pictures)
+    h << "<figure><a href=\"" << escape(name) << "\"><img src=\"" << escape(name) << "\" alt=\""
+      << escape(caption_of(name, o)) << "\"></a>\n<figcaption>" << escape(caption_of(name, o))
+      << "</figcaption></figure>\n";
+  if (plots.pictures.size() == 1)
+    h << "<p>The triangle method has no fitted surfaces: only the principal strain plot is drawn. "
+         "Run with <code>--method surface</code> for arrow diagrams and contours.</p>\n";
+  h << "</main>\n</div>\n</body>\n</html>\n";
+  io::write_file_atomic(path, h.str());
+}
+
+void write_strains_with_margin(const io::CsvTable& t, const std::filesystem::path& original, const std::string& out,
+                               const std::vector<double>& margin, const std::string& measure_word,
+                               const std::string& flc_path) {
+  // Keep the leading comment lines of the original file.
+  std::vector<std::string> comments;
+  {
+    std::ifstream in(original);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (line.rfind('#', 0) != 0) break;
+      if (line.rfind("# flc_margin", 0) == 0) continue;
+      comments.push_back(line);
+    }
+  }
+  std::vector<std::string> header;
+  std::vector<std::size_t> keep;
+  for (std::size_t c = 0; c < t.n_columns(); ++c)
+    if (t.names()[c] != "flc_margin") {
+      header.push_back(t.names()[c]);
+      keep.push_back(c);
+    }
+  header.push_back("flc_margin");
+  io::write_file_atomic(out, [&](std::ostream& os) {
+    for (const auto& c : comments) os << c << "\n";
+    os << "# flc_margin: forming limit major strain at the mark's minor strain minus its major strain ("
+       << measure_word << " strain; curve " << flc_path
+       << "); negative = beyond the limit; empty where the mark has no strain or its minor strain is "
+          "outside the curve\n";
+    io::CsvWriter w(os, header);
+    for (std::size_t r = 0; r < t.n_rows(); ++r) {
+      w.begin_row();
+      for (std::size_t c : keep) w.add(t.cell(r, c));
+      w.add(r < margin.size() ? margin[r] : std::nan(""));
+      w.end_row();
+    }
+  });
+}
+
+}  // namespace sf::gsa

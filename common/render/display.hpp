@@ -1,0 +1,53 @@
+#pragma once
+// A display for off-screen rendering on machines without one (servers, CI).
+//
+// Debian's VTK 9.1 renders through X/GLX only: without a reachable X server VTK prints
+// "bad X server connection" and calls abort(). So every render first holds a DisplayGuard:
+//
+//  1. a VTK built with OSMesa or EGL and without X needs no display: the guard does nothing;
+//  2. else, if DISPLAY names a server that accepts a connection and offers GLX, it is used;
+//  3. else a private `Xvfb -displayfd FD -screen 0 1280x1024x24 -nolisten tcp` is started on
+//     a free display number (Xvfb picks it), the guard waits until its socket
+//     /tmp/.X11-unix/X<N> exists, sets DISPLAY=:<N> for this process, and on destruction
+//     stops the server and restores DISPLAY;
+//  4. if Xvfb is not on PATH or does not come up, the constructor throws sf::Error saying so
+//     (and what to do); VTK is never reached.
+//
+// Guards may nest; render::write_png() acquires the shared one itself. Hold a guard across
+// several renders (acquire_display()) to start Xvfb only once. Destroy every render window
+// before the guard that gave it its display (the renderer in this folder does).
+
+#include <memory>
+#include <string>
+#include <sys/types.h>
+
+namespace sf::render {
+
+class DisplayGuard {
+ public:
+  // Finds or starts a display; throws sf::Error when none can be had.
+  DisplayGuard();
+  ~DisplayGuard();
+  DisplayGuard(const DisplayGuard&) = delete;
+  DisplayGuard& operator=(const DisplayGuard&) = delete;
+
+  // The X display in use (":99"), or "" when rendering needs none.
+  const std::string& display() const { return display_; }
+  // True when this guard started (and will stop) a private Xvfb.
+  bool owns_server() const { return server_pid_ > 0; }
+
+ private:
+  std::string display_;
+  pid_t server_pid_ = -1;
+  bool had_display_env_ = false;
+  std::string previous_display_;
+};
+
+// The process-wide guard: the one alive if any, else a new one. It lives while a caller
+// holds the pointer. Thread-safe.
+std::shared_ptr<DisplayGuard> acquire_display();
+
+// True when VTK was built to render without any display (OSMesa or EGL, no X).
+bool renders_without_display();
+
+}  // namespace sf::render

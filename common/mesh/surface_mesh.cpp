@@ -211,6 +211,14 @@ std::vector<double> breaks_or_uniform(const std::vector<double>& b, double len, 
       throw std::invalid_argument("make_rectangle_mesh: breakpoints must have n+1 values");
     for (int i = 0; i < n; ++i)
       if (!(b[i + 1] > b[i])) throw std::invalid_argument("make_rectangle_mesh: breakpoints must ascend");
+    // Nodal scale factors are the mean of the adjacent widths; beyond a width ratio
+    // of about 7 the narrow element's cubic folds back (dx/dxi < 0; measured).
+    for (int i = 0; i + 1 < n; ++i) {
+      const double w0 = b[i + 1] - b[i], w1 = b[i + 2] - b[i + 1];
+      if (std::max(w0, w1) > 7.0 * std::min(w0, w1))
+        throw std::invalid_argument("make_rectangle_mesh: adjacent element widths differ by more than 7x "
+                                    "(the arc-length parameterisation would fold); grade more gently");
+    }
     return b;
   }
   std::vector<double> out(n + 1);

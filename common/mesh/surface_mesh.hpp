@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/core/error.hpp"
 #include "common/core/types.hpp"
 
 namespace sf::mesh {
@@ -106,7 +107,11 @@ class SurfaceMesh {
 
   // Topology: call after adding elements (the generators do).
   void build_topology();
-  const EdgeNeighbour& neighbour(Index e, int edge) const { return neighbours_[4 * e + edge]; }
+  bool has_topology() const { return neighbours_.size() == 4 * elements_.size(); }
+  const EdgeNeighbour& neighbour(Index e, int edge) const {
+    SF_ASSERT(has_topology(), "SurfaceMesh::neighbour: call build_topology() first");
+    return neighbours_[4 * e + edge];
+  }
   // Free edges: (element, local edge), degenerate apex edges excluded.
   std::vector<std::pair<Index, int>> boundary_edges() const;
   static bool is_degenerate_edge(const Element& el, int edge) {
@@ -136,7 +141,8 @@ Vec2 edge_point(int edge, double t);
 
 // Structured mesh of a flat rectangle: origin + s*a1 + t*a2 with s in [0, L1],
 // t in [0, L2] (a1, a2 orthonormal), n1 x n2 elements; optional graded breakpoints
-// s1 (n1+1 ascending values from 0 to L1) and s2. Arc-length parameters exact.
+// s1 (n1+1 ascending values from 0 to L1) and s2; adjacent widths may differ by at
+// most 7x (std::invalid_argument otherwise). Arc-length parameters exact.
 SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& a2, double length1,
                                 double length2, int n1, int n2,
                                 const std::vector<double>& breaks1 = {},

@@ -34,6 +34,13 @@ bool clip(Vec2& p, Vec2& q, const std::array<double, 4>& r) {
   return true;
 }
 
+std::vector<double> ticks_with_step(double lo, double hi, double step) {
+  std::vector<double> t;
+  for (double k = std::ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k += 1)
+    t.push_back(std::abs(k) < 0.5 ? 0.0 : k * step);
+  return t;
+}
+
 Shape2D line(std::vector<Vec2> pts, const Colour& c, double width, double dash = 0, double opacity = 1) {
   Shape2D s;
   s.points = std::move(pts);
@@ -93,6 +100,13 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
         y1 = std::max(y1, s.y[i]);
       }
   }
+  for (const Vec2& p : chart.range_points)
+    if (p.allFinite()) {
+      x0 = std::min(x0, p.x());
+      x1 = std::max(x1, p.x());
+      y0 = std::min(y0, p.y());
+      y1 = std::max(y1, p.y());
+    }
   if (chart.range) {
     x0 = (*chart.range)[0];
     x1 = (*chart.range)[1];
@@ -123,7 +137,7 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
   double ytick_w = 0;
   for (double t : nice_ticks(y0, y1, 8, &dec))
     ytick_w = std::max(ytick_w, text_extent(format_fixed(t, dec), tick_font)[0]);
-  const double left = ytick_w + 10 * f + label_font * 1.4 + 6 * f;
+  const double left = ytick_w + 12 * f + label_font * 1.4 + 6 * f;
   const double bottom = tick_font * 1.3 + 10 * f + label_font * 1.4 + 4 * f;
   std::array<double, 4> plot = {fr[0] + left, fr[1] + bottom, fr[2] - 16 * f, fr[3] - 10 * f};
   const double pw = std::max(10.0, plot[2] - plot[0]), ph = std::max(10.0, plot[3] - plot[1]);
@@ -155,10 +169,11 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
   std::vector<double> xt = nice_ticks(x0, x1, std::max(2, static_cast<int>(pw / px_per_tick)), &xdec);
   std::vector<double> yt = nice_ticks(y0, y1, std::max(2, static_cast<int>(ph / px_per_tick)), &ydec);
   if (chart.equal_axes && xt.size() > 1 && yt.size() > 1) {
+    // One data unit is as long on both axes: use the finer of the two steps on both.
     const double sx = xt[1] - xt[0], sy = yt[1] - yt[0];
-    if (sx > sy) yt = nice_ticks(y0, y1, std::max(1, static_cast<int>((y1 - y0) / sx)), &ydec);
-    if (sy > sx) xt = nice_ticks(x0, x1, std::max(1, static_cast<int>((x1 - x0) / sy)), &xdec);
-    const int d = std::max(xdec, ydec);
+    if (sx < sy) yt = ticks_with_step(y0, y1, sx);
+    if (sy < sx) xt = ticks_with_step(x0, x1, sy);
+    const int d = sx < sy ? xdec : sy < sx ? ydec : std::max(xdec, ydec);
     xdec = ydec = d;
   }
   const Colour grid{0.88, 0.88, 0.88}, zero{0.55, 0.55, 0.55};
@@ -229,8 +244,8 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
   scene.texts.push_back({chart.x_label, Vec2((plot[0] + plot[2]) / 2, plot[1] - tick - 3 * f - tick_font * 1.3 - 8 * f),
                          label_font, kInk, 0, 1, false, 0});
   scene.texts.push_back({chart.y_label,
-                         Vec2(plot[0] - tick - 4 * f - ytick_w - 10 * f, (plot[1] + plot[3]) / 2),
-                         label_font, kInk, 0, -1, false, 90});
+                         Vec2(plot[0] - tick - 4 * f - ytick_w - 12 * f, (plot[1] + plot[3]) / 2),
+                         label_font, kInk, 0, -1, false, 90});  // justified in the text's own frame
   write_png(scene, size, path);
   return cf;
 }

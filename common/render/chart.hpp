@@ -32,8 +32,10 @@ struct Chart {
   std::vector<ChartSeries> series;
   bool equal_axes = false;
   bool include_origin = true;
-  // x_min, x_max, y_min, y_max; default: the data of the series with sets_range, padded.
+  // x_min, x_max, y_min, y_max; default: the data of the series with sets_range and the
+  // points below, padded.
   std::optional<std::array<double, 4>> range;
+  std::vector<Vec2> range_points;  // (x, y) points the automatic range must include
   std::string legend_title;
   std::vector<LegendEntry> extra_legend;  // appended after the series' entries
 };

@@ -100,6 +100,33 @@ std::vector<std::string> edge_labels(const Bands& b) {
   return out;
 }
 
+// Splits `text` into lines no wider than `width` pixels (at word boundaries; '\n' forces).
+std::vector<std::string> wrap(const std::string& text, double width, double size) {
+  std::vector<std::string> lines;
+  std::stringstream paragraphs(text);
+  std::string para;
+  while (std::getline(paragraphs, para, '\n')) {
+    std::stringstream words(para);
+    std::string word, line;
+    while (words >> word) {
+      const std::string candidate = line.empty() ? word : line + " " + word;
+      if (!line.empty() && text_extent(candidate, size)[0] > width) {
+        lines.push_back(line);
+        line = word;
+      } else {
+        line = candidate;
+      }
+    }
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+std::vector<std::string> footnote_lines(const Scene& scene, const ImageSize& size, const Fonts& ft) {
+  if (scene.footnote.empty()) return {};
+  return wrap(scene.footnote, size.width - 2 * ft.pad, ft.footnote);
+}
+
 // Width the right panel needs (0: no panel).
 double panel_width(const Scene& scene, const ImageSize& size, const Fonts& ft) {
   double need = 0;
@@ -116,7 +143,7 @@ double panel_width(const Scene& scene, const ImageSize& size, const Fonts& ft) {
     for (const LegendEntry& e : scene.legend) {
       const double symbol = e.kind == LegendEntry::Kind::kNone ? 0 : 44 * ft.f;
       const double text = text_extent(e.label, ft.panel)[0];
-      need = std::max(need, e.kind == LegendEntry::Kind::kArrow ? text : symbol + text);
+      need = std::max(need, symbol + 8 * ft.f + text);
     }
   }
   if (need <= 0) return 0;
@@ -723,7 +750,8 @@ Layout layout_of(const Scene& scene, const ImageSize& size) {
   if (!scene.title.empty()) l.title_band += ft.title * 1.3;
   if (!scene.subtitle.empty()) l.title_band += ft.subtitle * 1.45;
   l.title_band += ft.pad / 2;
-  l.footnote_band = scene.footnote.empty() ? 0 : ft.footnote * 2.2;
+  const auto foot = footnote_lines(scene, size, ft);
+  l.footnote_band = foot.empty() ? 0 : ft.footnote * (1.0 + 1.3 * static_cast<double>(foot.size()));
   l.panel_left = size.width - panel_width(scene, size, ft);
   l.frame = {ft.pad, l.footnote_band + ft.pad, l.panel_left - ft.pad,
              size.height - l.title_band - ft.pad / 2};
@@ -836,9 +864,12 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
   if (!scene.subtitle.empty())
     o.texts.push_back({scene.subtitle, Vec2(size.width / 2.0, y_title), ft.subtitle,
                        Colour{0.3, 0.3, 0.3}, 0, 1, false, 0});
-  if (!scene.footnote.empty())
-    o.texts.push_back({scene.footnote, Vec2(ft.pad, ft.footnote * 0.8), ft.footnote,
-                       Colour{0.35, 0.35, 0.35}, -1, -1, false, 0});
+  {
+    const auto foot = footnote_lines(scene, size, ft);
+    for (std::size_t i = 0; i < foot.size(); ++i)
+      o.texts.push_back({foot[i], Vec2(ft.pad, ft.footnote * (0.7 + 1.3 * static_cast<double>(foot.size() - 1 - i))),
+                         ft.footnote, Colour{0.35, 0.35, 0.35}, -1, -1, false, 0});
+  }
   if (layout.panel_left < size.width) {
     const double x0 = layout.panel_left + ft.pad * 0.5;
     const double panel_w = size.width - layout.panel_left - ft.pad;
@@ -874,7 +905,7 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
 
   vtkNew<vtkRenderWindow> win;
   win->SetOffScreenRendering(1);
-  win->SetMultiSamples(4);
+  win->SetMultiSamples(0);
   win->SetSize(size.width, size.height);
   win->AddRenderer(ren);
   win->Render();

@@ -419,7 +419,7 @@ TEST(SurfaceMeshGraded, ModerateGradingIsFoldFreeWithExactArcLengthFactors) {
 // becomes 1.36 instead of 1), and the surface Jacobian vanishes inside the
 // element. Either rejecting such grading (std::invalid_argument) or producing a
 // fold-free mesh passes this test.
-TEST(SurfaceMeshGraded, DISABLED_StrongGradingIsRejectedOrFoldFree) {
+TEST(SurfaceMeshGraded, StrongGradingIsRejectedOrFoldFree) {
   for (double w : {10.0, 20.0}) {
     SurfaceMesh m;
     try {

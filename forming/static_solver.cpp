@@ -1,0 +1,411 @@
+#include "forming/static_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include "common/core/error.hpp"
+
+namespace sf::forming {
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+[[noreturn]] void bad_option(const std::string& name, const std::string& expected, double found) {
+  std::ostringstream os;
+  os.precision(10);
+  os << "static solver " << name << ": expected " << expected << ", found " << found;
+  throw InputError(os.str());
+}
+
+// Relative size of the last Newton correction below which the state is converged even
+// when the residual test is not met (round-off floor of the residual).
+constexpr double kIncrementTolRel = 1e-14;
+// Armijo-type sufficient decrease of |r| in the line search.
+constexpr double kSufficientDecrease = 1e-4;
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------
+// Model
+
+Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()) {}
+
+int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material) {
+  if (!material) throw InputError("model: ply added without a material");
+  const Index n = ply.n_dofs();
+  bodies_.push_back(Body{std::move(ply), std::move(material), n_dofs_});
+  n_dofs_ += n;
+  return n_bodies() - 1;
+}
+
+VecX Model::reference_positions() const {
+  VecX x(n_dofs_);
+  for (const Body& b : bodies_) x.segment(b.offset, b.ply.n_dofs()) = b.ply.reference_dofs();
+  return x;
+}
+
+std::vector<bool> Model::used_dofs() const {
+  std::vector<bool> used(n_dofs_, false);
+  for (const Body& b : bodies_)
+    for (Index e = 0; e < b.ply.n_elements(); ++e) {
+      const BrickMap map = b.ply.element_map(e);
+      for (int k = 0; k < kBrickFunctions; ++k)
+        for (int t = 0; t < map.n_terms[k]; ++t)
+          if (map.terms[k][t].coef != 0.0)
+            for (int i = 0; i < 3; ++i) used[b.offset + 3 * map.terms[k][t].dof + i] = true;
+    }
+  return used;
+}
+
+Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) const {
+  SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
+  Assembly out;
+  out.force = VecX::Zero(n_dofs_);
+  linalg::TripletAssembler triplets(n_dofs_, n_dofs_);
+  if (want_tangent) {
+    Index n_el = 0;
+    for (const Body& b : bodies_) n_el += b.ply.n_elements();
+    triplets.reserve(n_el * kBrickDofs * kBrickDofs);
+  }
+  std::vector<Index> dofs;
+  std::vector<double> coefs;
+  std::vector<int> local;
+  MatX block;
+  for (int body = 0; body < n_bodies(); ++body) {
+    const Body& b = bodies_[body];
+    const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+    for (Index e = 0; e < b.ply.n_elements(); ++e) {
+      const BrickParams X_e = b.ply.element_parameters(e, b.ply.reference());
+      const BrickParams x_e = b.ply.element_parameters(e, xb);
+      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent);
+      if (!r.ok()) {
+        out.ok = false;
+        out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
+                      to_string(r.status) + " (min det F " + fmt(r.min_det_f) + ")";
+        out.energy = std::numeric_limits<double>::infinity();
+        return out;
+      }
+      out.energy += r.energy;
+      // Expanded local -> global list: one entry per (function, map term, coordinate);
+      // duplicates (collapsed elements) are summed by the assembler.
+      const BrickMap map = b.ply.element_map(e);
+      dofs.clear();
+      coefs.clear();
+      local.clear();
+      for (int k = 0; k < kBrickFunctions; ++k)
+        for (int t = 0; t < map.n_terms[k]; ++t)
+          for (int i = 0; i < 3; ++i) {
+            dofs.push_back(b.offset + 3 * map.terms[k][t].dof + i);
+            coefs.push_back(map.terms[k][t].coef);
+            local.push_back(3 * k + i);
+          }
+      const int m = static_cast<int>(dofs.size());
+      for (int a = 0; a < m; ++a) out.force(dofs[a]) += coefs[a] * r.force(local[a]);
+      if (!want_tangent) continue;
+      block.resize(m, m);
+      for (int c = 0; c < m; ++c)
+        for (int a = 0; a < m; ++a) block(a, c) = coefs[a] * coefs[c] * r.tangent(local[a], local[c]);
+      triplets.add_block(dofs, dofs, block);
+    }
+  }
+  if (want_tangent) out.tangent = triplets.compress();
+  return out;
+}
+
+std::vector<Mat3> Model::deformation_gradients(int body, const Eigen::Ref<const VecX>& x) const {
+  const Body& b = bodies_[body];
+  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+  std::vector<Mat3> out;
+  for (Index e = 0; e < b.ply.n_elements(); ++e) {
+    const std::vector<Mat3> f = brick_deformation_gradients(b.ply.element_parameters(e, b.ply.reference()),
+                                                            b.ply.element_parameters(e, xb), brick_rule_);
+    out.insert(out.end(), f.begin(), f.end());
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------
+// Options and report
+
+void StaticOptions::validate() const {
+  if (!(initial_increment > 0.0 && initial_increment <= 1.0))
+    bad_option("initial_increment", "a load-factor increment in (0, 1]", initial_increment);
+  if (!(max_increment > 0.0 && max_increment <= 1.0))
+    bad_option("max_increment", "a load-factor increment in (0, 1]", max_increment);
+  if (!(min_increment > 0.0 && min_increment <= initial_increment))
+    bad_option("min_increment", "a value in (0, initial_increment]", min_increment);
+  if (!(growth >= 1.0) || !std::isfinite(growth)) bad_option("growth", "a finite factor >= 1", growth);
+  if (easy_iterations < 1) bad_option("easy_iterations", "at least 1", easy_iterations);
+  if (max_iterations < 1) bad_option("max_iterations", "at least 1", max_iterations);
+  if (max_steps < 1) bad_option("max_steps", "at least 1", max_steps);
+  if (!(residual_tol_rel >= 0.0)) bad_option("residual_tol_rel", "a value >= 0", residual_tol_rel);
+  if (!(residual_tol_abs >= 0.0)) bad_option("residual_tol_abs", "a value >= 0 (N)", residual_tol_abs);
+  if (!(divergence_factor > 1.0)) bad_option("divergence_factor", "a factor > 1", divergence_factor);
+  if (max_line_search < 0) bad_option("max_line_search", "at least 0", max_line_search);
+  if (!linalg::solver_available(linear_solver))
+    throw InputError("static solver linear_solver: '" + linalg::to_string(linear_solver) +
+                     "' is not compiled in");
+}
+
+std::string to_string(StaticReport::Status status) {
+  switch (status) {
+    case StaticReport::Status::kConverged:
+      return "converged";
+    case StaticReport::Status::kStepFailed:
+      return "step-failed";
+    case StaticReport::Status::kInvalidStart:
+      return "invalid-start";
+  }
+  return "unknown";
+}
+
+std::string StaticReport::brief() const {
+  std::ostringstream os;
+  os << to_string(status) << ": lambda " << load_factor << " in " << n_converged_steps << " steps ("
+     << n_cutbacks << " cut-backs), " << total_iterations << " Newton iterations";
+  for (auto it = steps.rbegin(); it != steps.rend(); ++it)
+    if (it->converged && !it->residual_norms.empty()) {
+      os << ", |r| " << fmt(it->residual_norms.back());
+      break;
+    }
+  if (!message.empty()) os << "; " << message;
+  return os.str();
+}
+
+// ---------------------------------------------------------------------------------
+// Newton solver
+
+StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
+                          const std::vector<PrescribedDof>& prescribed, const VecX& f_ext,
+                          const StaticOptions& options) {
+  options.validate();
+  const Index n = model.n_dofs();
+  StaticResult result;
+  StaticReport& report = result.report;
+  result.positions = x_start;
+  result.reactions = VecX::Zero(n);
+  auto invalid = [&](const std::string& msg) {
+    report.status = StaticReport::Status::kInvalidStart;
+    report.message = msg;
+    return result;
+  };
+  if (x_start.size() != n)
+    return invalid("start positions have " + std::to_string(x_start.size()) + " entries, expected " +
+                   std::to_string(n));
+  if (f_ext.size() != 0 && f_ext.size() != n)
+    return invalid("external force has " + std::to_string(f_ext.size()) + " entries, expected " +
+                   std::to_string(n));
+  const VecX load = f_ext.size() == 0 ? VecX::Zero(n) : f_ext;
+
+  // Dof classes: free, prescribed, held (used by no element).
+  enum : char { kFree, kPrescribed, kHeld };
+  std::vector<char> kind(n, kFree);
+  VecX target = x_start;
+  for (const PrescribedDof& p : prescribed) {
+    if (p.dof < 0 || p.dof >= n)
+      return invalid("prescribed dof " + std::to_string(p.dof) + " is outside 0.." + std::to_string(n - 1));
+    if (!std::isfinite(p.value)) return invalid("prescribed dof " + std::to_string(p.dof) + " has a non-finite value");
+    kind[p.dof] = kPrescribed;
+    target(p.dof) = p.value;
+  }
+  const std::vector<bool> used = model.used_dofs();
+  std::vector<Index> free;
+  for (Index d = 0; d < n; ++d) {
+    if (!used[d] && kind[d] == kFree) kind[d] = kHeld;
+    if (kind[d] == kFree) free.push_back(d);
+  }
+  const Index nf = static_cast<Index>(free.size());
+  linalg::SparseMatrix select(n, nf);  // n x nf: column j = unit vector of free dof j
+  {
+    std::vector<Eigen::Triplet<double, int>> t;
+    t.reserve(nf);
+    for (Index j = 0; j < nf; ++j) t.emplace_back(static_cast<int>(free[j]), static_cast<int>(j), 1.0);
+    select.setFromTriplets(t.begin(), t.end());
+  }
+  double length_scale = 0.0;
+  for (Index d = 0; d < n; ++d) length_scale = std::max(length_scale, std::abs(x_start(d)));
+  length_scale = std::max(length_scale, 1e-300);
+
+  {
+    const Assembly a0 = model.assemble(x_start, false);
+    if (!a0.ok) return invalid("start state: " + a0.message);
+  }
+
+  linalg::LinearSolver solver(options.linear_solver, linalg::MatrixProperty::kSymmetricIndefinite);
+  VecX x = x_start;
+  double lambda = 0.0;
+  double increment = std::min(options.initial_increment, options.max_increment);
+  auto prescribed_at = [&](double lam) {
+    VecX v = x;
+    for (Index d = 0; d < n; ++d)
+      if (kind[d] == kPrescribed) v(d) = x_start(d) + lam * (target(d) - x_start(d));
+    return v;
+  };
+  auto free_part = [&](const VecX& v) {
+    VecX out(nf);
+    for (Index j = 0; j < nf; ++j) out(j) = v(free[j]);
+    return out;
+  };
+
+  int attempts = 0;
+  while (lambda < 1.0) {
+    if (attempts >= options.max_steps) {
+      report.status = StaticReport::Status::kStepFailed;
+      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted load steps reached at lambda " +
+                       fmt(lambda);
+      break;
+    }
+    ++attempts;
+    const double lam_new = (1.0 - lambda <= increment * (1.0 + 1e-12)) ? 1.0 : lambda + increment;
+    StepRecord rec;
+    rec.load_factor = lam_new;
+    rec.increment = lam_new - lambda;
+
+    // Predictor: tangent at the converged state, prescribed dofs moved.
+    VecX xt = x;
+    bool failed = false;
+    {
+      const Assembly a = model.assemble(x, true);
+      const VecX x_new = prescribed_at(lam_new);
+      const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
+      const VecX r = a.force - lam_new * load;
+      const VecX rhs = -free_part(r + a.tangent * dxp);
+      const linalg::SparseMatrix kff = select.transpose() * a.tangent * select;
+      if (nf > 0) {
+        const linalg::SolveReport& sr = solver.factorize(kff);
+        if (!sr.ok()) {
+          rec.failure = "predictor: linear solve " + sr.brief();
+          failed = true;
+        } else {
+          const VecX dxf = solver.solve(rhs);
+          xt = x_new + select * dxf;
+        }
+      } else {
+        xt = x_new;
+      }
+      rec.iterations = 1;
+    }
+    // Corrector.
+    double first_norm = -1.0;
+    while (!failed) {
+      const Assembly a = model.assemble(xt, true);
+      if (!a.ok) {
+        rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + a.message;
+        failed = true;
+        break;
+      }
+      const VecX r = a.force - lam_new * load;
+      const VecX rf = free_part(r);
+      const double rnorm = rf.norm();
+      rec.residual_norms.push_back(rnorm);
+      const double scale = std::max(a.force.norm(), (lam_new * load).norm());
+      if (first_norm < 0.0) first_norm = rnorm;
+      if (rnorm <= std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) {
+        rec.converged = true;
+        report.force_scale = scale;
+        break;
+      }
+      if (!std::isfinite(rnorm) || rnorm > options.divergence_factor * std::max(first_norm, 1e-300)) {
+        rec.failure = "diverged: |r| " + fmt(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
+        failed = true;
+        break;
+      }
+      if (rec.iterations >= options.max_iterations) {
+        rec.failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " +
+                      fmt(rnorm) + ", tolerance " +
+                      fmt(std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) + ")";
+        failed = true;
+        break;
+      }
+      const linalg::SolveReport& sr = solver.factorize(select.transpose() * a.tangent * select);
+      if (!sr.ok()) {
+        rec.failure = "linear solve " + sr.brief();
+        failed = true;
+        break;
+      }
+      const VecX dxf = solver.solve(-rf);
+      ++rec.iterations;
+      if (!dxf.allFinite()) {
+        rec.failure = "linear solve returned non-finite values";
+        failed = true;
+        break;
+      }
+      const VecX dx = select * dxf;
+      // Round-off floor: a correction this small cannot reduce |r| further.
+      if (dxf.size() == 0 || dxf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale) {
+        xt += dx;
+        rec.step_lengths.push_back(1.0);
+        rec.converged = true;
+        report.force_scale = scale;
+        break;
+      }
+      double alpha = 1.0;
+      if (options.line_search) {
+        double best_alpha = -1.0, best_norm = std::numeric_limits<double>::infinity();
+        bool accepted = false;
+        for (int ls = 0; ls <= options.max_line_search; ++ls, alpha *= 0.5) {
+          const Assembly trial = model.assemble(xt + alpha * dx, false);
+          if (!trial.ok) continue;
+          const double tn = free_part(trial.force - lam_new * load).norm();
+          if (tn <= (1.0 - kSufficientDecrease * alpha) * rnorm) {
+            accepted = true;
+            break;
+          }
+          if (tn < best_norm) {
+            best_norm = tn;
+            best_alpha = alpha;
+          }
+        }
+        if (!accepted) {
+          if (best_alpha < 0.0) {
+            rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+            failed = true;
+            break;
+          }
+          alpha = best_alpha;
+        }
+      }
+      xt += alpha * dx;
+      rec.step_lengths.push_back(alpha);
+    }
+    report.total_iterations += rec.iterations;
+    if (rec.converged) {
+      x = xt;
+      lambda = lam_new;
+      ++report.n_converged_steps;
+      if (rec.iterations <= options.easy_iterations)
+        increment = std::min(options.max_increment, increment * options.growth);
+      report.steps.push_back(std::move(rec));
+      continue;
+    }
+    ++report.n_cutbacks;
+    const std::string why = rec.failure;
+    report.steps.push_back(std::move(rec));
+    increment *= 0.5;
+    if (increment < options.min_increment) {
+      report.status = StaticReport::Status::kStepFailed;
+      report.message = "load step from lambda " + fmt(lambda) + " failed (" + why +
+                       "); increment cut back below min_increment " + fmt(options.min_increment);
+      break;
+    }
+  }
+  if (lambda >= 1.0) {
+    report.status = StaticReport::Status::kConverged;
+    report.message.clear();
+  }
+  report.load_factor = lambda;
+  result.positions = x;
+  const Assembly a = model.assemble(x, false);
+  result.reactions = a.force - lambda * load;
+  return result;
+}
+
+}  // namespace sf::forming

@@ -10,6 +10,8 @@
 #include "common/core/error.hpp"
 #include "common/fe/surface_field.hpp"
 #include "common/mesh/projection.hpp"
+#include "common/quadrature/gauss.hpp"
+#include "gsa/mesh_file.hpp"
 
 namespace sf::gsa {
 
@@ -160,12 +162,36 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   res.centroid = frame.centroid;
   res.axis1 = frame.a1;
   res.axis2 = frame.a2;
+  std::vector<MeshLocation> loc(m);
+  if (!options.mesh_file.empty()) {
+    // The user's mesh: marks located by projection onto it.
+    res.mesh = read_mesh_file(options.mesh_file);
+    res.elements1 = res.elements2 = 0;
+    const mesh::SurfaceProjector projector(res.mesh, res.mesh.geometry());
+    const std::vector<mesh::Projection> proj = projector.project_all(X);
+    for (Index k = 0; k < m; ++k) {
+      if (!proj[k].ok())
+        throw InputError(grid.where[used[k]] + ": mark '" + grid.ids[used[k]] + "' could not be located on the mesh " +
+                         options.mesh_file);
+      loc[k] = {proj[k].element, proj[k].xi};
+    }
+    double area = 0.0;
+    const auto rule = quadrature::gauss_2d(4, 4);
+    const fe::SurfaceField geo(res.mesh, res.mesh.geometry());
+    for (Index e = 0; e < res.mesh.n_elements(); ++e)
+      for (int g = 0; g < rule.size(); ++g) {
+        const Mat32 t = geo.evaluate3(e, rule.points[g], basis::kFirst).dx;
+        area += rule.weights[g] * t.col(0).cross(t.col(1)).norm();
+      }
+    res.mark_spacing = std::sqrt(area / static_cast<double>(m));
+  }
   const Vec3 origin = frame.centroid + lo_m[0] * frame.a1 + lo_m[1] * frame.a2;
-  const mesh::SurfaceMesh full =
-      mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2);
+  const mesh::SurfaceMesh full = options.mesh_file.empty()
+      ? mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2)
+      : mesh::SurfaceMesh();
   std::vector<MeshLocation> loc_full(m);
   std::vector<bool> keep(full.n_elements(), false);
-  for (Index k = 0; k < m; ++k) {
+  for (Index k = 0; k < m && options.mesh_file.empty(); ++k) {
     const double u = (st(k, 0) - lo_m[0]) / len[0] * n1, v = (st(k, 1) - lo_m[1]) / len[1] * n2;
     const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
     const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
@@ -173,13 +199,14 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     loc_full[k].xi = Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0));
     keep[loc_full[k].element] = true;
   }
-  std::vector<Index> emap;
-  res.mesh = mesh::extract_elements(full, keep, &emap);
-  std::vector<MeshLocation> loc(m);
-  for (Index k = 0; k < m; ++k) loc[k] = {emap[loc_full[k].element], loc_full[k].xi};
+  if (options.mesh_file.empty()) {
+    std::vector<Index> emap;
+    res.mesh = mesh::extract_elements(full, keep, &emap);
+    for (Index k = 0; k < m; ++k) loc[k] = {emap[loc_full[k].element], loc_full[k].xi};
+    res.mark_spacing = std::sqrt(len[0] * len[1] * static_cast<double>(res.mesh.n_elements()) /
+                                 (static_cast<double>(n1) * n2) / static_cast<double>(m));
+  }
   const mesh::SurfaceMesh& mesh = res.mesh;
-  res.mark_spacing = std::sqrt(len[0] * len[1] * static_cast<double>(mesh.n_elements()) /
-                               (static_cast<double>(n1) * n2) / static_cast<double>(m));
   const PenaltyMatrices penalties = assemble_penalties(mesh);
   res.times.mesh = seconds_since(t0);
 

@@ -32,6 +32,7 @@ struct AnalyseOptions {
   Method method = Method::kSurface;
   PenaltyKind penalty = PenaltyKind::kJumps;
   int elements1 = 0, elements2 = 0;  // 0 = automatic (--elements NxM)
+  std::string mesh_file;              // --mesh FILE: the user's own mesh (gsa/mesh_file.hpp)
   std::optional<double> alpha, beta, gamma, delta;  // unset = automatic
   std::vector<double> fibre_angles;          // degrees from the X axis on the undeformed sheet
   std::string units = "mm";

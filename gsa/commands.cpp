@@ -5,12 +5,14 @@
 #include <cmath>
 #include <limits>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "common/cli/app.hpp"
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/output.hpp"
@@ -27,7 +29,7 @@ namespace {
 constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 
 struct AnalyseArgs {
-  std::string grid, undeformed, deformed, out, method = "surface", penalty = "jumps", elements, columns,
+  std::string grid, undeformed, deformed, out, method = "surface", penalty = "jumps", elements, mesh, columns,
       delimiter = ",", fibres, units = "mm";
   double alpha = kUnset, beta = kUnset, gamma = kUnset, delta = kUnset, outlier_sigma = 6.0, smoothing_scale = 1.0;
   int sample = 0;
@@ -86,6 +88,8 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   else if (a.penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
   else if (a.penalty == "jumps") o.penalty = PenaltyKind::kJumps;
   else throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + a.penalty + "'");
+  if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
+  o.mesh_file = a.mesh;
   if (!a.elements.empty()) {
     const auto x = a.elements.find('x');
     try {
@@ -114,7 +118,11 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   o.quiet = quiet;
   o.validate();
   PlotOptions po;
-  if (!a.no_plots) po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+  std::shared_ptr<render::DisplayGuard> display;
+  if (!a.no_plots) {
+    po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+    display = render::acquire_display();  // no display: fail now, not after the analysis
+  }
 
   GridReadOptions ro;
   ro.delimiter = parse_delimiter(a.delimiter);
@@ -142,9 +150,10 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   result.times.read = read_s;
   io::AtomicOutputDir out(a.out);
   write_results(out, grid, result, o, info);
+  std::optional<PlotSummary> plots;
   if (!a.no_plots) {
     cli::status(quiet, "gsa: drawing pictures");
-    write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
+    plots = write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
   }
   out.commit();
   Index ok = 0;
@@ -152,9 +161,13 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   std::ostringstream msg;
   msg << "gsa: " << ok << " of " << grid.n_points() << " points analysed; results in " << a.out;
   if (result.method == Method::kSurface)
-    msg << " (mesh " << result.elements1 << "x" << result.elements2 << ", " << result.mesh.n_elements()
+    msg << " (mesh " << (o.mesh_file.empty() ? std::to_string(result.elements1) + "x" + std::to_string(result.elements2)
+                                              : "from " + o.mesh_file)
+        << ", " << result.mesh.n_elements()
         << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
         << ")";
+  if (plots && plots->flc)
+    msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
   cli::status(quiet, msg.str());
   return cli::kExitOk;
 }
@@ -239,6 +252,7 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("-o,--out", args->out, "Output folder (created; files replaced only on success)")->required();
         app.add_option("--method", args->method, "surface (default) or triangles (classical, for comparison)");
         app.add_option("--penalty", args->penalty, "Smoothing: jumps (default; fourth order, C3 edge jumps, weight by cross-validation), third (third-order + edge jumps) or sobolev (alpha/beta of the brief)");
+        app.add_option("--mesh", args->mesh, "Your own mesh (JSON: nodes and elements, see docs/usage.md) instead of the automatic one");
         app.add_option("--elements", args->elements, "Mesh size NxM (default: from the number of marks)");
         app.add_option("--alpha", args->alpha, "First-derivative smoothing weight (default 0)");
         app.add_option("--beta", args->beta, "Second-derivative (curvature) smoothing weight, units^2 (default: automatic)");

@@ -28,10 +28,15 @@ const render::Colour kCompression{0.09, 0.31, 0.78};
 const render::Colour kScaleArrow{0.2, 0.2, 0.2};
 const render::Colour kFibre1{0.90, 0.42, 0.0};
 const render::Colour kFibre2{0.16, 0.16, 0.62};
+const render::Colour kElementEdges{0.78, 0.78, 0.78};
+
+int reference_decimals(double v) {
+  return v > 0 ? std::max(0, static_cast<int>(-std::floor(std::log10(v) + 1e-9))) : 0;
+}
 
 // Marks per sample spacing across the part: about this many sample points along the
 // longer side of a square mesh.
-constexpr double kSamplesAcross = 12.0;
+constexpr double kSamplesAcross = 10.0;
 
 const io::FieldArray* find_field(const io::PolyMesh& m, const std::string& name, int n_components) {
   for (const auto& f : m.point_data)
@@ -90,16 +95,7 @@ std::string measure_word(StrainMeasure m) {
 // ---------------------------------------------------------------------------------------
 // The results folder
 
-struct Results {
-  std::string dir;
-  nlohmann::json summary;
-  std::string units = "mm";
-  std::string case_name;
-  std::vector<double> fibre_angles;
-  bool has_surfaces = false;
-  io::PolyMesh undeformed, deformed;
-  io::CsvTable strains;
-};
+using Results = ResultsFolder;
 
 std::string case_name_of(const nlohmann::json& summary, const std::string& dir) {
   if (summary.contains("inputs") && summary["inputs"].is_array() && !summary["inputs"].empty() &&
@@ -111,7 +107,7 @@ std::string case_name_of(const nlohmann::json& summary, const std::string& dir) 
   return fs::path(dir).filename().string();
 }
 
-Results read_results(const std::string& dir) {
+Results read_results_impl(const std::string& dir) {
   Results r;
   r.dir = dir;
   const fs::path d(dir);
@@ -228,7 +224,7 @@ render::Surface plain_surface(const io::PolyMesh& m) {
 
 // Colour range for a field: round bands over its finite values, at least `min_span` wide
 // (a nearly uniform field shows as one or two bands, not as amplified noise); diverging
-// and centred on 0 when the values take both signs.
+// and centred on 0 when the values take both signs (viridis otherwise).
 render::ScalarColouring colouring_for(const std::vector<double>& values, const std::string& title,
                                       const std::string& units, double min_span) {
   render::ScalarColouring c;
@@ -239,12 +235,17 @@ render::ScalarColouring colouring_for(const std::vector<double>& values, const s
   for (double v : values)
     if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   if (!(hi >= lo)) lo = 0, hi = 1;
+  // Round-off on the other side of zero (a shear angle of -1e-6 deg) does not start a band.
+  if (lo < 0 && hi > 0 && -lo < 1e-3 * (hi - lo)) lo = 0;
+  if (lo < 0 && hi > 0 && hi < 1e-3 * (hi - lo)) hi = 0;
   if (hi - lo < min_span) {
     const double mid = 0.5 * (lo + hi);
     lo = mid - min_span / 2;
     hi = mid + min_span / 2;
   }
-  const bool signed_field = lo < 0 && hi > 0;
+  // Diverging (centred on 0) only when both signs matter: a side below 10 % of the other
+  // (e.g. round-off around a zero shear angle) would waste half the bands.
+  const bool signed_field = lo < 0 && hi > 0 && std::min(-lo, hi) >= 0.1 * std::max(-lo, hi);
   c.map = signed_field ? render::ColourMap::kDiverging : render::ColourMap::kViridis;
   c.bands = render::nice_bands(lo, hi, 10, signed_field);
   return c;
@@ -254,12 +255,16 @@ std::vector<double> scalar_values(const io::PolyMesh& m, const std::string& name
   return require_field(m, name, 1, file).values;
 }
 
-std::string range_text(const std::vector<double>& v, int decimals, const std::string& unit) {
+// "from A to B" (or "uniform, A" / "nearly uniform, A to B" when the range is below
+// `min_span`, the smallest range the colour bands resolve).
+std::string range_text(const std::vector<double>& v, int decimals, const std::string& unit, double min_span) {
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (double x : v)
     if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
   if (!(hi >= lo)) return "no values";
-  return "from " + render::format_fixed(lo, decimals) + unit + " to " + render::format_fixed(hi, decimals) + unit;
+  const std::string a = render::format_fixed(lo, decimals), b = render::format_fixed(hi, decimals);
+  if (hi - lo < min_span) return a == b ? "uniform: " + a + unit : "nearly uniform: " + a + unit + " to " + b + unit;
+  return "from " + a + unit + " to " + b + unit;
 }
 
 // Decimals that show a strain range sensibly (3 significant digits of its largest value).
@@ -271,13 +276,14 @@ int decimals_for(const std::vector<double>& v) {
   return std::clamp(2 - static_cast<int>(std::floor(std::log10(m))), 0, 6);
 }
 
-// The largest round number (1, 2, 5 x 10^k) not above `x`.
-double round_down_125(double x) {
+// The round number (1, 2, 5 x 10^k) nearest to `x` on a log scale.
+double round_125(double x) {
   if (!(x > 0)) return 0;
   const double p = std::pow(10.0, std::floor(std::log10(x)));
-  for (double m : {5.0, 2.0, 1.0})
-    if (m * p <= x * (1 + 1e-9)) return m * p;
-  return p;
+  double best = p;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (std::abs(std::log(m * p / x)) < std::abs(std::log(best / x))) best = m * p;
+  return best;
 }
 
 struct ArrowScale {
@@ -300,9 +306,10 @@ ArrowScale arrow_scale(const Results& r, const Sampling& s, StrainMeasure m) {
   ArrowScale a;
   a.spacing = s.spacing;
   if (emax <= 0) emax = 1e-3;
-  // The longest arrow reaches 38 % of the spacing from the centre (pairs never touch).
-  a.model_per_strain = 0.34 * s.spacing / emax;
-  a.reference = round_down_125(emax);
+  // The longest arrow reaches 40 % of the spacing from the centre: pairs on neighbouring
+  // points stay a fifth of the spacing apart even when they point at each other.
+  a.model_per_strain = 0.35 * s.spacing / emax;
+  a.reference = round_125(emax);
   return a;
 }
 
@@ -321,13 +328,18 @@ render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale&
   scene.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(o.measure) + " strain  \xC2\xB7  " +
                    (deformed ? "deformed surface" : "undeformed surface (material directions before forming)");
   scene.view = deformed ? o.view : render::View{};
+  const double gap = 0.05 * a.spacing;
+  const double min_length = 0.03 * a.spacing;
+  const double min_strain = min_length / a.model_per_strain;
   scene.footnote = "Arrows along the major and minor directions at " + std::to_string(s.points.size()) +
-                   " points; length proportional to the strain, true to scale where the surface faces the "
-                   "viewer. View: " + render::view_name(scene.view) + ". Lengths in " + r.units + ".";
+                   " points, one length scale for both arrow pictures, true to scale where the surface faces "
+                   "the viewer; none drawn where the strain is below " +
+                   render::format_fixed(min_strain, reference_decimals(min_strain) + 1) +
+                   " in magnitude. View: " + render::view_name(scene.view) + ". Lengths in " + r.units + ".";
   render::Surface surf = plain_surface(m);
   surf.colour = {0.93, 0.93, 0.93};
   surf.lines = s.element_edges;
-  surf.line_colour = {0.78, 0.78, 0.78};
+  surf.line_colour = kElementEdges;
   scene.surfaces.push_back(std::move(surf));
 
   render::GlyphSet tension, compression;
@@ -338,8 +350,6 @@ render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale&
     g->head_length = 0.16 * a.spacing;
     g->head_width = 0.15 * a.spacing;
   }
-  const double gap = 0.06 * a.spacing;
-  const double min_length = 0.03 * a.spacing;
   for (Index p : s.points) {
     const Vec3 x = m.points.row(p).transpose();
     for (int k = 0; k < 2; ++k) {
@@ -374,9 +384,14 @@ render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale&
   ref.colour = kScaleArrow;
   ref.glyph_set = 0;
   ref.model_length = a.model_per_strain * a.reference;
-  ref.label = "scale: " + render::format_fixed(a.reference, std::max(0, decimals_for({a.reference}) - 2)) +
-              " " + measure_word(o.measure) + " strain";
-  scene.legend = {t, c, ref};
+  ref.label = "length of " + render::format_fixed(a.reference, reference_decimals(a.reference)) + " " +
+              measure_word(o.measure) + " strain";
+  render::LegendEntry edges;
+  edges.kind = render::LegendEntry::Kind::kLine;
+  edges.colour = kElementEdges;
+  edges.width_px = 2;
+  edges.label = "element edges";
+  scene.legend = {t, c, ref, edges};
   return scene;
 }
 
@@ -408,7 +423,7 @@ render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions
   render::Surface surf = plain_surface(r.deformed);
   surf.colour = {0.93, 0.93, 0.93};
   surf.lines = s.element_edges;
-  surf.line_colour = {0.78, 0.78, 0.78};
+  surf.line_colour = kElementEdges;
   scene.surfaces.push_back(std::move(surf));
   const double half = 0.36 * s.spacing;
   render::GlyphSet g1, g2;
@@ -440,6 +455,12 @@ render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions
     e.label = "family " + std::to_string(k + 1) + (angle.empty() ? "" : " (" + angle + " on the blank)");
     scene.legend.push_back(e);
   }
+  render::LegendEntry edges;
+  edges.kind = render::LegendEntry::Kind::kLine;
+  edges.colour = kElementEdges;
+  edges.width_px = 2;
+  edges.label = "element edges";
+  scene.legend.push_back(edges);
   return scene;
 }
 
@@ -496,7 +517,7 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
   chart.x_label = "minor strain (" + w + ")";
   chart.y_label = "major strain (" + w + ")";
   chart.equal_axes = true;
-  chart.legend_title = "Reference lines";
+  chart.legend_title = "Key";
   const std::string uni = o.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
   const std::string shear = o.measure == StrainMeasure::kTrue ? "pure shear (major = -minor)" : "pure shear";
   chart.series.push_back(reference_line(1.0, o.measure, "equibiaxial (major = minor)", {0.85, 0.45, 0.0}, 9));
@@ -505,7 +526,7 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
   chart.series.push_back(reference_line(-1.0, o.measure, shear, {0.45, 0.33, 0.18}, 2.5));
   render::ChartSeries safe, beyond;
   safe.colour = {0.10, 0.27, 0.60};
-  beyond.colour = {0.85, 0.08, 0.08};
+  beyond.colour = {0.80, 0.0, 0.45};
   safe.size_px = beyond.size_px = 3.2;
   safe.opacity = 0.75;
   Index n = 0;
@@ -518,7 +539,7 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
     s.y.push_back(ms.major[i]);
   }
   summary.n_marks = n;
-  safe.label = "marks (" + std::to_string(safe.x.size()) + ")";
+  safe.label = (flc ? "marks within the limit (" : "marks (") + std::to_string(safe.x.size()) + ")";
   chart.series.push_back(safe);
   if (flc) {
     render::ChartSeries curve;
@@ -526,11 +547,20 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
     curve.label = "forming limit curve";
     curve.colour = {0.85, 0.08, 0.08};
     curve.size_px = 3;
-    curve.sets_range = true;
+    curve.sets_range = false;
     curve.x = flc->minor;
     curve.y = flc->major;
     chart.series.push_back(curve);
-    beyond.label = "beyond the limit (" + std::to_string(beyond.x.size()) + ")";
+    // Show the curve where the marks are (not its whole extent, which may dwarf them).
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const auto* s : {&safe, &beyond})
+      for (double x : s->x) lo = std::min(lo, x), hi = std::max(hi, x);
+    if (hi >= lo) {
+      for (double x : {lo, hi}) chart.range_points.emplace_back(x, flc->major_at(x));
+      for (std::size_t i = 0; i < flc->minor.size(); ++i)
+        if (flc->minor[i] >= lo && flc->minor[i] <= hi) chart.range_points.emplace_back(flc->minor[i], flc->major[i]);
+    }
+    beyond.label = "marks beyond the limit (" + std::to_string(beyond.x.size()) + ")";
     chart.series.push_back(beyond);
     summary.n_beyond_flc = static_cast<Index>(beyond.x.size());
   }
@@ -602,10 +632,19 @@ FormingLimitCurve read_flc(const std::string& path) {
   return c;
 }
 
+ResultsFolder read_results_folder(const std::string& dir) { return read_results_impl(dir); }
+
+render::Scene arrow_diagram(const ResultsFolder& r, bool deformed, const PlotOptions& o) {
+  if (!r.has_surfaces)
+    throw InputError(r.dir + ": no undeformed.vtp / deformed.vtp (triangle method?): no arrow diagram");
+  const Sampling s = sample_surface(r.undeformed);
+  return arrow_scene(r, s, arrow_scale(r, s, o.measure), deformed, o);
+}
+
 PlotSummary write_pictures(const std::string& in_dir,
                            const std::function<std::string(const std::string&)>& out_path,
                            const PlotOptions& o) {
-  const Results r = read_results(in_dir);
+  const Results r = read_results_folder(in_dir);
   std::optional<FormingLimitCurve> flc;
   if (!o.flc_path.empty()) flc = read_flc(o.flc_path);
   PlotSummary summary;
@@ -643,21 +682,21 @@ PlotSummary write_pictures(const std::string& in_dir,
     const auto th = scalar_values(r.deformed, "thickness_change_pct", file);
     draw("thickness.png",
          contour_scene(r, th, "Thickness change", "Thickness change", "%", 1.0,
-                       "incompressible sheet: 100 (1/(lambda1 lambda2) - 1), " + range_text(th, 1, " %"), o));
+                       "formed part, incompressible sheet, " + range_text(th, 1, " %", 1.0), o));
     const auto names = measure_fields(o.measure);
     const std::string w = measure_word(o.measure);
     const auto e1 = scalar_values(r.deformed, names[0], file);
     const auto e2 = scalar_values(r.deformed, names[1], file);
     draw("major_strain.png", contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
-                                           measure_name(o.measure) + " strain, " + range_text(e1, decimals_for(e1), ""), o));
+                                           measure_name(o.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o));
     draw("minor_strain.png", contour_scene(r, e2, "Minor strain", "Minor " + w + " strain", "-", 0.01,
-                                           measure_name(o.measure) + " strain, " + range_text(e2, decimals_for(e2), ""), o));
+                                           measure_name(o.measure) + " strain, " + range_text(e2, decimals_for(e2), "", 0.01), o));
     if (fibres) {
       const auto sh = scalar_values(r.deformed, "shear_angle_deg", file);
       draw("shear_angle.png",
            contour_scene(r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
                          "initial angle between the fibre families minus the current one, " +
-                             range_text(sh, 1, "\xC2\xB0"),
+                             range_text(sh, 1, "\xC2\xB0", 1.0),
                          o));
       draw("fibres.png", fibre_scene(r, s, o));
     }

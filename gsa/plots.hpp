@@ -27,7 +27,11 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "common/core/types.hpp"
+#include "common/io/csv.hpp"
+#include "common/io/vtk_xml.hpp"
 #include "common/render/scene.hpp"
 
 namespace sf::gsa {
@@ -62,6 +66,24 @@ struct PlotOptions {
   std::string flc_path;    // --flc FILE: forming limit curve (minor, major) in `measure`
   bool quiet = true;
 };
+
+// A results folder read back: what the pictures are drawn from.
+struct ResultsFolder {
+  std::string dir;
+  nlohmann::json summary;          // summary.json (empty if absent)
+  std::string units = "mm";        // length unit from summary.json
+  std::string case_name;           // e.g. "dome/grid.csv": the input's folder and name
+  std::vector<double> fibre_angles;  // degrees, fibre mode only
+  bool has_surfaces = false;       // undeformed.vtp and deformed.vtp present (surface method)
+  io::PolyMesh undeformed, deformed;
+  io::CsvTable strains;
+};
+// Throws sf::InputError when DIR has no strains.csv or its files do not belong together.
+ResultsFolder read_results_folder(const std::string& dir);
+
+// The arrow diagram on the undeformed (deformed = false) or deformed surface, as a scene
+// (write it with render::write_png). Needs has_surfaces.
+render::Scene arrow_diagram(const ResultsFolder& results, bool deformed, const PlotOptions& options);
 
 struct PlotSummary {
   std::vector<std::string> pictures;  // file names written, in report order

@@ -10,4 +10,4 @@ for dir in data/gsa/*/; do
   "$gsa" analyse "$dir/grid.csv" --out "results/$name" "${extra[@]}"
 done
 echo "Results: $(ls -d results/*/ | tr '\n' ' ')"
-echo "Open results/<case>/deformed.vtp in ParaView; strains per mark are in results/<case>/strains.csv."
+echo "Open results/<case>/report.html for the pictures, results/<case>/deformed.vtp in ParaView; strains per mark are in results/<case>/strains.csv."

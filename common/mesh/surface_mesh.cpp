@@ -1,5 +1,6 @@
 #include "common/mesh/surface_mesh.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -336,5 +337,95 @@ SurfaceMesh extract_elements(const SurfaceMesh& mesh, const std::vector<bool>& k
   out.build_topology();
   if (element_map_out) *element_map_out = std::move(element_map);
   return out;
+}
+}  // namespace sf::mesh
+
+namespace sf::mesh {
+SurfaceMesh mesh_from_corners(const Points3& nodes, const std::vector<std::array<Index, 4>>& elements,
+                              const std::string& where) {
+  const Index nn = nodes.rows();
+  SurfaceMesh mesh;
+  mesh.add_nodes(nn);
+  for (Index n = 0; n < nn; ++n) mesh.geometry().row(SurfaceMesh::dof(n, kValue)) = nodes.row(n);
+  // Edge vectors through each node, per xi direction (sign: increasing xi).
+  std::vector<Vec3> d1(nn, Vec3::Zero()), d2(nn, Vec3::Zero()), normal(nn, Vec3::Zero());
+  std::vector<bool> apex(nn, false);
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const auto& el = elements[e];
+    for (Index n : el)
+      if (n < 0 || n >= nn)
+        throw InputError(where + ": element " + std::to_string(e) + " refers to node " + std::to_string(n) +
+                         ", but there are " + std::to_string(nn) + " nodes (ids from 0)");
+    const bool collapsed = el[0] == el[1];
+    if (el[2] == el[3] || el[0] == el[2] || el[1] == el[3] || el[0] == el[3] || el[1] == el[2])
+      throw InputError(where + ": element " + std::to_string(e) +
+                       " repeats a node; only n0 == n1 (a collapsed element with its apex there) is allowed");
+    auto p = [&](int k) { return Vec3(nodes.row(el[k]).transpose()); };
+    const Vec3 nrm = (p(3) - p(0)).cross(p(2) - p(1));
+    if (collapsed) apex[el[0]] = true;
+    for (int k = 0; k < 4; ++k) normal[el[k]] += nrm;
+    if (!collapsed) {
+      d1[el[0]] += p(1) - p(0);
+      d1[el[1]] += p(1) - p(0);
+    }
+    d1[el[2]] += p(3) - p(2);
+    d1[el[3]] += p(3) - p(2);
+    d2[el[0]] += p(2) - p(0);
+    d2[el[2]] += p(2) - p(0);
+    d2[el[1]] += p(3) - p(1);
+    d2[el[3]] += p(3) - p(1);
+  }
+  for (Index n = 0; n < nn; ++n) {
+    if (apex[n]) {
+      // Orthonormal tangent frame of the apex from the mean normal.
+      const Vec3 nz = normal[n].normalized();
+      Vec3 t = Vec3::UnitX() - Vec3::UnitX().dot(nz) * nz;
+      if (t.norm() < 0.3) t = Vec3::UnitY() - Vec3::UnitY().dot(nz) * nz;
+      t.normalize();
+      mesh.geometry().row(SurfaceMesh::dof(n, kD1)) = t.transpose();
+      mesh.geometry().row(SurfaceMesh::dof(n, kD2)) = nz.cross(t).transpose();
+      continue;
+    }
+    if (d1[n].norm() > 0) mesh.geometry().row(SurfaceMesh::dof(n, kD1)) = d1[n].normalized().transpose();
+    if (d2[n].norm() > 0) mesh.geometry().row(SurfaceMesh::dof(n, kD2)) = d2[n].normalized().transpose();
+  }
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const auto& ids = elements[e];
+    Element el;
+    el.nodes = ids;
+    // Initial scale factors: edge lengths (refined below).
+    auto p = [&](int k) { return Vec3(nodes.row(ids[k]).transpose()); };
+    const double l01 = (p(1) - p(0)).norm(), l23 = (p(3) - p(2)).norm();
+    const double l02 = (p(2) - p(0)).norm(), l13 = (p(3) - p(1)).norm();
+    el.scale = {{{l01 > 0 ? l01 : l23, l02}, {l01 > 0 ? l01 : l23, l13}, {l23, l02}, {l23, l13}}};
+    if (ids[0] == ids[1]) {
+      el.shape = ElementShape::kCollapsed;
+      const Index a = ids[0];
+      const Vec3 t1 = mesh.geometry().row(SurfaceMesh::dof(a, kD1)).transpose();
+      const Vec3 t2 = mesh.geometry().row(SurfaceMesh::dof(a, kD2)).transpose();
+      const Vec3 r0 = p(2) - p(0), r1 = p(3) - p(0);
+      double th0 = std::atan2(r0.dot(t2), r0.dot(t1)), th1 = std::atan2(r1.dot(t2), r1.dot(t1));
+      // Going from edge 0-2 to edge 1-3 by the short way round.
+      const double pi = 3.14159265358979323846;
+      while (th1 - th0 > pi) th1 -= 2 * pi;
+      while (th1 - th0 < -pi) th1 += 2 * pi;
+      el.apex_angle = {th0, th1};
+    }
+    mesh.add_element(el);
+  }
+  mesh.build_topology();
+  // Directions must agree across shared edges (structured orientation).
+  for (Index e = 0; e < mesh.n_elements(); ++e)
+    for (int edge = 0; edge < 4; ++edge) {
+      const EdgeNeighbour& nb = mesh.neighbour(e, edge);
+      if (nb.element < 0) continue;
+      const bool same_axis = ((edge % 2) == (nb.edge % 2));
+      if (!same_axis || nb.reversed || (edge == nb.edge))
+        throw InputError(where + ": elements " + std::to_string(e) + " and " + std::to_string(nb.element) +
+                         " meet with disagreeing xi directions; list every element's nodes in the same "
+                         "orientation (xi1 from n0 to n1 and n2 to n3, xi2 from n0 to n2)");
+    }
+  mesh.compute_arc_length_scale_factors();
+  return mesh;
 }
 }  // namespace sf::mesh

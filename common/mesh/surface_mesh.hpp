@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "common/core/error.hpp"
@@ -162,4 +163,18 @@ namespace sf::mesh {
 // old element -> new element (-1 when dropped).
 SurfaceMesh extract_elements(const SurfaceMesh& mesh, const std::vector<bool>& keep,
                              std::vector<Index>* element_map_out = nullptr);
+}  // namespace sf::mesh
+
+namespace sf::mesh {
+// A bicubic Hermite mesh through given corner nodes (n_nodes x 3) and elements
+// (global node ids in the local order n0 (0,0), n1 (1,0), n2 (0,1), n3 (1,1)).
+// An element whose n0 == n1 is a collapsed (3-noded) element with its apex there.
+// Nodal d/ds1, d/ds2 are the unit mean of the element edge vectors through the
+// node in each xi direction (cross derivatives 0); an apex gets two orthonormal
+// tangents of the mean plane of its elements and the radial angles of its edges
+// in that frame; scale factors then come from compute_arc_length_scale_factors().
+// Element xi directions must agree across shared edges (as in a structured mesh);
+// throws sf::InputError naming the element otherwise, or for bad node ids.
+SurfaceMesh mesh_from_corners(const Points3& nodes, const std::vector<std::array<Index, 4>>& elements,
+                              const std::string& where = "mesh");
 }  // namespace sf::mesh

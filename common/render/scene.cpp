@@ -12,7 +12,6 @@
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
-#include <vtkPNGReader.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -147,7 +146,7 @@ double panel_width(const Scene& scene, const ImageSize& size, const Fonts& ft) {
     }
   }
   if (need <= 0) return 0;
-  return std::clamp(need + 2 * ft.pad, 0.16 * size.width, 0.42 * size.width);
+  return std::clamp(need + 2.5 * ft.pad, 0.16 * size.width, 0.42 * size.width);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -250,27 +249,25 @@ void stroke(PolyBuilder& b, const Shape2D& s) {
       pts.emplace_back(c + w / 2 * Vec2(std::cos(k * kPi / 4), std::sin(k * kPi / 4)));
     b.polygon(pts, s.colour, s.opacity);
   };
-  double phase = 0;  // distance along the dash pattern
+  const double period = 2 * s.dash_px;
+  double start = 0;  // distance along the polyline where the segment starts
   for (std::size_t k = 0; k + 1 < s.points.size(); ++k) {
     const Vec2 p = s.points[k], q = s.points[k + 1];
     const double len = (q - p).norm();
-    if (len <= 1e-9) continue;
-    if (s.dash_px <= 0) {
+    if (!(len > 1e-9) || !std::isfinite(len)) continue;
+    if (s.dash_px < 0.5) {  // solid (dashes under half a pixel would not show)
       quad(p, q);
       if (w >= 2.5 && k + 2 < s.points.size()) dot(q);
-      continue;
+    } else {
+      // Dashes are the intervals [m period, m period + dash] of the distance along the line.
+      const Vec2 t = (q - p) / len;
+      const double end = start + len;
+      for (double m = std::floor(start / period); m * period < end; m += 1) {
+        const double lo = std::max(start, m * period), hi = std::min(end, m * period + s.dash_px);
+        if (hi > lo) quad(p + (lo - start) * t, p + (hi - start) * t);
+      }
     }
-    const Vec2 t = (q - p) / len;
-    double at = 0;
-    while (at < len) {
-      const double period = 2 * s.dash_px;
-      const double in = std::fmod(phase, period);
-      const double left = (in < s.dash_px ? s.dash_px : period) - in;
-      const double step = std::min(left, len - at);
-      if (in < s.dash_px) quad(p + at * t, p + (at + step) * t);
-      at += step;
-      phase += step;
-    }
+    start += len;
   }
 }
 
@@ -669,79 +666,6 @@ std::string temp_path_for(const std::string& path) {
 
 // ---------------------------------------------------------------------------------------
 
-View parse_view(const std::string& text, const std::string& option) {
-  View v;
-  if (text == "auto") v.kind = ViewKind::kAuto;
-  else if (text == "iso") v.kind = ViewKind::kIso;
-  else if (text == "top") v.kind = ViewKind::kTop;
-  else if (text == "front") v.kind = ViewKind::kFront;
-  else if (text == "side") v.kind = ViewKind::kSide;
-  else {
-    std::stringstream ss(text);
-    std::string item;
-    std::vector<double> xyz;
-    bool ok = true;
-    while (std::getline(ss, item, ',')) {
-      try {
-        std::size_t used = 0;
-        xyz.push_back(std::stod(item, &used));
-        if (used != item.size()) ok = false;
-      } catch (const std::exception&) {
-        ok = false;
-      }
-    }
-    if (!ok || xyz.size() != 3 || !std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) ||
-        !std::isfinite(xyz[2]) || Vec3(xyz[0], xyz[1], xyz[2]).norm() == 0)
-      throw UsageError(option + ": expected auto, iso, top, front, side or a view direction x,y,z "
-                                "(e.g. 1,-1,2), found '" + text + "'");
-    v.kind = ViewKind::kDirection;
-    v.direction = Vec3(xyz[0], xyz[1], xyz[2]);
-  }
-  return v;
-}
-
-std::string view_name(const View& v) {
-  switch (v.kind) {
-    case ViewKind::kAuto: return "auto (along the mean normal)";
-    case ViewKind::kIso: return "iso";
-    case ViewKind::kTop: return "top";
-    case ViewKind::kFront: return "front";
-    case ViewKind::kSide: return "side";
-    case ViewKind::kDirection: {
-      std::ostringstream os;
-      os << "from (" << v.direction.x() << ", " << v.direction.y() << ", " << v.direction.z() << ")";
-      return os.str();
-    }
-  }
-  return "auto";
-}
-
-ImageSize parse_size(const std::string& text, const std::string& option) {
-  const auto x = text.find_first_of("xX");
-  ImageSize s;
-  try {
-    if (x == std::string::npos) throw std::invalid_argument(text);
-    std::size_t u1 = 0, u2 = 0;
-    const std::string a = text.substr(0, x), b = text.substr(x + 1);
-    s.width = std::stoi(a, &u1);
-    s.height = std::stoi(b, &u2);
-    if (u1 != a.size() || u2 != b.size()) throw std::invalid_argument(text);
-  } catch (const std::exception&) {
-    throw UsageError(option + ": expected WIDTHxHEIGHT in pixels (e.g. 1200x900), found '" + text + "'");
-  }
-  if (s.width < 200 || s.height < 200 || s.width > 8000 || s.height > 8000)
-    throw UsageError(option + ": width and height must be between 200 and 8000 pixels, found '" +
-                     text + "'");
-  return s;
-}
-
-Vec2 Framing::to_pixel(const Vec3& p) const {
-  const Vec3 d = p - focal;
-  const double x = width / 2.0 + d.dot(right) * pixels_per_unit;
-  const double y = height / 2.0 + d.dot(up) * pixels_per_unit;
-  return {x, height - y};
-}
-
 Layout layout_of(const Scene& scene, const ImageSize& size) {
   const Fonts ft(size);
   Layout l;
@@ -1000,36 +924,6 @@ Framing write_png(const Scene& scene, const ImageSize& size, const std::string& 
     throw Error(path + ": cannot write PNG file (" + ec.message() + ")");
   }
   return framing;
-}
-
-Colour RgbImage::at(int x, int y) const {
-  if (x < 0 || y < 0 || x >= width || y >= height) return {};
-  const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
-  return Colour::from_rgb8(pixels[i], pixels[i + 1], pixels[i + 2]);
-}
-
-RgbImage read_png_rgb(const std::string& path) {
-  vtkNew<vtkPNGReader> reader;
-  if (!std::filesystem::exists(path) || !reader->CanReadFile(path.c_str()))
-    throw Error(path + ": cannot read PNG");
-  reader->SetFileName(path.c_str());
-  reader->Update();
-  vtkImageData* img = reader->GetOutput();
-  int dims[3];
-  img->GetDimensions(dims);
-  const int nc = img->GetNumberOfScalarComponents();
-  if (dims[0] <= 0 || dims[1] <= 0 || nc < 3 || img->GetScalarType() != VTK_UNSIGNED_CHAR) throw Error(path + ": cannot read PNG");
-  RgbImage out;
-  out.width = dims[0];
-  out.height = dims[1];
-  out.pixels.resize(static_cast<std::size_t>(out.width) * out.height * 3);
-  for (int y = 0; y < out.height; ++y)
-    for (int x = 0; x < out.width; ++x) {
-      const auto* p = static_cast<const unsigned char*>(img->GetScalarPointer(x, out.height - 1 - y, 0));
-      const std::size_t i = (static_cast<std::size_t>(y) * out.width + x) * 3;
-      for (int c = 0; c < 3; ++c) out.pixels[i + c] = p[c];
-    }
-  return out;
 }
 
 }  // namespace sf::render

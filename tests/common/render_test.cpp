@@ -173,6 +173,29 @@ TEST(RenderDisplay, GuardNestsAndReusesOneServer) {
   }
 }
 
+// A DISPLAY that names no server is not trusted (VTK would abort on it): a private Xvfb is
+// used instead, and DISPLAY is given back its old value afterwards. A second guard while
+// the first is alive uses the first one's display instead of starting another server.
+TEST(RenderDisplay, UnusableDisplayIsReplacedAndRestored) {
+  if (renders_without_display()) GTEST_SKIP() << "this VTK renders without any display";
+  ::setenv("DISPLAY", ":987", 1);  // nothing listens there
+  {
+    DisplayGuard outer;
+    EXPECT_TRUE(outer.owns_server());
+    EXPECT_NE(outer.display(), ":987");
+    EXPECT_EQ(std::string(std::getenv("DISPLAY")), outer.display());
+    DisplayGuard inner;
+    EXPECT_FALSE(inner.owns_server());
+    EXPECT_EQ(inner.display(), outer.display());
+    const fs::path dir = test_dir("bad_display");
+    write_png(linear_field_scene(ColourMap::kViridis, 0, 1, true), {200, 200}, (dir / "a.png").string());
+    EXPECT_TRUE(fs::exists(dir / "a.png"));
+  }
+  ASSERT_NE(std::getenv("DISPLAY"), nullptr);
+  EXPECT_EQ(std::string(std::getenv("DISPLAY")), ":987");
+  ::unsetenv("DISPLAY");
+}
+
 // A linear field on a flat square seen from the top: the low end of the colour map on the
 // left (x = 0), the high end on the right; for a field along y, low at the bottom.
 TEST(RenderImage, LinearFieldShowsMapEndsAtTheRightSides) {

@@ -204,27 +204,23 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, const A
           disp.values.push_back(pd.x[c] - pu.x[c]);
         }
         if (fibres) {
+          // Fibre directions (undeformed or deformed surface), stretches and shear angle.
           Vec3 a[2] = {Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
           double st[2] = {kNaN, kNaN};
+          std::optional<FibreState> fs[2];
           for (int k = 0; k < 2; ++k) {
             const auto a0 = tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[k]);
-            const auto fs = a0 ? fibre_state(pu.dx, pd.dx, *a0) : std::nullopt;
-            if (fs) {
-              a[k] = deformed ? fs->direction_deformed : *a0;
-              st[k] = fs->stretch;
-              if (!deformed) a[k] = *a0;
-              if (deformed) a[k] = fs->direction_deformed;
+            if (a0) fs[k] = fibre_state(pu.dx, pd.dx, *a0);
+            if (fs[k]) {
+              a[k] = deformed ? fs[k]->direction_deformed : *a0;
+              st[k] = fs[k]->stretch;
             }
           }
           double ang = kNaN;
-          if (a[0].allFinite() && a[1].allFinite()) {
-            const auto fs0 = fibre_state(pu.dx, pd.dx, *tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[0]));
-            const auto fs1 = fibre_state(pu.dx, pd.dx, *tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[1]));
-            if (fs0 && fs1)
-              ang = std::abs(options.fibre_angles[1] - options.fibre_angles[0]) -
-                    std::acos(std::clamp(fs0->direction_deformed.dot(fs1->direction_deformed), -1.0, 1.0)) * 180.0 /
-                        3.14159265358979323846;
-          }
+          if (fs[0] && fs[1])
+            ang = std::abs(options.fibre_angles[1] - options.fibre_angles[0]) -
+                  std::acos(std::clamp(fs[0]->direction_deformed.dot(fs[1]->direction_deformed), -1.0, 1.0)) *
+                      180.0 / 3.14159265358979323846;
           for (int c = 0; c < 3; ++c) {
             f1.values.push_back(a[0][c]);
             f2.values.push_back(a[1][c]);

@@ -2,18 +2,89 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <memory>
 
 #include "common/cli/app.hpp"
+#include "common/cli/progress.hpp"
+#include "forming/case.hpp"
+#include "forming/run.hpp"
 
 namespace sf::forming {
+namespace {
+
+// simform check CASE: every problem with its place, exit 1 if any.
+int run_check(const std::string& path, bool quiet) {
+  const CaseCheck c = check_case_file(path);
+  if (!c.ok()) {
+    for (std::size_t i = 0; i < c.problems.size(); ++i) std::cerr << c.located(i) << "\n";
+    std::cerr << "simform: " << c.problems.size() << (c.problems.size() == 1 ? " problem" : " problems") << " in "
+              << path << "\n";
+    return sf::cli::kExitFailure;
+  }
+  const FormingCase& s = c.spec;
+  std::size_t n_elements = 0;
+  for (const CasePly& p : s.plies) n_elements += static_cast<std::size_t>(p.n1) * static_cast<std::size_t>(p.n2);
+  if (!quiet)
+    std::cout << path << ": ok (" << s.plies.size() << (s.plies.size() == 1 ? " ply, " : " plies, ") << n_elements
+              << " elements, " << s.materials.size() << (s.materials.size() == 1 ? " material, " : " materials, ")
+              << s.boundaries.size() << " boundary conditions, " << s.solver.steps << " load steps)\n";
+  return sf::cli::kExitOk;
+}
+
+struct RunArgs {
+  std::string case_file;
+  RunOptions options;
+};
+
+int run_run(RunArgs& a, bool quiet) {
+  a.options.quiet = quiet;
+  a.options.command_line = "simform run " + a.case_file + " --out " + a.options.out_dir;
+  a.options.validate();
+  const FormingCase spec = load_case(a.case_file);
+  sf::cli::status(quiet, "simform: running " + a.case_file + " (" + std::to_string(spec.solver.steps) +
+                             " load steps) into " + a.options.out_dir);
+  const RunReport r = run_case(spec, a.options);
+  if (!r.ok()) {
+    std::cerr << "simform: error: " << a.case_file << ": " << r.message << " (" << a.options.out_dir
+              << "/summary.json has status not_converged)\n";
+    return sf::cli::kExitFailure;
+  }
+  sf::cli::status(quiet, "simform: " + r.brief() + "; wrote " + a.options.out_dir +
+                             (a.options.grid_out.empty() ? "" : " and " + a.options.grid_out));
+  return sf::cli::kExitOk;
+}
+
+}  // namespace
 
 void register_commands(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},
       [] {
         std::cout << "simform " << SF_VERSION << " (forming solver for fibre-reinforced plies)\n";
         return sf::cli::kExitOk;
       });
+
+  auto check_file = std::make_shared<std::string>();
+  program.add_command(
+      "check", "Validate a case file and list every problem with its place (file:line:column)",
+      [check_file](CLI::App& app) { app.add_option("case", *check_file, "Case file (YAML, see docs/forming.md)")->required(); },
+      [check_file, prog] { return run_check(*check_file, prog->common().quiet); });
+
+  auto args = std::make_shared<RunArgs>();
+  program.add_command(
+      "run", "Run a quasi-static case; write a ParaView series, history.csv and summary.json",
+      [args](CLI::App& app) {
+        app.add_option("case", args->case_file, "Case file (YAML, see docs/forming.md)")->required();
+        app.add_option("-o,--out", args->options.out_dir, "Output folder (files replaced only when written completely)")
+            ->required();
+        app.add_option("--grid-out", args->options.grid_out,
+                       "Also write the final positions of a grid of marks on a ply's top face (gsa grid file)");
+        app.add_option("--grid-marks", args->options.grid_marks, "Marks per side of that grid (default 21)")
+            ->check(CLI::Range(2, 10000));
+        app.add_option("--grid-ply", args->options.grid_ply, "Ply carrying the grid (default: the first)");
+      },
+      [args, prog] { return run_run(*args, prog->common().quiet); });
 }
 
 }  // namespace sf::forming

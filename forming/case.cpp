@@ -1,0 +1,687 @@
+#include "forming/case.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+#include "common/core/error.hpp"
+
+namespace sf::forming {
+
+std::string to_string(PlySide side) {
+  switch (side) {
+    case PlySide::kX0: return "x0";
+    case PlySide::kX1: return "x1";
+    case PlySide::kY0: return "y0";
+    case PlySide::kY1: return "y1";
+    case PlySide::kBottom: return "bottom";
+  }
+  return "?";
+}
+
+std::string to_string(Ramp ramp) { return ramp == Ramp::kLinear ? "linear" : "smooth"; }
+
+double ramp_value(Ramp ramp, double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return ramp == Ramp::kLinear ? t : t * t * (3.0 - 2.0 * t);
+}
+
+std::string to_string(CaseBoundary::Kind kind) {
+  switch (kind) {
+    case CaseBoundary::Kind::kClamp: return "clamp";
+    case CaseBoundary::Kind::kDisplacement: return "displacement";
+    case CaseBoundary::Kind::kSymmetry: return "symmetry";
+  }
+  return "?";
+}
+
+int FormingCase::find_ply(const std::string& name) const {
+  for (std::size_t i = 0; i < plies.size(); ++i)
+    if (plies[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+std::string CaseCheck::located(std::size_t i) const {
+  const CaseProblem& p = problems.at(i);
+  return located_message(spec.file, p.place.line, p.place.column, p.message);
+}
+
+namespace {
+
+SourcePlace place_of(const YAML::Node& n) {
+  if (!n.IsDefined()) return {};
+  const YAML::Mark m = n.Mark();
+  if (m.is_null()) return {};
+  return {m.line + 1, m.column + 1};
+}
+
+std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined()) return "nothing";
+  switch (n.Type()) {
+    case YAML::NodeType::Null: return "null";
+    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a mapping";
+    default: return "nothing";
+  }
+}
+
+// Collects problems while walking the document; every accessor returns what it could
+// read (or nothing) and records a problem otherwise, so the walk goes on.
+class Reader {
+ public:
+  explicit Reader(std::vector<CaseProblem>& problems) : problems_(problems) {}
+
+  void problem(const YAML::Node& at, const std::string& message) { problems_.push_back({place_of(at), message}); }
+  void problem(SourcePlace at, const std::string& message) { problems_.push_back({at, message}); }
+
+  // `n` must be a mapping whose keys are all in `allowed` (no duplicates).
+  bool mapping(const YAML::Node& n, const std::string& what, const std::vector<std::string>& allowed) {
+    if (!n.IsMap()) {
+      problem(n, what + ": expected a mapping (key: value), found " + describe(n));
+      return false;
+    }
+    std::set<std::string> seen;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const std::string key = it->first.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        std::string list;
+        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        problem(it->first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
+      } else if (!seen.insert(key).second) {
+        problem(it->first, what + ": key '" + key + "' given twice");
+      }
+    }
+    return true;
+  }
+
+  std::optional<double> number(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar()) {
+      problem(n, what + ": expected a number, found " + describe(n));
+      return std::nullopt;
+    }
+    const std::string& s = n.Scalar();
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) {
+      problem(n, what + ": expected a finite number, found '" + s + "'");
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  std::optional<double> positive(const YAML::Node& n, const std::string& what, const std::string& unit) {
+    const std::optional<double> v = number(n, what);
+    if (v && !(*v > 0.0)) {
+      problem(n, what + ": expected a positive value (" + unit + "), found " + n.Scalar());
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  std::optional<int> integer(const YAML::Node& n, const std::string& what, int lo, int hi) {
+    if (!n.IsScalar()) {
+      problem(n, what + ": expected an integer, found " + describe(n));
+      return std::nullopt;
+    }
+    const std::string& s = n.Scalar();
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) {
+      problem(n, what + ": expected an integer, found '" + s + "'");
+      return std::nullopt;
+    }
+    if (v < lo || v > hi) {
+      problem(n, what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "], found " + s);
+      return std::nullopt;
+    }
+    return static_cast<int>(v);
+  }
+
+  std::optional<bool> boolean(const YAML::Node& n, const std::string& what) {
+    if (n.IsScalar()) {
+      const std::string& s = n.Scalar();
+      if (s == "true" || s == "yes" || s == "on") return true;
+      if (s == "false" || s == "no" || s == "off") return false;
+    }
+    problem(n, what + ": expected true or false, found " + describe(n));
+    return std::nullopt;
+  }
+
+  std::optional<std::string> text(const YAML::Node& n, const std::string& what) {
+    if (!n.IsScalar() || n.Scalar().empty()) {
+      problem(n, what + ": expected a name, found " + describe(n));
+      return std::nullopt;
+    }
+    return n.Scalar();
+  }
+
+  // A required key of mapping `parent`; records "missing" at the parent.
+  YAML::Node required(const YAML::Node& parent, const std::string& key, const std::string& what) {
+    const YAML::Node n = parent[key];
+    if (!n.IsDefined()) problem(parent, what + ": missing required key '" + key + "'");
+    return n;
+  }
+
+ private:
+  std::vector<CaseProblem>& problems_;
+};
+
+const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "boundary_conditions", "solver", "output"};
+
+void read_material(Reader& r, const std::string& name, const YAML::Node& key, const YAML::Node& body,
+                   FormingCase& spec) {
+  const std::string what = "material '" + name + "'";
+  CaseMaterial m;
+  m.name = name;
+  m.place = place_of(key);
+  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic"})) return;
+  if (body.size() != 1) {
+    r.problem(key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
+    return;
+  }
+  const auto law = body.begin();
+  const std::string law_name = law->first.Scalar();
+  const YAML::Node p = law->second;
+  if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
+  const std::string lw = what + " " + law_name;
+  if (law_name == "neo_hookean") {
+    m.kind = CaseMaterial::Kind::kNeoHookean;
+    if (!r.mapping(p, lw, {"E", "nu", "mu", "lambda"})) return;
+    const bool young = p["E"].IsDefined() || p["nu"].IsDefined();
+    const bool lame = p["mu"].IsDefined() || p["lambda"].IsDefined();
+    if (young == lame) {
+      r.problem(law->first, lw + ": give either {E, nu} or {mu, lambda}");
+      return;
+    }
+    try {
+      if (young) {
+        const auto E = r.number(r.required(p, "E", lw), lw + " E");
+        const auto nu = r.number(r.required(p, "nu", lw), lw + " nu");
+        if (!E || !nu) return;
+        m.neo_hookean = NeoHookeanParams::from_young_poisson(*E, *nu);
+        m.given_as = "E, nu";
+      } else {
+        const auto mu = r.number(r.required(p, "mu", lw), lw + " mu");
+        const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
+        if (!mu || !la) return;
+        m.neo_hookean = NeoHookeanParams{*mu, *la};
+        m.neo_hookean.validate();
+        m.given_as = "mu, lambda";
+      }
+    } catch (const InputError& e) {
+      r.problem(law->first, what + ": " + e.what());
+      return;
+    }
+  } else {  // transversely_isotropic (the mapping check rejected anything else)
+    m.kind = CaseMaterial::Kind::kTransverselyIsotropic;
+    if (!r.mapping(p, lw, {"mu_T", "mu_L", "kappa_f", "lambda", "E_f", "E_T", "G_L", "G_T"})) return;
+    const bool engineering = p["E_f"].IsDefined() || p["E_T"].IsDefined() || p["G_L"].IsDefined() ||
+                             p["G_T"].IsDefined();
+    const bool direct = p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() ||
+                        p["lambda"].IsDefined();
+    if (engineering == direct) {
+      r.problem(law->first, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
+      return;
+    }
+    try {
+      if (engineering) {
+        TransverselyIsotropicEngineering e;
+        const auto Ef = r.number(r.required(p, "E_f", lw), lw + " E_f");
+        const auto Et = r.number(r.required(p, "E_T", lw), lw + " E_T");
+        const auto Gl = r.number(r.required(p, "G_L", lw), lw + " G_L");
+        const auto Gt = r.number(r.required(p, "G_T", lw), lw + " G_T");
+        if (!Ef || !Et || !Gl || !Gt) return;
+        e.E_f = *Ef;
+        e.E_T = *Et;
+        e.G_L = *Gl;
+        e.G_T = *Gt;
+        e.incompressible = false;
+        m.ti = e.to_params();
+        m.given_as = "E_f, E_T, G_L, G_T";
+      } else {
+        const auto mt = r.number(r.required(p, "mu_T", lw), lw + " mu_T");
+        const auto ml = r.number(r.required(p, "mu_L", lw), lw + " mu_L");
+        const auto kf = r.number(r.required(p, "kappa_f", lw), lw + " kappa_f");
+        const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
+        if (!mt || !ml || !kf || !la) return;
+        m.ti.mu_T = *mt;
+        m.ti.mu_L = *ml;
+        m.ti.kappa_f = *kf;
+        m.ti.lambda = *la;
+        m.ti.incompressible = false;
+        m.ti.validate();
+        m.given_as = "mu_T, mu_L, kappa_f, lambda";
+      }
+    } catch (const InputError& e) {
+      r.problem(law->first, what + ": " + e.what());
+      return;
+    }
+  }
+  spec.materials.push_back(m);
+}
+
+// [a, b] of positive numbers, or [n1, n2] of integers.
+bool pair_of(Reader& r, const YAML::Node& n, const std::string& what) {
+  if (!n.IsSequence() || n.size() != 2) {
+    r.problem(n, what + ": expected a list of two values [x, y], found " + describe(n));
+    return false;
+  }
+  return true;
+}
+
+void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
+  std::string what = "ply " + std::to_string(index + 1);
+  if (!r.mapping(n, what, {"name", "origin", "size", "thickness", "elements", "angle", "material"})) return;
+  CasePly ply;
+  ply.place = place_of(n);
+  bool ok = true;
+  if (const auto name = r.text(r.required(n, "name", what), what + " name")) {
+    ply.name = *name;
+    what = "ply '" + ply.name + "'";
+    if (spec.find_ply(ply.name) >= 0) {
+      r.problem(n["name"], what + ": name used by an earlier ply");
+      ok = false;
+    }
+  } else {
+    ok = false;
+  }
+  if (const YAML::Node o = n["origin"]; o.IsDefined()) {
+    if (!o.IsSequence() || o.size() != 3) {
+      r.problem(o, what + " origin: expected [x, y, z] (mm), found " + describe(o));
+      ok = false;
+    } else {
+      for (int i = 0; i < 3; ++i) {
+        const auto v = r.number(o[i], what + " origin");
+        if (v) ply.origin[i] = *v; else ok = false;
+      }
+    }
+  }
+  if (const YAML::Node s = r.required(n, "size", what); s.IsDefined()) {
+    if (pair_of(r, s, what + " size")) {
+      const auto a = r.positive(s[0], what + " size Lx", "mm");
+      const auto b = r.positive(s[1], what + " size Ly", "mm");
+      if (a && b) { ply.length_x = *a; ply.length_y = *b; } else ok = false;
+    } else ok = false;
+  } else ok = false;
+  if (const YAML::Node t = r.required(n, "thickness", what); t.IsDefined()) {
+    if (const auto h = r.positive(t, what + " thickness", "mm")) ply.thickness = *h; else ok = false;
+  } else ok = false;
+  if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined()) {
+    if (pair_of(r, e, what + " elements")) {
+      const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
+      const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
+      if (a && b) { ply.n1 = *a; ply.n2 = *b; } else ok = false;
+    } else ok = false;
+  } else ok = false;
+  if (const YAML::Node a = n["angle"]; a.IsDefined()) {
+    if (const auto v = r.number(a, what + " angle (degrees)")) ply.angle_deg = *v; else ok = false;
+  }
+  if (const YAML::Node m = r.required(n, "material", what); m.IsDefined()) {
+    if (const auto name = r.text(m, what + " material")) {
+      ply.material = *name;
+      for (std::size_t i = 0; i < spec.materials.size(); ++i)
+        if (spec.materials[i].name == *name) ply.material_index = static_cast<int>(i);
+      if (ply.material_index < 0) {
+        r.problem(m, what + ": unknown material '" + *name + "' (not defined under materials)");
+        ok = false;
+      }
+    } else ok = false;
+  } else ok = false;
+  if (ok) spec.plies.push_back(ply);
+}
+
+std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string& what, bool allow_bottom) {
+  if (n.IsScalar()) {
+    const std::string& s = n.Scalar();
+    if (s == "x0") return PlySide::kX0;
+    if (s == "x1") return PlySide::kX1;
+    if (s == "y0") return PlySide::kY0;
+    if (s == "y1") return PlySide::kY1;
+    if (allow_bottom && s == "bottom") return PlySide::kBottom;
+  }
+  r.problem(n, what + ": expected " + std::string(allow_bottom ? "x0, x1, y0, y1 or bottom" : "x0, x1, y0 or y1") +
+                   ", found " + describe(n));
+  return std::nullopt;
+}
+
+void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
+  const std::string what = "boundary condition " + std::to_string(index + 1);
+  if (!r.mapping(n, what, {"clamp", "displacement", "symmetry"})) return;
+  if (n.size() != 1) {
+    r.problem(n, what + ": expected exactly one of clamp, displacement, symmetry");
+    return;
+  }
+  const auto kv = n.begin();
+  const std::string kind = kv->first.Scalar();
+  const YAML::Node b = kv->second;
+  if (kind != "clamp" && kind != "displacement" && kind != "symmetry") return;  // reported above
+  const std::string bw = what + " (" + kind + ")";
+  CaseBoundary bc;
+  bc.place = place_of(kv->first);
+  std::vector<std::string> keys = {"ply"};
+  if (kind == "clamp") {
+    bc.kind = CaseBoundary::Kind::kClamp;
+    keys.push_back("edge");
+  } else if (kind == "displacement") {
+    bc.kind = CaseBoundary::Kind::kDisplacement;
+    keys.insert(keys.end(), {"edge", "value", "ramp"});
+  } else {
+    bc.kind = CaseBoundary::Kind::kSymmetry;
+    keys.push_back("plane");
+  }
+  if (!r.mapping(b, bw, keys)) return;
+  bool ok = true;
+  if (const YAML::Node p = r.required(b, "ply", bw); p.IsDefined()) {
+    if (const auto name = r.text(p, bw + " ply")) {
+      bc.ply = *name;
+      bc.ply_index = spec.find_ply(*name);
+      if (bc.ply_index < 0) {
+        r.problem(p, bw + ": unknown ply '" + *name + "'");
+        ok = false;
+      }
+    } else ok = false;
+  } else ok = false;
+  const bool symmetry = bc.kind == CaseBoundary::Kind::kSymmetry;
+  const std::string side_key = symmetry ? "plane" : "edge";
+  if (const YAML::Node s = r.required(b, side_key, bw); s.IsDefined()) {
+    if (const auto side = side_of(r, s, bw + " " + side_key, symmetry)) bc.side = *side; else ok = false;
+  } else ok = false;
+  if (bc.kind == CaseBoundary::Kind::kDisplacement) {
+    const YAML::Node v = r.required(b, "value", bw);
+    if (v.IsDefined()) {
+      if (!v.IsSequence() || v.size() != 3) {
+        r.problem(v, bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
+        ok = false;
+      } else {
+        int given = 0;
+        for (int i = 0; i < 3; ++i) {
+          if (v[i].IsNull() || (v[i].IsScalar() && v[i].Scalar() == "free")) continue;
+          const auto u = r.number(v[i], bw + " value");
+          if (u) { bc.value[i] = *u; ++given; } else ok = false;
+        }
+        if (ok && given == 0) {
+          r.problem(v, bw + " value: every component is free; give at least one");
+          ok = false;
+        }
+      }
+    } else ok = false;
+    if (const YAML::Node rp = b["ramp"]; rp.IsDefined()) {
+      if (rp.IsScalar() && rp.Scalar() == "linear") bc.ramp = Ramp::kLinear;
+      else if (rp.IsScalar() && rp.Scalar() == "smooth") bc.ramp = Ramp::kSmooth;
+      else {
+        r.problem(rp, bw + " ramp: expected linear or smooth, found " + describe(rp));
+        ok = false;
+      }
+    }
+  }
+  if (ok) spec.boundaries.push_back(bc);
+}
+
+void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
+  if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment"})) return;
+  if (n["steps"].IsDefined())
+    if (const auto v = r.integer(n["steps"], "solver steps", 1, 100000)) s.steps = *v;
+  if (n["max_iterations"].IsDefined())
+    if (const auto v = r.integer(n["max_iterations"], "solver max_iterations", 1, 1000)) s.max_iterations = *v;
+  if (n["tolerance"].IsDefined()) {
+    const auto v = r.number(n["tolerance"], "solver tolerance");
+    if (v && (*v <= 0.0 || *v >= 1.0))
+      r.problem(n["tolerance"], "solver tolerance: expected a relative residual in (0, 1), found " +
+                                    n["tolerance"].Scalar());
+    else if (v) s.tolerance = *v;
+  }
+  if (n["line_search"].IsDefined())
+    if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;
+  if (n["min_increment"].IsDefined()) {
+    const auto v = r.number(n["min_increment"], "solver min_increment");
+    if (v && !(*v > 0.0 && *v <= 1.0))
+      r.problem(n["min_increment"], "solver min_increment: expected a fraction of a step in (0, 1], found " +
+                                        n["min_increment"].Scalar());
+    else if (v) s.min_increment = *v;
+  }
+}
+
+void read_output(Reader& r, const YAML::Node& n, CaseOutput& o) {
+  if (!r.mapping(n, "output", {"every", "samples"})) return;
+  if (n["every"].IsDefined())
+    if (const auto v = r.integer(n["every"], "output every", 1, 100000)) o.every = *v;
+  if (const YAML::Node s = n["samples"]; s.IsDefined()) {
+    if (pair_of(r, s, "output samples [in-plane, through thickness]")) {
+      const auto a = r.integer(s[0], "output samples in-plane", 1, 16);
+      const auto b = r.integer(s[1], "output samples through the thickness", 1, 16);
+      if (a) o.samples_inplane = *a;
+      if (b) o.samples_thickness = *b;
+    }
+  }
+}
+
+void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::vector<CaseProblem>& problems) {
+  if (!root.IsDefined() || root.IsNull()) {
+    r.problem(SourcePlace{1, 1}, "empty case file: expected materials, plies, boundary_conditions");
+    return;
+  }
+  if (!r.mapping(root, "case", kTopKeys)) return;
+  if (const YAML::Node u = root["units"]; u.IsDefined()) {
+    if (u.IsScalar()) spec.units = u.Scalar();
+    else r.problem(u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
+  }
+  if (const YAML::Node ms = r.required(root, "materials", "case"); ms.IsDefined()) {
+    if (!ms.IsMap()) {
+      r.problem(ms, "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
+                        describe(ms));
+    } else {
+      std::set<std::string> seen;
+      for (auto it = ms.begin(); it != ms.end(); ++it) {
+        const std::string name = it->first.Scalar();
+        if (!seen.insert(name).second) {
+          r.problem(it->first, "material '" + name + "' defined twice");
+          continue;
+        }
+        read_material(r, name, it->first, it->second, spec);
+      }
+      if (ms.size() == 0) r.problem(ms, "materials: expected at least one material");
+    }
+  }
+  // Names of materials that failed to read must not also be reported as "unknown".
+  std::set<std::string> material_names;
+  if (const YAML::Node ms = root["materials"]; ms.IsMap())
+    for (auto it = ms.begin(); it != ms.end(); ++it) material_names.insert(it->first.Scalar());
+  if (const YAML::Node ps = r.required(root, "plies", "case"); ps.IsDefined()) {
+    if (!ps.IsSequence() || ps.size() == 0) {
+      r.problem(ps, "plies: expected a list of plies (- name: ...), found " + describe(ps));
+    } else {
+      for (std::size_t i = 0; i < ps.size(); ++i) {
+        const std::size_t before = problems.size();
+        read_ply(r, ps[i], static_cast<int>(i), spec);
+        // A ply naming a material that exists but was bad: one problem is enough.
+        for (std::size_t k = before; k < problems.size(); ++k) {
+          const std::string& msg = problems[k].message;
+          const auto pos = msg.find("unknown material '");
+          if (pos == std::string::npos) continue;
+          const auto start = pos + 18;
+          const std::string name = msg.substr(start, msg.find('\'', start) - start);
+          if (material_names.count(name)) problems.erase(problems.begin() + static_cast<long>(k--));
+        }
+      }
+    }
+  }
+  std::set<std::string> ply_names;
+  if (const YAML::Node ps = root["plies"]; ps.IsSequence())
+    for (const YAML::Node& p : ps)
+      if (p.IsMap() && p["name"].IsScalar()) ply_names.insert(p["name"].Scalar());
+  if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
+    if (!bs.IsSequence() || bs.size() == 0) {
+      r.problem(bs, "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
+    } else {
+      for (std::size_t i = 0; i < bs.size(); ++i) {
+        const std::size_t before = problems.size();
+        read_boundary(r, bs[i], static_cast<int>(i), spec);
+        for (std::size_t k = before; k < problems.size(); ++k) {
+          const std::string& msg = problems[k].message;
+          const auto pos = msg.find("unknown ply '");
+          if (pos == std::string::npos) continue;
+          const auto start = pos + 13;
+          if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
+            problems.erase(problems.begin() + static_cast<long>(k--));
+        }
+      }
+    }
+  }
+  if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
+  if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
+}
+
+}  // namespace
+
+std::vector<Index> side_surface_nodes(int n1, int n2, PlySide side) {
+  std::vector<Index> out;
+  auto id = [&](int i, int j) { return static_cast<Index>(j) * (n1 + 1) + i; };
+  switch (side) {
+    case PlySide::kX0: for (int j = 0; j <= n2; ++j) out.push_back(id(0, j)); break;
+    case PlySide::kX1: for (int j = 0; j <= n2; ++j) out.push_back(id(n1, j)); break;
+    case PlySide::kY0: for (int i = 0; i <= n1; ++i) out.push_back(id(i, 0)); break;
+    case PlySide::kY1: for (int i = 0; i <= n1; ++i) out.push_back(id(i, n2)); break;
+    case PlySide::kBottom:
+      for (Index s = 0; s < static_cast<Index>(n1 + 1) * (n2 + 1); ++s) out.push_back(s);
+      break;
+  }
+  return out;
+}
+
+std::vector<PlyPrescription> ply_prescriptions(const FormingCase& spec, int ply,
+                                               std::vector<CaseProblem>& conflicts) {
+  const CasePly& p = spec.plies.at(static_cast<std::size_t>(ply));
+  const Index n_s = static_cast<Index>(p.n1 + 1) * (p.n2 + 1);
+  std::map<std::tuple<Index, int, int>, PlyPrescription> dofs;
+  std::set<std::pair<int, int>> reported;  // (earlier, later) condition pairs
+  for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+    const CaseBoundary& bc = spec.boundaries[b];
+    if (bc.ply_index != ply) continue;
+    auto add = [&](Index node, int d, int coord, double u) {
+      PlyPrescription pr{node, d, coord, u, bc.ramp, static_cast<int>(b)};
+      const auto key = std::make_tuple(node, d, coord);
+      const auto [it, inserted] = dofs.emplace(key, pr);
+      if (inserted) return;
+      const PlyPrescription& old = it->second;
+      const bool same = old.displacement == u && (u == 0.0 || old.ramp == bc.ramp);
+      if (!same && reported.insert({old.boundary, static_cast<int>(b)}).second) {
+        const CaseBoundary& ob = spec.boundaries[static_cast<std::size_t>(old.boundary)];
+        conflicts.push_back({bc.place, to_string(bc.kind) + " on " + to_string(bc.side) + " of ply '" + p.name +
+                                           "' prescribes some of the same dofs as the " + to_string(ob.kind) +
+                                           " on " + to_string(ob.side) + " (line " +
+                                           std::to_string(ob.place.line) + ") differently"});
+      }
+    };
+    const bool x_side = bc.side == PlySide::kX0 || bc.side == PlySide::kX1;
+    const int along = x_side ? 2 : 1;   // derivative along the edge
+    const int across = x_side ? 1 : 2;  // derivative across the edge
+    const std::vector<Index> nodes = side_surface_nodes(p.n1, p.n2, bc.side);
+    for (const Index s : nodes) {
+      for (int layer = 0; layer < 2; ++layer) {
+        const Index node = s + layer * n_s;
+        switch (bc.kind) {
+          case CaseBoundary::Kind::kClamp:
+            for (int d = 0; d < 4; ++d)
+              for (int c = 0; c < 3; ++c) add(node, d, c, 0.0);
+            break;
+          case CaseBoundary::Kind::kDisplacement:
+            for (int c = 0; c < 3; ++c) {
+              if (!bc.value[static_cast<std::size_t>(c)]) continue;
+              add(node, 0, c, *bc.value[static_cast<std::size_t>(c)]);
+              add(node, along, c, 0.0);
+            }
+            break;
+          case CaseBoundary::Kind::kSymmetry:
+            if (bc.side == PlySide::kBottom) {
+              if (layer == 0)
+                for (int d = 0; d < 4; ++d) add(node, d, 2, 0.0);
+            } else {
+              const int k = x_side ? 0 : 1;  // normal of the plane
+              add(node, 0, k, 0.0);
+              add(node, along, k, 0.0);
+              for (int c = 0; c < 3; ++c)
+                if (c != k) {
+                  add(node, across, c, 0.0);
+                  add(node, 3, c, 0.0);
+                }
+            }
+            break;
+        }
+      }
+    }
+  }
+  std::vector<PlyPrescription> out;
+  out.reserve(dofs.size());
+  for (const auto& kv : dofs) out.push_back(kv.second);
+  return out;
+}
+
+CaseCheck check_case_text(const std::string& text, const std::string& name) {
+  CaseCheck result;
+  result.spec.file = name;
+  Reader r(result.problems);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    result.problems.push_back({{e.mark.line + 1, e.mark.column + 1}, "invalid YAML: " + e.msg});
+    return result;
+  }
+  try {
+    read_document(r, root, result.spec, result.problems);
+  } catch (const YAML::Exception& e) {
+    result.problems.push_back({{e.mark.line + 1, e.mark.column + 1}, std::string("cannot read: ") + e.msg});
+  }
+  if (result.ok()) {
+    bool any = false;
+    for (std::size_t p = 0; p < result.spec.plies.size(); ++p) {
+      const std::vector<PlyPrescription> pr = ply_prescriptions(result.spec, static_cast<int>(p), result.problems);
+      any = any || !pr.empty();
+    }
+    if (!any)
+      result.problems.push_back({{1, 1}, "boundary_conditions: nothing is held (the plies could move as rigid bodies)"});
+  }
+  std::stable_sort(result.problems.begin(), result.problems.end(), [](const CaseProblem& a, const CaseProblem& b) {
+    return std::tie(a.place.line, a.place.column) < std::tie(b.place.line, b.place.column);
+  });
+  return result;
+}
+
+CaseCheck check_case_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    CaseCheck c;
+    c.spec.file = path;
+    c.problems.push_back({{}, "cannot open case file"});
+    return c;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return check_case_text(ss.str(), path);
+}
+
+FormingCase load_case(const std::string& path) {
+  CaseCheck c = check_case_file(path);
+  if (!c.ok()) {
+    std::string msg = c.located(0);
+    if (c.problems.size() > 1)
+      msg += " (and " + std::to_string(c.problems.size() - 1) + " more problems; run 'simform check " + path +
+             "' to list them)";
+    throw InputError(msg);
+  }
+  return c.spec;
+}
+
+}  // namespace sf::forming

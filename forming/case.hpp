@@ -1,0 +1,164 @@
+#pragma once
+// Case files of `simform` (YAML, read with yaml-cpp; format documented in docs/forming.md).
+//
+//   units: "mm, N, MPa"            # informational; any consistent set works
+//   materials:
+//     gfpp:
+//       transversely_isotropic: {E_f: 25000, E_T: 1, G_L: 0.5, G_T: 0.4}
+//   plies:
+//     - {name: ply, size: [100, 20], thickness: 2, elements: [10, 2], angle: 0, material: gfpp}
+//   boundary_conditions:
+//     - clamp: {ply: ply, edge: x0}
+//     - displacement: {ply: ply, edge: x1, value: [5, ~, ~], ramp: linear}
+//     - symmetry: {ply: ply, plane: bottom}
+//   solver: {steps: 10, max_iterations: 25, tolerance: 1e-8, line_search: true}
+//   output: {every: 1, samples: [4, 2]}
+//
+// Quasi-static only for now: no contact, no dynamics, no exact constraints (the TI law
+// is used in its compressible form), no follower pressure.
+//
+// check_case_*() returns EVERY problem found (unknown keys, wrong types, values out of
+// range, unknown names, conflicting boundary conditions), each with its place in the
+// file (1-based line and column of yaml-cpp's Mark); load_case() throws sf::InputError
+// when there is any.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "forming/materials.hpp"
+
+namespace sf::forming {
+
+// 1-based line and column in the case file; 0 = not known.
+struct SourcePlace {
+  int line = 0;
+  int column = 0;
+};
+
+// Sides of a rectangular ply (reference frame of the ply: x along size[0], y along size[1]);
+// kBottom is the face z = origin z (symmetry planes only).
+enum class PlySide { kX0, kX1, kY0, kY1, kBottom };
+std::string to_string(PlySide side);
+
+// Load-factor ramp r(t), t in [0, 1], r(0) = 0, r(1) = 1.
+//   kLinear r = t;  kSmooth r = 3 t^2 - 2 t^3 (zero rate at both ends).
+enum class Ramp { kLinear, kSmooth };
+std::string to_string(Ramp ramp);
+double ramp_value(Ramp ramp, double t);
+
+struct CaseMaterial {
+  enum class Kind { kNeoHookean, kTransverselyIsotropic };
+  std::string name;
+  Kind kind = Kind::kNeoHookean;
+  NeoHookeanParams neo_hookean;      // kNeoHookean
+  TransverselyIsotropicParams ti;    // kTransverselyIsotropic (compressible)
+  std::string given_as;              // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
+  SourcePlace place;
+};
+
+struct CasePly {
+  std::string name;
+  Vec3 origin = Vec3::Zero();  // corner (x0, y0, bottom), mm
+  double length_x = 0.0;       // mm
+  double length_y = 0.0;       // mm
+  double thickness = 0.0;      // mm
+  int n1 = 0, n2 = 0;          // elements along x and y
+  double angle_deg = 0.0;      // layup angle from x towards y, degrees
+  std::string material;
+  int material_index = -1;
+  SourcePlace place;
+};
+
+struct CaseBoundary {
+  enum class Kind {
+    kClamp,         // every dof (values and derivatives, both layers) of the edge nodes fixed
+    kDisplacement,  // edge translated by value * ramp(load factor); null components free
+    kSymmetry,      // mirror plane through the side (see docs/forming.md for the dofs)
+  };
+  Kind kind = Kind::kClamp;
+  std::string ply;
+  int ply_index = -1;
+  PlySide side = PlySide::kX0;
+  std::array<std::optional<double>, 3> value{};  // kDisplacement, mm
+  Ramp ramp = Ramp::kLinear;
+  SourcePlace place;
+};
+std::string to_string(CaseBoundary::Kind kind);
+
+struct CaseSolver {
+  int steps = 10;             // load steps (load factor k / steps)
+  int max_iterations = 25;    // Newton iterations per attempt
+  double tolerance = 1e-8;    // residual, relative to the force scale
+  bool line_search = true;
+  double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
+};
+
+struct CaseOutput {
+  int every = 1;              // write a .vtu every N steps (and always the last)
+  int samples_inplane = 4;    // hexahedra per element per in-plane direction in the .vtu
+  int samples_thickness = 2;  // ... through the thickness
+};
+
+struct FormingCase {
+  std::string file;  // as given (messages)
+  std::string units = "mm, N, MPa";
+  std::vector<CaseMaterial> materials;
+  std::vector<CasePly> plies;
+  std::vector<CaseBoundary> boundaries;
+  CaseSolver solver;
+  CaseOutput output;
+
+  int find_ply(const std::string& name) const;  // -1 when absent
+};
+
+struct CaseProblem {
+  SourcePlace place;
+  std::string message;
+};
+
+struct CaseCheck {
+  FormingCase spec;                   // complete only when ok()
+  std::vector<CaseProblem> problems;  // in file order
+  bool ok() const { return problems.empty(); }
+  // "FILE:LINE:COLUMN: message" for problem i.
+  std::string located(std::size_t i) const;
+};
+
+// Reads and validates a case file (a missing file is a problem too).
+CaseCheck check_case_file(const std::string& path);
+// Same from text; `name` stands for the file name in messages.
+CaseCheck check_case_text(const std::string& text, const std::string& name);
+// check_case_file(); throws sf::InputError with the first problem and the number of
+// others ("run simform check") when there is any.
+FormingCase load_case(const std::string& path);
+
+}  // namespace sf::forming
+
+namespace sf::forming {
+
+// One prescribed parameter of a ply: ply node (PlyMesh::node numbering, structured
+// rectangle: surface node j (n1 + 1) + i, layer 0 bottom / 1 top), parameter d
+// (0 value, 1 d/ds1, 2 d/ds2, 3 cross), coordinate; its target is
+// reference + displacement * ramp(load factor).
+struct PlyPrescription {
+  Index node = 0;
+  int d = 0;
+  int coord = 0;
+  double displacement = 0.0;  // mm for d = 0, 0 for derivative parameters
+  Ramp ramp = Ramp::kLinear;
+  int boundary = -1;  // index into FormingCase::boundaries
+};
+
+// Every prescribed parameter of ply `ply` (sorted by node, d, coord; no duplicates).
+// Two conditions prescribing one parameter differently are a problem appended to
+// `conflicts` (at the later condition's place).
+std::vector<PlyPrescription> ply_prescriptions(const FormingCase& spec, int ply,
+                                               std::vector<CaseProblem>& conflicts);
+
+// Surface nodes of a side of a structured n1 x n2 rectangle (kBottom: all of them).
+std::vector<Index> side_surface_nodes(int n1, int n2, PlySide side);
+
+}  // namespace sf::forming

@@ -1,0 +1,444 @@
+#include "forming/run.hpp"
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <utility>
+
+#include "common/basis/hermite.hpp"
+#include "common/cli/progress.hpp"
+#include "common/core/error.hpp"
+#include "common/io/atomic_file.hpp"
+#include "common/io/csv.hpp"
+#include "common/io/json.hpp"
+#include "common/io/vtk_xml.hpp"
+#include "common/mesh/surface_mesh.hpp"
+#include "forming/materials.hpp"
+
+namespace sf::forming {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string sci(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+// A prescribed dof with its reference value and load-factor dependence.
+struct Prescription {
+  Index dof = 0;
+  double reference = 0.0;
+  double displacement = 0.0;
+  Ramp ramp = Ramp::kLinear;
+};
+
+std::vector<Prescription> prescriptions(const FormingCase& spec, const Model& model) {
+  const VecX X = model.reference_positions();
+  std::vector<Prescription> out;
+  std::vector<CaseProblem> conflicts;
+  for (int b = 0; b < model.n_bodies(); ++b)
+    for (const PlyPrescription& p : ply_prescriptions(spec, b, conflicts)) {
+      const Index dof = model.dof(b, p.node, p.d, p.coord);
+      out.push_back({dof, X[dof], p.displacement, p.ramp});
+    }
+  if (!conflicts.empty())
+    throw InputError(located_message(spec.file, conflicts[0].place.line, conflicts[0].place.column,
+                                     conflicts[0].message));
+  return out;
+}
+
+std::vector<PrescribedDof> targets(const std::vector<Prescription>& ps, double lambda) {
+  std::vector<PrescribedDof> out;
+  out.reserve(ps.size());
+  for (const Prescription& p : ps) out.push_back({p.dof, p.reference + p.displacement * ramp_value(p.ramp, lambda)});
+  return out;
+}
+
+// The edge whose displacement and reaction go into history.csv: the first displacement
+// condition (or, without one, the first condition).
+struct Tool {
+  std::string label;
+  std::vector<Index> value_dofs_x;  // global dof of coordinate 0 of each value parameter
+};
+
+Tool find_tool(const FormingCase& spec, const Model& model) {
+  Tool t;
+  const CaseBoundary* chosen = nullptr;
+  for (const CaseBoundary& bc : spec.boundaries)
+    if (bc.kind == CaseBoundary::Kind::kDisplacement) {
+      chosen = &bc;
+      break;
+    }
+  if (!chosen && !spec.boundaries.empty()) chosen = &spec.boundaries.front();
+  if (!chosen) return t;
+  const CasePly& p = spec.plies[static_cast<std::size_t>(chosen->ply_index)];
+  const Index n_s = static_cast<Index>(p.n1 + 1) * (p.n2 + 1);
+  t.label = to_string(chosen->kind) + " on " + to_string(chosen->side) + " of ply '" + p.name + "'";
+  for (const Index s : side_surface_nodes(p.n1, p.n2, chosen->side))
+    for (int layer = 0; layer < 2; ++layer)
+      t.value_dofs_x.push_back(model.dof(chosen->ply_index, s + layer * n_s, 0, 0));
+  return t;
+}
+
+struct ToolState {
+  Vec3 displacement = Vec3::Zero();
+  Vec3 force = Vec3::Zero();
+};
+
+ToolState tool_state(const Tool& tool, const VecX& x, const VecX& X, const VecX& reactions) {
+  ToolState s;
+  if (tool.value_dofs_x.empty()) return s;
+  for (const Index d : tool.value_dofs_x)
+    for (int c = 0; c < 3; ++c) {
+      s.displacement[c] += x[d + c] - X[d + c];
+      if (reactions.size() > 0) s.force[c] += reactions[d + c];
+    }
+  s.displacement /= static_cast<double>(tool.value_dofs_x.size());
+  return s;
+}
+
+// Position and deformation gradient of brick e of a body at xi.
+struct PointState {
+  Vec3 X, x;
+  Mat3 F;
+};
+
+PointState evaluate_point(const BrickParams& Xe, const BrickParams& xe, const Vec3& xi) {
+  const basis::BrickValues v = basis::BicubicHermiteLinear::evaluate(xi, basis::kValues | basis::kFirst);
+  PointState s;
+  s.X = Xe.transpose() * v.value;
+  s.x = xe.transpose() * v.value;
+  const Mat3 G = Xe.transpose() * v.first;
+  const Mat3 g = xe.transpose() * v.first;
+  s.F = g * G.inverse();
+  return s;
+}
+
+io::VolumeMesh tessellate(const FormingCase& spec, const Model& model, const VecX& x) {
+  const int ns = spec.output.samples_inplane, nt = spec.output.samples_thickness;
+  io::VolumeMesh mesh;
+  std::vector<Vec3> points;
+  std::vector<double> disp, stress, fibre, stretch, body_id;
+  for (int b = 0; b < model.n_bodies(); ++b) {
+    const PlyMesh& ply = model.ply(b);
+    const Material& material = model.material(b);
+    const Vec3 a0 = ply.fibre_direction();
+    const MatX xb = PlyMesh::unflatten(x.segment(model.offset(b), ply.n_dofs()));
+    for (Index e = 0; e < ply.n_elements(); ++e) {
+      const BrickParams Xe = ply.element_parameters(e, ply.reference());
+      const BrickParams xe = ply.element_parameters(e, xb);
+      const Index first = static_cast<Index>(points.size());
+      for (int k = 0; k <= nt; ++k)
+        for (int j = 0; j <= ns; ++j)
+          for (int i = 0; i <= ns; ++i) {
+            const PointState s = evaluate_point(Xe, xe, Vec3(double(i) / ns, double(j) / ns, double(k) / nt));
+            points.push_back(s.x);
+            for (int c = 0; c < 3; ++c) disp.push_back(s.x[c] - s.X[c]);
+          }
+      auto pid = [&](int i, int j, int k) { return first + (static_cast<Index>(k) * (ns + 1) + j) * (ns + 1) + i; };
+      for (int k = 0; k < nt; ++k)
+        for (int j = 0; j < ns; ++j)
+          for (int i = 0; i < ns; ++i) {
+            mesh.add_cell(io::CellType::kHexahedron,
+                          {pid(i, j, k), pid(i + 1, j, k), pid(i + 1, j + 1, k), pid(i, j + 1, k),
+                           pid(i, j, k + 1), pid(i + 1, j, k + 1), pid(i + 1, j + 1, k + 1), pid(i, j + 1, k + 1)});
+            const Vec3 xi((i + 0.5) / ns, (j + 0.5) / ns, (k + 0.5) / nt);
+            const PointState s = evaluate_point(Xe, xe, xi);
+            const Mat3 C = s.F.transpose() * s.F;
+            Mat3 sigma = Mat3::Constant(std::nan(""));
+            if (s.F.determinant() > 0.0) sigma = cauchy_stress(s.F, material.evaluate(C, false).stress);
+            const Vec6 v = voigt_stress(sigma);
+            for (int c = 0; c < 6; ++c) stress.push_back(v[c]);
+            const Vec3 a = s.F * a0;
+            const double lam = a.norm();
+            for (int c = 0; c < 3; ++c) fibre.push_back(lam > 0.0 ? a[c] / lam : 0.0);
+            stretch.push_back(lam);
+            body_id.push_back(b);
+          }
+    }
+  }
+  mesh.points.resize(static_cast<Index>(points.size()), 3);
+  for (std::size_t p = 0; p < points.size(); ++p) mesh.points.row(static_cast<Index>(p)) = points[p].transpose();
+  mesh.point_data.push_back({"displacement", 3, std::move(disp)});
+  mesh.cell_data.push_back({"cauchy_stress", 6, std::move(stress)});
+  mesh.cell_data.push_back({"fibre_direction", 3, std::move(fibre)});
+  mesh.cell_data.push_back({"fibre_stretch", 1, std::move(stretch)});
+  mesh.cell_data.push_back({"ply", 1, std::move(body_id)});
+  return mesh;
+}
+
+// n x n marks on the top face of body b, reference and deformed.
+void write_grid(const std::string& path, const FormingCase& spec, const Model& model, int b, const VecX& x, int n) {
+  const CasePly& p = spec.plies[static_cast<std::size_t>(b)];
+  const PlyMesh& ply = model.ply(b);
+  const MatX xb = PlyMesh::unflatten(x.segment(model.offset(b), ply.n_dofs()));
+  io::write_file_atomic(path, [&](std::ostream& out) {
+    out << "# simform --grid-out: " << n << " x " << n << " marks on the top face of ply '" << p.name
+        << "' (case " << spec.file << "), mm\n";
+    io::CsvWriter w(out, {"id", "X", "Y", "Z", "x", "y", "z", "i", "j"});
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double u = double(i) / (n - 1) * p.n1, v = double(j) / (n - 1) * p.n2;
+        const int ie = std::min(static_cast<int>(u), p.n1 - 1), je = std::min(static_cast<int>(v), p.n2 - 1);
+        const Index e = static_cast<Index>(je) * p.n1 + ie;
+        const PointState s = evaluate_point(ply.element_parameters(e, ply.reference()), ply.element_parameters(e, xb),
+                                            Vec3(u - ie, v - je, 1.0));
+        w.begin_row().add("m" + std::to_string(i) + "_" + std::to_string(j));
+        for (int c = 0; c < 3; ++c) w.add(s.X[c]);
+        for (int c = 0; c < 3; ++c) w.add(s.x[c]);
+        w.add(i).add(j).end_row();
+      }
+  });
+}
+
+nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
+  nlohmann::json j;
+  j["units"] = spec.units;
+  for (const CaseMaterial& m : spec.materials) {
+    nlohmann::json mj{{"name", m.name}, {"given_as", m.given_as}};
+    if (m.kind == CaseMaterial::Kind::kNeoHookean) {
+      mj["law"] = "neo_hookean";
+      mj["mu"] = m.neo_hookean.mu;
+      mj["lambda"] = m.neo_hookean.lambda;
+    } else {
+      const TransverselyIsotropicModuli mod = small_strain_moduli(m.ti);
+      mj["law"] = "transversely_isotropic (compressible)";
+      mj["mu_T"] = m.ti.mu_T;
+      mj["mu_L"] = m.ti.mu_L;
+      mj["kappa_f"] = m.ti.kappa_f;
+      mj["lambda"] = m.ti.lambda;
+      mj["small_strain"] = {{"E_L", mod.E_L}, {"E_T", mod.E_T}, {"G_L", mod.G_L},
+                            {"G_T", mod.G_T}, {"nu_LT", mod.nu_LT}, {"nu_TT", mod.nu_TT}};
+    }
+    j["materials"].push_back(mj);
+  }
+  for (std::size_t b = 0; b < spec.plies.size(); ++b) {
+    const CasePly& p = spec.plies[b];
+    const Vec3 a0 = model.ply(static_cast<int>(b)).fibre_direction();
+    j["plies"].push_back({{"name", p.name},
+                          {"origin", {p.origin.x(), p.origin.y(), p.origin.z()}},
+                          {"size", {p.length_x, p.length_y}},
+                          {"thickness", p.thickness},
+                          {"elements", {p.n1, p.n2}},
+                          {"angle", p.angle_deg},
+                          {"fibre_direction", {a0.x(), a0.y(), a0.z()}},
+                          {"material", p.material}});
+  }
+  for (const CaseBoundary& bc : spec.boundaries) {
+    nlohmann::json bj{{"kind", to_string(bc.kind)}, {"ply", bc.ply}, {"side", to_string(bc.side)}};
+    if (bc.kind == CaseBoundary::Kind::kDisplacement) {
+      for (const auto& v : bc.value) bj["value"].push_back(v ? nlohmann::json(*v) : nlohmann::json());
+      bj["ramp"] = to_string(bc.ramp);
+    }
+    j["boundary_conditions"].push_back(bj);
+  }
+  j["solver"] = {{"steps", spec.solver.steps},
+                 {"max_iterations", spec.solver.max_iterations},
+                 {"tolerance", spec.solver.tolerance},
+                 {"line_search", spec.solver.line_search},
+                 {"min_increment", spec.solver.min_increment}};
+  j["output"] = {{"every", spec.output.every},
+                 {"samples", {spec.output.samples_inplane, spec.output.samples_thickness}}};
+  j["model"] = {{"dofs", model.n_dofs()},
+                {"element", "ply brick: bicubic Hermite in-plane x linear through the thickness"},
+                {"quadrature", {model.rule().n_inplane, model.rule().n_inplane, model.rule().n_thickness}}};
+  return j;
+}
+
+std::string step_name(int k) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "steps/step_%04d.vtu", k);
+  return buf;
+}
+
+}  // namespace
+
+void RunOptions::validate() const {
+  if (out_dir.empty()) throw UsageError("--out: an output folder is required");
+  if (grid_marks < 2) throw UsageError("--grid-marks: expected at least 2, found " + std::to_string(grid_marks));
+}
+
+std::string RunReport::brief() const {
+  std::ostringstream os;
+  if (ok())
+    os << "converged: " << steps_converged << " steps, " << total_iterations << " Newton iterations, |r| "
+       << sci(final_residual) << " N";
+  else
+    os << "not converged: " << message;
+  return os.str();
+}
+
+Model build_model(const FormingCase& spec) {
+  Model model;
+  for (const CasePly& p : spec.plies) {
+    mesh::SurfaceMesh s =
+        mesh::make_rectangle_mesh(p.origin, Vec3::UnitX(), Vec3::UnitY(), p.length_x, p.length_y, p.n1, p.n2);
+    PlyMesh ply(std::move(s), p.thickness, p.angle_deg, PlyPlacement::kBottom);
+    const CaseMaterial& m = spec.materials.at(static_cast<std::size_t>(p.material_index));
+    std::shared_ptr<const Material> law;
+    if (m.kind == CaseMaterial::Kind::kNeoHookean)
+      law = std::make_shared<NeoHookean>(m.neo_hookean);
+    else
+      law = std::make_shared<TransverselyIsotropic>(m.ti, ply.fibre_direction());
+    model.add_ply(std::move(ply), std::move(law));
+  }
+  return model;
+}
+
+std::vector<PrescribedDof> prescribed_at(const FormingCase& spec, const Model& model, double lambda) {
+  return targets(prescriptions(spec, model), lambda);
+}
+
+RunReport run_case(const FormingCase& spec, const RunOptions& options) {
+  options.validate();
+  const Clock::time_point t_start = Clock::now();
+  int grid_body = 0;
+  if (!options.grid_ply.empty()) {
+    grid_body = spec.find_ply(options.grid_ply);
+    if (grid_body < 0) throw UsageError("--grid-ply: no ply named '" + options.grid_ply + "' in " + spec.file);
+  }
+
+  const Model model = build_model(spec);
+  const std::vector<Prescription> prescribed = prescriptions(spec, model);
+  const Tool tool = find_tool(spec, model);
+  const VecX X = model.reference_positions();
+  const double t_build = seconds_since(t_start);
+
+  StaticOptions so;
+  so.max_iterations = spec.solver.max_iterations;
+  so.residual_tol_rel = spec.solver.tolerance;
+  so.line_search = spec.solver.line_search;
+  so.min_increment = spec.solver.min_increment;
+  so.validate();
+
+  io::AtomicOutputDir out(options.out_dir);
+  std::vector<std::pair<double, std::string>> frames;
+  double t_write = 0.0, t_solve = 0.0;
+  auto write_frame = [&](int k, double lambda, const VecX& x) {
+    const Clock::time_point t0 = Clock::now();
+    io::write_vtu(out.path(step_name(k)), tessellate(spec, model, x));
+    frames.emplace_back(lambda, step_name(k));
+    t_write += seconds_since(t0);
+  };
+
+  std::ostringstream history;
+  io::CsvWriter h(history, {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy", "tool_fz",
+                            "strain_energy", "newton_iterations", "cutbacks", "residual"});
+  auto history_row = [&](int k, double lambda, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
+                         double residual) {
+    const ToolState ts = tool_state(tool, x, X, reactions);
+    const Assembly a = model.assemble(x, false);
+    h.begin_row().add(k).add(lambda);
+    for (int c = 0; c < 3; ++c) h.add(ts.displacement[c]);
+    for (int c = 0; c < 3; ++c) h.add(ts.force[c]);
+    h.add(a.energy).add(iterations).add(cutbacks).add(residual).end_row();
+    return ts;
+  };
+
+  VecX x = X;
+  history_row(0, 0.0, x, VecX::Zero(model.n_dofs()), 0, 0, 0.0);
+  write_frame(0, 0.0, x);
+
+  RunReport report;
+  report.status = RunReport::Status::kConverged;
+  const int n_steps = spec.solver.steps;
+  int last_written = 0;
+  for (int k = 1; k <= n_steps; ++k) {
+    const double lambda = double(k) / n_steps;
+    const Clock::time_point t0 = Clock::now();
+    const StaticResult r = solve_static(model, x, targets(prescribed, lambda), VecX(), so);
+    t_solve += seconds_since(t0);
+    report.total_iterations += r.report.total_iterations;
+    if (!r.report.ok()) {
+      report.status = RunReport::Status::kNotConverged;
+      std::ostringstream os;
+      os << "step " << k << " of " << n_steps << " (load factor " << lambda << ") did not converge: "
+         << r.report.message << "; results up to step " << (k - 1)
+         << " are written. Try more steps, a larger max_iterations or a smaller min_increment";
+      report.message = os.str();
+      cli::status(options.quiet, "simform: step " + std::to_string(k) + " failed: " + r.report.message);
+      break;
+    }
+    x = r.positions;
+    double residual = 0.0;
+    for (auto it = r.report.steps.rbegin(); it != r.report.steps.rend(); ++it)
+      if (it->converged && !it->residual_norms.empty()) {
+        residual = it->residual_norms.back();
+        break;
+      }
+    const ToolState ts = history_row(k, lambda, x, r.reactions, r.report.total_iterations, r.report.n_cutbacks,
+                                     residual);
+    report.steps_converged = k;
+    report.load_factor = lambda;
+    report.final_residual = residual;
+    report.tool_displacement = ts.displacement;
+    report.tool_force = ts.force;
+    std::ostringstream os;
+    os << "simform: step " << k << "/" << n_steps << "  load factor " << lambda << "  Newton "
+       << r.report.total_iterations << (r.report.n_cutbacks ? " (" + std::to_string(r.report.n_cutbacks) + " cut-backs)" : "")
+       << "  |r| " << sci(residual) << " N";
+    cli::status(options.quiet, os.str());
+    if (k % spec.output.every == 0 || k == n_steps) {
+      write_frame(k, lambda, x);
+      last_written = k;
+    }
+  }
+  if (!report.ok() && report.steps_converged > last_written) write_frame(report.steps_converged, report.load_factor, x);
+
+  const Clock::time_point t_out = Clock::now();
+  io::write_pvd(out.path("result.pvd"), frames);
+  io::write_file_atomic(out.path("history.csv"), history.str());
+  // The grid file is written after the folder is committed (it may lie inside it).
+  const bool write_grid_file = !options.grid_out.empty() && report.ok();
+  if (!options.grid_out.empty() && !report.ok())
+    cli::status(options.quiet, "simform: not writing " + options.grid_out + " (the run did not converge)");
+  const std::string grid_note = write_grid_file ? options.grid_out : std::string();
+  t_write += seconds_since(t_out);
+  report.seconds = seconds_since(t_start);
+
+  nlohmann::json j;
+  j["tool"] = "simform run";
+  j["version"] = SF_VERSION;
+  j["command_line"] = options.command_line;
+  j["inputs"] = {{"case", spec.file}};
+  j["parameters"] = parameters_json(spec, model);
+  j["analysis"] = "quasi-static (no contact, no dynamics, no exact constraints)";
+  j["status"] = report.ok() ? "converged" : "not_converged";
+  j["message"] = report.ok() ? report.brief() : report.message;
+  j["steps"] = {{"requested", n_steps}, {"converged", report.steps_converged}, {"written", frames.size()}};
+  j["load_factor"] = report.load_factor;
+  j["final_residual"] = report.final_residual;
+  j["newton_iterations"] = report.total_iterations;
+  j["tool_edge"] = {{"edge", tool.label},
+               {"displacement", {report.tool_displacement.x(), report.tool_displacement.y(), report.tool_displacement.z()}},
+               {"force", {report.tool_force.x(), report.tool_force.y(), report.tool_force.z()}}};
+  j["timings_s"] = {{"build", t_build}, {"solve", t_solve}, {"write", t_write}, {"total", report.seconds}};
+  nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json"};
+  for (const auto& f : frames) outputs.push_back(f.second);
+  j["outputs"] = outputs;
+  j["grid_out"] = grid_note.empty() ? nlohmann::json() : nlohmann::json(grid_note);
+  j["units"] = {{"length", "mm"}, {"force", "N"}, {"stress", "MPa"}, {"energy", "N mm"}, {"note", spec.units}};
+  io::write_json(out.path("summary.json"), j);
+  out.commit();
+  if (write_grid_file) {
+    const std::filesystem::path parent = std::filesystem::path(options.grid_out).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    if (ec) throw Error(options.grid_out + ": cannot create folder " + parent.string() + " (" + ec.message() + ")");
+    write_grid(options.grid_out, spec, model, grid_body, x, options.grid_marks);
+  }
+  return report;
+}
+
+}  // namespace sf::forming

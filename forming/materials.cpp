@@ -10,7 +10,6 @@
 namespace sf::forming {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Voigt index pairs (11, 22, 33, 12, 23, 13).
 constexpr int kVoigtPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
 

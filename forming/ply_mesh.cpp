@@ -11,7 +11,6 @@
 namespace sf::forming {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Flatness of a surface, relative to its size (coordinates of O(size) built in floating point).
 constexpr double kFlatRel = 1e-9;
 

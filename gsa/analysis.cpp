@@ -12,6 +12,7 @@
 #include "common/mesh/projection.hpp"
 #include "common/quadrature/gauss.hpp"
 #include "gsa/mesh_file.hpp"
+#include "gsa/plane.hpp"
 
 namespace sf::gsa {
 
@@ -40,43 +41,6 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-struct Frame {
-  Vec3 centroid, a1, a2, normal;
-  double spread1 = 0, spread2 = 0, spread_normal = 0;
-};
-
-// Best-fit plane of the rows of `pts` (PCA), axes oriented towards +X / +Z.
-Frame best_fit_plane(const Points3& pts) {
-  Frame f;
-  f.centroid = pts.colwise().mean().transpose();
-  const MatX c = pts.rowwise() - f.centroid.transpose();
-  const Mat3 cov = (c.transpose() * c) / static_cast<double>(pts.rows());
-  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
-  f.a1 = es.eigenvectors().col(2);
-  f.a2 = es.eigenvectors().col(1);
-  f.spread1 = std::sqrt(std::max(0.0, es.eigenvalues()[2]));
-  f.spread2 = std::sqrt(std::max(0.0, es.eigenvalues()[1]));
-  f.spread_normal = std::sqrt(std::max(0.0, es.eigenvalues()[0]));
-  // In-plane axes: for a clearly elongated part (a strip) the long axis; otherwise
-  // (near-square or round parts, where PCA axes are arbitrary) the X axis projected
-  // onto the plane, so the mesh lines up with the marks. a1 towards +X, normal towards +Z.
-  f.normal = f.a1.cross(f.a2).normalized();
-  if (f.spread1 < 1.5 * f.spread2) {
-    Vec3 x = Vec3::UnitX() - Vec3::UnitX().dot(f.normal) * f.normal;
-    if (x.norm() < 0.3) x = Vec3::UnitY() - Vec3::UnitY().dot(f.normal) * f.normal;
-    f.a1 = x.normalized();
-  }
-  const Vec3 ref = std::abs(f.a1.x()) > 1e-3 ? Vec3::UnitX() : Vec3::UnitY();
-  if (f.a1.dot(ref) < 0) f.a1 = -f.a1;
-  f.a2 = f.normal.cross(f.a1).normalized();
-  f.normal = f.a1.cross(f.a2);
-  if (f.normal.z() < 0 || (std::abs(f.normal.z()) < 1e-12 && f.normal.y() < 0)) {
-    f.a2 = -f.a2;
-    f.normal = -f.normal;
-  }
-  return f;
-}
-
 // Marks per element: ~9 for a few hundred marks, growing slowly for dense grids
 // (fit-feasibility study: 21x21 marks -> 6-9 elements a side; 1e5 marks -> 20-50).
 void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int& n2) {
@@ -91,11 +55,15 @@ void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int
 // Marks whose residual exceeds max(k * robust sigma, floor) and at least half the
 // largest such residual (the worst ones of this round). Robust sigma: the median
 // residual norm / 1.54 (median of a 3-D Gaussian vector's norm is 1.54 sigma).
-std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, double k, double floor) {
+double outlier_threshold(const VecX& residual, const VecX& weight, double k, double floor) {
   std::vector<double> r;
   for (Index i = 0; i < residual.size(); ++i)
     if (weight[i] > 0) r.push_back(residual[i]);
-  const double threshold = std::max(k * median(r) / 1.54, floor);
+  return std::max(k * median(r) / 1.54, floor);
+}
+
+std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, double k, double floor) {
+  const double threshold = outlier_threshold(residual, weight, k, floor);
   double worst = 0.0;
   for (Index i = 0; i < residual.size(); ++i)
     if (weight[i] > 0 && residual[i] > threshold) worst = std::max(worst, residual[i]);
@@ -144,7 +112,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
 
   // --- Frame and automatic mesh.
   auto t0 = Clock::now();
-  const Frame frame = best_fit_plane(X);
+  const PlaneFrame frame = best_fit_plane(X);
   if (!(frame.spread2 > 1e-6 * frame.spread1))
     throw InputError(grid.sources.front() +
                      ": the undeformed points lie on a line (or coincide); a surface cannot be fitted");
@@ -372,10 +340,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   {
     // Readmit flagged marks that the final surface fits well (good neighbours of a
     // bad mark can exceed the threshold while the bad mark still pulls the fit).
-    std::vector<double> r;
-    for (Index k = 0; k < m; ++k)
-      if (w_d[k] > 0) r.push_back(fit_d.residual[k]);
-    const double threshold = std::max(options.outlier_sigma * median(r) / 1.54, 0.02 * d);
+    const double threshold = outlier_threshold(fit_d.residual, w_d, options.outlier_sigma, 0.02 * d);
     bool readmitted = false;
     for (Index k = 0; k < m; ++k)
       if (res.points[used[k]].status == kStatusOutlierDeformed && fit_d.residual[k] < threshold) {
@@ -416,14 +381,10 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       continue;
     }
     if (options.fibre_angles.size() == 2) {
-      for (double angle : options.fibre_angles) {
-        const auto a0 = tangent_at_angle(pu.dx, Vec3::UnitX(), angle);
-        const auto fs = a0 ? fibre_state(pu.dx, pd.dx, *a0) : std::nullopt;
+      const FibrePair fp = fibre_pair(pu.dx, pd.dx, options.fibre_angles[0], options.fibre_angles[1]);
+      for (const auto& fs : fp.state)
         pr.fibres.push_back(fs ? FibreResult{fs->direction_deformed, fs->stretch} : FibreResult{});
-      }
-      const double initial = std::abs(options.fibre_angles[1] - options.fibre_angles[0]);
-      const double c = std::clamp(pr.fibres[0].direction.dot(pr.fibres[1].direction), -1.0, 1.0);
-      pr.shear_angle_deg = initial - std::acos(c) * 180.0 / 3.14159265358979323846;
+      pr.shear_angle_deg = fp.shear_angle_deg;
     }
   }
   res.times.strain = seconds_since(ts);

@@ -207,20 +207,13 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, const A
           // Fibre directions (undeformed or deformed surface), stretches and shear angle.
           Vec3 a[2] = {Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
           double st[2] = {kNaN, kNaN};
-          std::optional<FibreState> fs[2];
+          const FibrePair fp = fibre_pair(pu.dx, pd.dx, options.fibre_angles[0], options.fibre_angles[1]);
           for (int k = 0; k < 2; ++k) {
-            const auto a0 = tangent_at_angle(pu.dx, Vec3::UnitX(), options.fibre_angles[k]);
-            if (a0) fs[k] = fibre_state(pu.dx, pd.dx, *a0);
-            if (fs[k]) {
-              a[k] = deformed ? fs[k]->direction_deformed : *a0;
-              st[k] = fs[k]->stretch;
-            }
+            if (!fp.state[k]) continue;
+            a[k] = deformed ? fp.state[k]->direction_deformed : *fp.undeformed[k];
+            st[k] = fp.state[k]->stretch;
           }
-          double ang = kNaN;
-          if (fs[0] && fs[1])
-            ang = std::abs(options.fibre_angles[1] - options.fibre_angles[0]) -
-                  std::acos(std::clamp(fs[0]->direction_deformed.dot(fs[1]->direction_deformed), -1.0, 1.0)) *
-                      180.0 / 3.14159265358979323846;
+          const double ang = fp.shear_angle_deg;
           for (int c = 0; c < 3; ++c) {
             f1.values.push_back(a[0][c]);
             f2.values.push_back(a[1][c]);

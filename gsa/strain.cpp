@@ -1,6 +1,7 @@
 #include "gsa/strain.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 namespace sf::gsa {
@@ -50,8 +51,25 @@ std::optional<Vec3> tangent_at_angle(const Mat32& G, const Vec3& reference_axis,
   if (e1.norm() < 0.1 * reference_axis.norm()) e1 = G.col(0);
   e1.normalize();
   const Vec3 e2 = nn.cross(e1);
-  const double a = angle_deg * 3.14159265358979323846 / 180.0;
+  const double a = angle_deg * kPi / 180.0;
   return (std::cos(a) * e1 + std::sin(a) * e2).normalized();
+}
+
+double trellis_shear_deg(double initial_deg, const Vec3& d0, const Vec3& d1) {
+  return initial_deg - std::acos(std::clamp(d0.dot(d1), -1.0, 1.0)) * 180.0 / kPi;
+}
+
+FibrePair fibre_pair(const Mat32& G, const Mat32& g, double angle0_deg, double angle1_deg) {
+  FibrePair out;
+  const double angles[2] = {angle0_deg, angle1_deg};
+  for (int k = 0; k < 2; ++k) {
+    out.undeformed[k] = tangent_at_angle(G, Vec3::UnitX(), angles[k]);
+    if (out.undeformed[k]) out.state[k] = fibre_state(G, g, *out.undeformed[k]);
+  }
+  if (out.state[0] && out.state[1])
+    out.shear_angle_deg = trellis_shear_deg(std::abs(angle1_deg - angle0_deg), out.state[0]->direction_deformed,
+                                            out.state[1]->direction_deformed);
+  return out;
 }
 
 }  // namespace sf::gsa

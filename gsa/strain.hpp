@@ -12,6 +12,7 @@
 //   Thickness stretch (incompressible sheet) lambda3 = 1/(lambda1 lambda2);
 //   thickness change in percent 100 (lambda3 - 1).
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -41,6 +42,20 @@ struct FibreState {
   double stretch = 1.0;     // |F a0|
 };
 std::optional<FibreState> fibre_state(const Mat32& G, const Mat32& g, const Vec3& a0);
+
+// Trellis shear angle (degrees) of two fibre families that started `initial_deg`
+// apart and now point along the unit vectors d0, d1: initial minus current angle.
+double trellis_shear_deg(double initial_deg, const Vec3& d0, const Vec3& d1);
+
+// Both fibre families at one point (angles in degrees on the undeformed sheet,
+// from the X axis, see tangent_at_angle): their undeformed directions, deformed
+// states and the trellis shear angle (NaN unless both families are defined).
+struct FibrePair {
+  std::optional<Vec3> undeformed[2];
+  std::optional<FibreState> state[2];
+  double shear_angle_deg = std::numeric_limits<double>::quiet_NaN();
+};
+FibrePair fibre_pair(const Mat32& G, const Mat32& g, double angle0_deg, double angle1_deg);
 
 // Unit tangent at angle `angle_deg` from the reference axis projected on the
 // tangent plane of G (anticlockwise about the normal G1 x G2). Falls back to G1's

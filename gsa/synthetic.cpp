@@ -11,7 +11,6 @@
 namespace sf::gsa {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Rigid motion: rotation about an oblique axis plus translation.
 Mat3 rotation() {

@@ -11,6 +11,7 @@
 
 #include "common/core/error.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/plane.hpp"
 
 namespace sf::gsa {
 
@@ -44,10 +45,9 @@ std::vector<std::array<Index, 3>> grid_triangles(const GridData& g, const std::v
 std::vector<std::array<Index, 3>> delaunay_triangles(const GridData& g, const std::vector<Index>& usable) {
   Points3 pts(static_cast<Index>(usable.size()), 3);
   for (std::size_t k = 0; k < usable.size(); ++k) pts.row(static_cast<Index>(k)) = g.undeformed.row(usable[k]);
-  const Vec3 c = pts.colwise().mean().transpose();
-  const MatX d = pts.rowwise() - c.transpose();
-  Eigen::SelfAdjointEigenSolver<Mat3> es((d.transpose() * d).eval());
-  const Vec3 a1 = es.eigenvectors().col(2), a2 = es.eigenvectors().col(1);
+  const PlaneFrame frame = best_fit_plane(pts);
+  const Vec3& c = frame.centroid;
+  const Vec3 &a1 = frame.a1, &a2 = frame.a2;
   std::vector<std::pair<Kernel::Point_2, Index>> in;
   in.reserve(usable.size());
   for (std::size_t k = 0; k < usable.size(); ++k) {
@@ -158,9 +158,8 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
         Vec3 a = a0 ? Vec3(F * *a0) : Vec3::Zero();
         pr.fibres.push_back(FibreResult{a.normalized(), a.norm()});
       }
-      pr.shear_angle_deg = std::abs(options.fibre_angles[1] - options.fibre_angles[0]) -
-                           std::acos(std::clamp(pr.fibres[0].direction.dot(pr.fibres[1].direction), -1.0, 1.0)) *
-                               180.0 / 3.14159265358979323846;
+      pr.shear_angle_deg = trellis_shear_deg(std::abs(options.fibre_angles[1] - options.fibre_angles[0]),
+                                             pr.fibres[0].direction, pr.fibres[1].direction);
     }
   }
   r.times.strain = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -18,4 +18,6 @@ using MatX = Eigen::MatrixXd;
 // Row-major n x 3 point arrays (one point per row, same layout as a CSV file).
 using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
+inline constexpr double kPi = 3.14159265358979323846;
+
 }  // namespace sf

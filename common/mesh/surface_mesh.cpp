@@ -262,7 +262,7 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
   check_frame(a1, a2);
   if (n_rings < 1 || n_sectors < 3 || !(radius > 0))
     throw std::invalid_argument("make_disk_mesh: need radius > 0, n_rings >= 1, n_sectors >= 3");
-  const double pi = 3.14159265358979323846;
+  const double pi = kPi;
   const double dtheta = 2.0 * pi / n_sectors;
   const double dr = radius / n_rings;
   SurfaceMesh mesh;
@@ -406,7 +406,7 @@ SurfaceMesh mesh_from_corners(const Points3& nodes, const std::vector<std::array
       const Vec3 r0 = p(2) - p(0), r1 = p(3) - p(0);
       double th0 = std::atan2(r0.dot(t2), r0.dot(t1)), th1 = std::atan2(r1.dot(t2), r1.dot(t1));
       // Going from edge 0-2 to edge 1-3 by the short way round.
-      const double pi = 3.14159265358979323846;
+      const double pi = kPi;
       while (th1 - th0 > pi) th1 -= 2 * pi;
       while (th1 - th0 < -pi) th1 += 2 * pi;
       el.apex_angle = {th0, th1};

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/core/types.hpp"
+
 namespace sf::quadrature {
 
 Rule1D gauss_legendre(int n) {
@@ -11,7 +13,7 @@ Rule1D gauss_legendre(int n) {
   Rule1D rule;
   rule.points.resize(n);
   rule.weights.resize(n);
-  const double pi = 3.14159265358979323846;
+  const double pi = sf::kPi;
   // Roots of P_n on [-1,1] by Newton from Chebyshev-like guesses, then map to [0,1].
   for (int i = 0; i < (n + 1) / 2; ++i) {
     double x = std::cos(pi * (i + 0.75) / (n + 0.5));

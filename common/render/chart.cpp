@@ -7,7 +7,6 @@ namespace sf::render {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 const Colour kInk{0.15, 0.15, 0.15};
 
 // Liang-Barsky: clips segment p-q to the rectangle; false when nothing is left.

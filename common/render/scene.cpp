@@ -45,7 +45,6 @@ namespace sf::render {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kSupersample = 2;      // render at twice the size and average
 constexpr int kMaxRenderSide = 4096;  // ... unless that exceeds this many pixels
 const Colour kDark{0.15, 0.15, 0.15};

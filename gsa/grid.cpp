@@ -60,6 +60,20 @@ void read_ij(const io::CsvTable& t, const GridReadOptions& o, GridData& g, std::
   g.j[p] = t.integer(row, *cj);
 }
 
+// Reads row r's id and records it in `seen` (id -> row); empty or repeated ids
+// are input errors naming the file, line and column (and the first occurrence).
+std::string take_id(const io::CsvTable& t, std::size_t r, std::size_t col,
+                    std::unordered_map<std::string, std::size_t>& seen) {
+  std::string id(t.cell(r, col));
+  if (id.empty()) throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, col), "empty id"));
+  auto [it, fresh] = seen.emplace(id, r);
+  if (!fresh)
+    throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, col),
+                                     "duplicate id '" + id + "' (first at line " + std::to_string(t.line(it->second)) +
+                                         "); ids must be unique"));
+  return id;
+}
+
 }  // namespace
 
 std::map<std::string, std::string> parse_column_map(const std::string& text) {
@@ -115,14 +129,7 @@ GridData read_grid(const std::string& path, const GridReadOptions& options) {
   bool first = true;
   for (std::size_t r = 0; r < n; ++r) {
     const Index p = static_cast<Index>(r);
-    g.ids[r] = std::string(t.cell(r, cid));
-    if (g.ids[r].empty())
-      throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, cid), "empty id"));
-    auto [it, fresh] = seen.emplace(g.ids[r], r);
-    if (!fresh)
-      throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, cid),
-                                       "duplicate id '" + g.ids[r] + "' (first at line " +
-                                           std::to_string(t.line(it->second)) + "); ids must be unique"));
+    g.ids[r] = take_id(t, r, cid, seen);
     read_xyz(t, r, cu, g.undeformed.row(p).data());
     read_xyz(t, r, cd, g.deformed.row(p).data());
     if (displacement) g.deformed.row(p) += g.undeformed.row(p);
@@ -158,24 +165,14 @@ GridData read_grid_pair(const std::string& undeformed_path, const std::string& d
   bool first = true;
   for (std::size_t r = 0; r < n; ++r) {
     const Index p = static_cast<Index>(r);
-    g.ids[r] = std::string(tu.cell(r, uid));
-    if (g.ids[r].empty())
-      throw InputError(located_message(tu.file_name(), tu.line(r), tu.char_column(r, uid), "empty id"));
-    auto [it, fresh] = index.emplace(g.ids[r], r);
-    if (!fresh)
-      throw InputError(located_message(tu.file_name(), tu.line(r), tu.char_column(r, uid),
-                                       "duplicate id '" + g.ids[r] + "' (first at line " +
-                                           std::to_string(tu.line(it->second)) + ")"));
+    g.ids[r] = take_id(tu, r, uid, index);
     read_xyz(tu, r, cu, g.undeformed.row(p).data());
     read_ij(tu, options, g, r, p, first);
     g.where[r] = where_of(tu, r);
   }
-  std::set<std::string> seen_deformed;
+  std::unordered_map<std::string, std::size_t> seen_deformed;
   for (std::size_t r = 0; r < td.n_rows(); ++r) {
-    const std::string id(td.cell(r, did));
-    if (!seen_deformed.insert(id).second)
-      throw InputError(located_message(td.file_name(), td.line(r), td.char_column(r, did),
-                                       "duplicate id '" + id + "'"));
+    const std::string id = take_id(td, r, did, seen_deformed);
     auto it = index.find(id);
     if (it == index.end())
       throw InputError(located_message(td.file_name(), td.line(r), td.char_column(r, did),

@@ -2,6 +2,7 @@
 // triangle method, on the analytic cases of gsa/synthetic.hpp (21 x 21 marks at
 // 5 mm). Prints RMS errors of the Green strains at interior marks.
 //   build/bin/gsa_accuracy_bench [seeds=3] [smoothing_scale=1] [third|sobolev|jumps]
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -18,10 +19,10 @@ int main(int argc, char** argv) {
   const char* cases[] = {"rigid", "stretch", "shear", "cylinder", "dome", "wavy", "trellis"};
   const double noises[] = {0.0, 0.01, 0.03};
   std::printf("%-9s %6s  %12s %12s %12s  %7s  %s\n", "case", "noise", "surface_rms", "triangle_rms", "surf_border3",
-              "ratio", "gauge/spacing");
+              "ratio", "gauge/spacing  gcv_lg(delta/d^6)  noise_rule_lg");
   for (const char* name : cases) {
     for (double noise : noises) {
-      double s = 0, t = 0, s3 = 0, gauge = 0;
+      double s = 0, t = 0, s3 = 0, gauge = 0, gcv = 0, rule = 0;
       const int ns = noise > 0 ? seeds : 1;
       for (int seed = 1; seed <= ns; ++seed) {
         SyntheticGridOptions go;
@@ -42,12 +43,14 @@ int main(int argc, char** argv) {
         t += strain_error(g, rt, exact).rms();
         s3 += strain_error(g, rs, exact, 3).rms();
         gauge += rs.gauge_length / rs.mark_spacing;
+        gcv += rs.gcv_log10_delta;
+        rule += std::log10(2e4 * std::max(rs.noise_estimate / rs.mark_spacing, 1e-6));
       }
       s /= ns;
       t /= ns;
       s3 /= ns;
-      std::printf("%-9s %6.3f  %12.3e %12.3e %12.3e  %7.3f  %.2f\n", name, noise, s, t, s3, t > 0 ? s / t : 0.0,
-                  gauge / ns);
+      std::printf("%-9s %6.3f  %12.3e %12.3e %12.3e  %7.3f  %.2f  %6.2f %6.2f\n", name, noise, s, t, s3,
+                  t > 0 ? s / t : 0.0, gauge / ns, gcv / ns, rule / ns);
     }
   }
   return 0;

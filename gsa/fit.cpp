@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "common/basis/hermite.hpp"
@@ -145,19 +146,27 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
 
 linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
                                         const std::vector<MeshLocation>& locations) {
+  // Row d = b(xi_d)^T T_e (the element's 16 local functions mapped to its global
+  // dofs), written straight into row-major storage: one row per point, in order.
   const Index n_points = static_cast<Index>(locations.size());
-  linalg::TripletAssembler phi(n_points, mesh.n_dofs());
-  phi.reserve(n_points * 16);
-  std::vector<mesh::ElementMap> maps(mesh.n_elements());
-  for (Index e = 0; e < mesh.n_elements(); ++e) maps[e] = mesh.element_map(e);
+  std::vector<fe::ElementDofMap> maps(mesh.n_elements());
+  for (Index e = 0; e < mesh.n_elements(); ++e) maps[e] = fe::element_dof_map(mesh.element_map(e));
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows(n_points, mesh.n_dofs());
+  Eigen::VectorXi per_row(n_points);
+  for (Index d = 0; d < n_points; ++d)
+    per_row[d] = locations[d].element < 0 ? 0 : static_cast<int>(maps[locations[d].element].dofs.size());
+  rows.reserve(per_row);
   for (Index d = 0; d < n_points; ++d) {
     const MeshLocation& loc = locations[d];
     if (loc.element < 0) continue;
-    const auto b = basis::BicubicHermite::evaluate(loc.xi, basis::kValues);
-    const fe::GlobalBasisRow row = fe::global_basis_row(maps[loc.element], b, 0);
-    for (std::size_t j = 0; j < row.dofs.size(); ++j) phi.add(d, row.dofs[j], row.coefs[j]);
+    const fe::ElementDofMap& dm = maps[loc.element];
+    const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+    const Eigen::RowVectorXd row = b.transpose() * dm.t;
+    for (std::size_t j = 0; j < dm.dofs.size(); ++j) rows.insert(d, dm.dofs[j]) = row[static_cast<Index>(j)];
   }
-  return phi.compress();
+  linalg::SparseMatrix out = rows;
+  out.makeCompressed();
+  return out;
 }
 
 struct FitSystem::Impl {
@@ -166,6 +175,9 @@ struct FitSystem::Impl {
   VecX w;
   std::vector<bool> used;
   linalg::LinearSolver solver{linalg::SolverKind::kAuto, linalg::MatrixProperty::kSymmetricPositiveDefinite};
+  // Hutchinson probes z (n_points x probes) and Phi^T W z, drawn once per system
+  // (fixed seed) and reused by every solve with the same number of probes.
+  MatX probes, probes_rhs;
 };
 
 FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi, const VecX& weights)
@@ -176,6 +188,31 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& 
   impl_->wphi = impl_->w.asDiagonal() * phi;
   impl_->normal = linalg::SparseMatrix(phi.transpose()) * impl_->wphi;
   impl_->used = mesh.used_dofs();
+}
+
+FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocation>& locations,
+                     const VecX& weights)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->mesh = &mesh;
+  impl_->phi = collocation_matrix(mesh, locations);
+  impl_->w = weights.size() ? weights : VecX::Ones(impl_->phi.rows());
+  impl_->wphi = impl_->w.asDiagonal() * impl_->phi;
+  impl_->used = mesh.used_dofs();
+  // Sum of w b b^T per element in the element's own basis, then mapped to the
+  // global dofs once per element.
+  std::vector<Eigen::Matrix<double, 16, 16>> local(mesh.n_elements(), Eigen::Matrix<double, 16, 16>::Zero());
+  for (std::size_t d = 0; d < locations.size(); ++d) {
+    const MeshLocation& loc = locations[d];
+    if (loc.element < 0 || !(impl_->w[static_cast<Index>(d)] > 0.0)) continue;
+    const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+    local[loc.element].selfadjointView<Eigen::Lower>().rankUpdate(b, impl_->w[static_cast<Index>(d)]);
+  }
+  linalg::TripletAssembler normal(mesh.n_dofs(), mesh.n_dofs());
+  for (Index e = 0; e < mesh.n_elements(); ++e) {
+    const Eigen::Matrix<double, 16, 16> a = local[e].selfadjointView<Eigen::Lower>();
+    add_element_block(normal, fe::element_dof_map(mesh.element_map(e)), a);
+  }
+  impl_->normal = normal.compress();
 }
 
 FitSystem::~FitSystem() = default;
@@ -213,15 +250,22 @@ FitResult FitSystem::solve(const Eigen::Ref<const MatX>& values, const linalg::S
   }
   out.parameters = s.solver.solve(rhs);
   if (trace_probes > 0) {
-    std::mt19937 rng(12345);
-    std::bernoulli_distribution coin(0.5);
-    MatX z(s.phi.rows(), trace_probes);
-    for (Index c = 0; c < z.cols(); ++c)
-      for (Index r = 0; r < z.rows(); ++r) z(r, c) = (w[r] > 0.0) ? (coin(rng) ? 1.0 : -1.0) : 0.0;
-    MatX b = s.wphi.transpose() * z;
+    if (s.probes.cols() != trace_probes) {
+      std::mt19937_64 rng(12345);
+      s.probes.resize(s.phi.rows(), trace_probes);
+      for (Index r = 0; r < s.probes.rows(); ++r) {
+        std::uint64_t bits = 0;  // one draw gives the signs of 64 probes
+        for (Index c = 0; c < trace_probes; ++c) {
+          if (c % 64 == 0) bits = rng();
+          s.probes(r, c) = (w[r] > 0.0) ? (((bits >> (c % 64)) & 1U) ? 1.0 : -1.0) : 0.0;
+        }
+      }
+      s.probes_rhs = s.wphi.transpose() * s.probes;
+    }
+    MatX b = s.probes_rhs;
     for (Index i : pinned) b.row(i).setZero();
     const MatX hz = s.phi * s.solver.solve(b);
-    out.edf = (z.array() * hz.array()).sum() / trace_probes;
+    out.edf = (s.probes.array() * hz.array()).sum() / trace_probes;
   }
   out.fitted = s.phi * out.parameters;
   out.residual = (out.fitted - values).rowwise().norm();

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <future>
 #include <limits>
 
 #include "common/core/error.hpp"
@@ -269,12 +270,20 @@ void write_samples_csv(const std::string& path, const AnalysisResult& r, const A
 void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
                    const AnalyseOptions& options, const RunInfo& info) {
   const auto t0 = std::chrono::steady_clock::now();
-  write_strains_csv(out.path("strains.csv"), grid, result, options);
-  if (result.method == Method::kSurface) {
-    write_surface_vtp(out.path("undeformed.vtp"), result, options, false);
-    write_surface_vtp(out.path("deformed.vtp"), result, options, true);
-    if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
+  // The mark table on a second thread while the surfaces are written (independent
+  // files and read-only inputs); its exception, if any, is rethrown by get().
+  auto csv = std::async(std::launch::async, [&] { write_strains_csv(out.path("strains.csv"), grid, result, options); });
+  try {
+    if (result.method == Method::kSurface) {
+      write_surface_vtp(out.path("undeformed.vtp"), result, options, false);
+      write_surface_vtp(out.path("deformed.vtp"), result, options, true);
+      if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
+    }
+  } catch (...) {
+    csv.wait();
+    throw;
   }
+  csv.get();
   result.times.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   io::write_json(out.path("summary.json"), make_summary(grid, result, options, info));
 }

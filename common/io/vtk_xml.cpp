@@ -217,7 +217,7 @@ void configure(vtkXMLWriter* writer, const VtkWriteOptions& options) {
     writer->EncodeAppendedDataOff();  // raw binary
   }
   if (options.compress && !options.ascii) {
-    writer->SetCompressorTypeToZLib();
+    writer->SetCompressorTypeToLZ4();
   } else {
     writer->SetCompressorTypeToNone();
   }

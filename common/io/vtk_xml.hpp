@@ -75,7 +75,7 @@ struct VolumeMesh {
 
 struct VtkWriteOptions {
   bool ascii = false;    // human-readable text instead of appended binary
-  bool compress = true;  // zlib compression of binary data
+  bool compress = true;  // LZ4 compression of binary data (fast; ParaView and VTK >= 8 read it)
 };
 
 // Write a file atomically (temporary sibling + rename). Sizes and indices are checked: a

@@ -178,7 +178,8 @@ class Reader {
   std::vector<CaseProblem>& problems_;
 };
 
-const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "boundary_conditions", "solver", "output"};
+const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "boundary_conditions", "loads", "solver",
+                                           "output"};
 
 void read_material(Reader& r, const std::string& name, const YAML::Node& key, const YAML::Node& body,
                    FormingCase& spec) {
@@ -186,12 +187,17 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   CaseMaterial m;
   m.name = name;
   m.place = place_of(key);
-  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic"})) return;
-  if (body.size() != 1) {
+  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic", "density"})) return;
+  const bool has_density = body["density"].IsDefined();
+  if (has_density) {
+    if (const auto rho = r.positive(body["density"], what + " density", "t/mm^3, e.g. 1.5e-9 for GF/PP")) m.density = *rho;
+  }
+  if (body.size() != (has_density ? 2u : 1u)) {
     r.problem(key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
     return;
   }
-  const auto law = body.begin();
+  auto law = body.begin();
+  if (law->first.Scalar() == "density") ++law;
   const std::string law_name = law->first.Scalar();
   const YAML::Node p = law->second;
   if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
@@ -429,6 +435,143 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   if (ok) spec.boundaries.push_back(bc);
 }
 
+std::optional<Vec3> vector3(Reader& r, const YAML::Node& n, const std::string& what, const std::string& unit) {
+  if (!n.IsSequence() || n.size() != 3) {
+    r.problem(n, what + ": expected [x, y, z] (" + unit + "), found " + describe(n));
+    return std::nullopt;
+  }
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    const auto c = r.number(n[i], what);
+    if (!c) return std::nullopt;
+    v[i] = *c;
+  }
+  return v;
+}
+
+void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
+  const std::string what = "load " + std::to_string(index + 1);
+  const std::vector<std::string> kinds = {"pressure", "gravity", "edge_force", "point_force"};
+  if (!r.mapping(n, what, kinds)) return;
+  if (n.size() != 1) {
+    r.problem(n, what + ": expected exactly one of pressure, gravity, edge_force, point_force");
+    return;
+  }
+  const auto kv = n.begin();
+  const std::string kind = kv->first.Scalar();
+  if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) return;  // reported above
+  const YAML::Node b = kv->second;
+  const std::string lw = what + " (" + kind + ")";
+  CaseLoad load;
+  load.place = place_of(kv->first);
+  std::vector<std::string> keys = {"ramp"};
+  if (kind == "pressure") {
+    load.kind = CaseLoad::Kind::kPressure;
+    keys.insert(keys.end(), {"ply", "face", "value", "follower"});
+  } else if (kind == "gravity") {
+    load.kind = CaseLoad::Kind::kGravity;
+    keys.insert(keys.end(), {"acceleration"});
+  } else if (kind == "edge_force") {
+    load.kind = CaseLoad::Kind::kEdgeForce;
+    keys.insert(keys.end(), {"ply", "edge", "force"});
+  } else {
+    load.kind = CaseLoad::Kind::kPointForce;
+    keys.insert(keys.end(), {"ply", "node", "layer", "force"});
+  }
+  if (!r.mapping(b, lw, keys)) return;
+  bool ok = true;
+  if (load.kind != CaseLoad::Kind::kGravity) {
+    if (const YAML::Node p = r.required(b, "ply", lw); p.IsDefined()) {
+      if (const auto name = r.text(p, lw + " ply")) {
+        load.ply = *name;
+        load.ply_index = spec.find_ply(*name);
+        if (load.ply_index < 0) {
+          r.problem(p, lw + ": unknown ply '" + *name + "'");
+          ok = false;
+        }
+      } else ok = false;
+    } else ok = false;
+  }
+  switch (load.kind) {
+    case CaseLoad::Kind::kPressure: {
+      if (const YAML::Node f = r.required(b, "face", lw); f.IsDefined()) {
+        if (f.IsScalar() && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
+          load.top = f.Scalar() == "top";
+        } else {
+          r.problem(f, lw + " face: expected top or bottom, found " + describe(f));
+          ok = false;
+        }
+      } else ok = false;
+      if (const YAML::Node v = r.required(b, "value", lw); v.IsDefined()) {
+        if (const auto p = r.number(v, lw + " value (MPa)")) load.value = *p; else ok = false;
+      } else ok = false;
+      if (b["follower"].IsDefined()) {
+        if (const auto f = r.boolean(b["follower"], lw + " follower")) load.follower = *f; else ok = false;
+      }
+      break;
+    }
+    case CaseLoad::Kind::kGravity: {
+      const YAML::Node a = b["acceleration"];
+      if (a.IsDefined()) {
+        if (const auto g = vector3(r, a, lw + " acceleration", "mm/s^2")) load.vector = *g; else ok = false;
+      } else {
+        load.vector = Vec3(0.0, 0.0, -9810.0);
+      }
+      for (const CaseMaterial& m : spec.materials)
+        if (!(m.density > 0.0)) {
+          r.problem(kv->first, lw + ": material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
+          ok = false;
+        }
+      break;
+    }
+    case CaseLoad::Kind::kEdgeForce: {
+      if (const YAML::Node e = r.required(b, "edge", lw); e.IsDefined()) {
+        if (const auto side = side_of(r, e, lw + " edge", false)) load.side = *side; else ok = false;
+      } else ok = false;
+      if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
+        if (const auto v = vector3(r, f, lw + " force", "N, total over the edge")) load.vector = *v; else ok = false;
+      } else ok = false;
+      break;
+    }
+    case CaseLoad::Kind::kPointForce: {
+      if (const YAML::Node nd = r.required(b, "node", lw); nd.IsDefined()) {
+        if (pair_of(r, nd, lw + " node [i, j]")) {
+          const int ply = load.ply_index;
+          const int n1 = ply >= 0 ? spec.plies[ply].n1 : 1000, n2 = ply >= 0 ? spec.plies[ply].n2 : 1000;
+          const auto i = r.integer(nd[0], lw + " node i (0 at x0 .. elements along x)", 0, n1);
+          const auto j = r.integer(nd[1], lw + " node j (0 at y0 .. elements along y)", 0, n2);
+          if (i && j) {
+            load.node_i = *i;
+            load.node_j = *j;
+          } else ok = false;
+        } else ok = false;
+      } else ok = false;
+      if (const YAML::Node l = b["layer"]; l.IsDefined()) {
+        if (l.IsScalar() && l.Scalar() == "bottom") load.layer = 0;
+        else if (l.IsScalar() && l.Scalar() == "top") load.layer = 1;
+        else if (l.IsScalar() && l.Scalar() == "both") load.layer = -1;
+        else {
+          r.problem(l, lw + " layer: expected bottom, top or both, found " + describe(l));
+          ok = false;
+        }
+      }
+      if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
+        if (const auto v = vector3(r, f, lw + " force", "N")) load.vector = *v; else ok = false;
+      } else ok = false;
+      break;
+    }
+  }
+  if (const YAML::Node rp = b["ramp"]; rp.IsDefined()) {
+    if (rp.IsScalar() && rp.Scalar() == "linear") load.ramp = Ramp::kLinear;
+    else if (rp.IsScalar() && rp.Scalar() == "smooth") load.ramp = Ramp::kSmooth;
+    else {
+      r.problem(rp, lw + " ramp: expected linear or smooth, found " + describe(rp));
+      ok = false;
+    }
+  }
+  if (ok) spec.loads.push_back(load);
+}
+
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment"})) return;
   if (n["steps"].IsDefined())
@@ -528,6 +671,24 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
       for (std::size_t i = 0; i < bs.size(); ++i) {
         const std::size_t before = problems.size();
         read_boundary(r, bs[i], static_cast<int>(i), spec);
+        for (std::size_t k = before; k < problems.size(); ++k) {
+          const std::string& msg = problems[k].message;
+          const auto pos = msg.find("unknown ply '");
+          if (pos == std::string::npos) continue;
+          const auto start = pos + 13;
+          if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
+            problems.erase(problems.begin() + static_cast<long>(k--));
+        }
+      }
+    }
+  }
+  if (const YAML::Node ls = root["loads"]; ls.IsDefined()) {
+    if (!ls.IsSequence()) {
+      r.problem(ls, "loads: expected a list (- pressure: ...), found " + describe(ls));
+    } else {
+      for (std::size_t i = 0; i < ls.size(); ++i) {
+        const std::size_t before = problems.size();
+        read_load(r, ls[i], static_cast<int>(i), spec);
         for (std::size_t k = before; k < problems.size(); ++k) {
           const std::string& msg = problems[k].message;
           const auto pos = msg.find("unknown ply '");

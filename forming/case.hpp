@@ -12,10 +12,13 @@
 //     - displacement: {ply: ply, edge: x1, value: [5, ~, ~], ramp: linear}
 //     - symmetry: {ply: ply, plane: bottom}
 //   solver: {steps: 10, max_iterations: 25, tolerance: 1e-8, line_search: true}
+//   loads:
+//     - pressure: {ply: ply, face: top, value: 0.01, follower: true, ramp: linear}
+//     - gravity: {acceleration: [0, 0, -9810]}     # materials need density: t/mm^3
 //   output: {every: 1, samples: [4, 2]}
 //
 // Quasi-static only for now: no contact, no dynamics, no exact constraints (the TI law
-// is used in its compressible form), no follower pressure.
+// is used in its compressible form).
 //
 // check_case_*() returns EVERY problem found (unknown keys, wrong types, values out of
 // range, unknown names, conflicting boundary conditions), each with its place in the
@@ -56,6 +59,7 @@ struct CaseMaterial {
   NeoHookeanParams neo_hookean;      // kNeoHookean
   TransverselyIsotropicParams ti;    // kTransverselyIsotropic (compressible)
   std::string given_as;              // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
+  double density = 0.0;              // t/mm^3 (0 = not given; gravity and dynamics need it)
   SourcePlace place;
 };
 
@@ -88,6 +92,31 @@ struct CaseBoundary {
 };
 std::string to_string(CaseBoundary::Kind kind);
 
+// A load, scaled by ramp(load factor):
+//   pressure     {ply, face: top|bottom, value: MPa (positive pushes into the ply),
+//                 follower: true (acts on the current face) | false (dead, reference face)}
+//   gravity      {acceleration: [x, y, z] mm/s^2, default [0, 0, -9810]}; every material
+//                needs a density
+//   edge_force   {ply, edge: x0|x1|y0|y1, force: [x, y, z] N in total, spread uniformly
+//                 over the side face (dead)}
+//   point_force  {ply, node: [i, j] (grid node, 0..elements), layer: bottom|top|both
+//                 (both: half on each), force: [x, y, z] N (dead)}
+struct CaseLoad {
+  enum class Kind { kPressure, kGravity, kEdgeForce, kPointForce };
+  Kind kind = Kind::kPressure;
+  std::string ply;
+  int ply_index = -1;       // -1 for gravity (all plies)
+  bool top = true;          // kPressure face
+  double value = 0.0;       // kPressure, MPa
+  bool follower = true;     // kPressure
+  PlySide side = PlySide::kX1;  // kEdgeForce
+  int node_i = 0, node_j = 0;   // kPointForce
+  int layer = -1;               // kPointForce: 0 bottom, 1 top, -1 both
+  Vec3 vector = Vec3::Zero();   // gravity acceleration (mm/s^2) or force (N)
+  Ramp ramp = Ramp::kLinear;
+  SourcePlace place;
+};
+
 struct CaseSolver {
   int steps = 10;             // load steps (load factor k / steps)
   int max_iterations = 25;    // Newton iterations per attempt
@@ -108,6 +137,7 @@ struct FormingCase {
   std::vector<CaseMaterial> materials;
   std::vector<CasePly> plies;
   std::vector<CaseBoundary> boundaries;
+  std::vector<CaseLoad> loads;
   CaseSolver solver;
   CaseOutput output;
 

@@ -1,6 +1,7 @@
 #include "forming/run.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -296,6 +297,75 @@ Model build_model(const FormingCase& spec) {
   return model;
 }
 
+ExternalLoad CaseLoads::at(const Model& model, double lambda, const VecX& x, bool want_tangent) const {
+  ExternalLoad out;
+  out.force = VecX::Zero(model.n_dofs());
+  for (const auto& [ramp, set] : sets) {
+    const double factor = ramp_value(ramp, std::clamp(lambda, 0.0, 1.0));
+    if (factor == 0.0) continue;
+    ExternalLoad l = set.assemble(model, x, factor, want_tangent);
+    out.force += l.force;
+    if (l.tangent.size() == 0) continue;
+    if (out.tangent.size() == 0) out.tangent = std::move(l.tangent);
+    else out.tangent += l.tangent;
+  }
+  return out;
+}
+
+CaseLoads build_loads(const FormingCase& spec, const Model& model) {
+  CaseLoads out;
+  const VecX X = model.reference_positions();
+  for (const CaseLoad& cl : spec.loads) {
+    LoadSet set;
+    switch (cl.kind) {
+      case CaseLoad::Kind::kPressure: {
+        PressureLoad p;
+        for (Index e = 0; e < model.ply(cl.ply_index).n_elements(); ++e)
+          p.faces.push_back({cl.ply_index, e, cl.top ? BrickFace::kTop : BrickFace::kBottom});
+        p.pressure = cl.value;
+        p.follower = cl.follower;
+        set.pressures.push_back(std::move(p));
+        break;
+      }
+      case CaseLoad::Kind::kGravity:
+        for (std::size_t b = 0; b < spec.plies.size(); ++b) {
+          const double rho = spec.materials.at(static_cast<std::size_t>(spec.plies[b].material_index)).density;
+          set.body_forces.push_back({static_cast<int>(b), rho * cl.vector});
+        }
+        break;
+      case CaseLoad::Kind::kEdgeForce: {
+        const CasePly& ply = spec.plies.at(static_cast<std::size_t>(cl.ply_index));
+        TractionLoad t;
+        auto element = [&](int i, int j) { return static_cast<Index>(j) * ply.n1 + i; };
+        switch (cl.side) {
+          case PlySide::kX0: for (int j = 0; j < ply.n2; ++j) t.faces.push_back({cl.ply_index, element(0, j), BrickFace::kXi1Min}); break;
+          case PlySide::kX1: for (int j = 0; j < ply.n2; ++j) t.faces.push_back({cl.ply_index, element(ply.n1 - 1, j), BrickFace::kXi1Max}); break;
+          case PlySide::kY0: for (int i = 0; i < ply.n1; ++i) t.faces.push_back({cl.ply_index, element(i, 0), BrickFace::kXi2Min}); break;
+          case PlySide::kY1: for (int i = 0; i < ply.n1; ++i) t.faces.push_back({cl.ply_index, element(i, ply.n2 - 1), BrickFace::kXi2Max}); break;
+          case PlySide::kBottom: break;  // not an edge (rejected by the case reader)
+        }
+        t.traction = cl.vector / face_area(model, t.faces, X);
+        set.tractions.push_back(std::move(t));
+        break;
+      }
+      case CaseLoad::Kind::kPointForce: {
+        const CasePly& ply = spec.plies.at(static_cast<std::size_t>(cl.ply_index));
+        const Index s = static_cast<Index>(cl.node_j) * (ply.n1 + 1) + cl.node_i;
+        for (int layer = 0; layer < 2; ++layer) {
+          if (cl.layer >= 0 && cl.layer != layer) continue;
+          const double share = cl.layer < 0 ? 0.5 : 1.0;
+          for (int c = 0; c < 3; ++c)
+            set.nodal.push_back({model.dof(cl.ply_index, model.ply(cl.ply_index).node(s, layer), 0, c), share * cl.vector[c]});
+        }
+        break;
+      }
+    }
+    out.follower = out.follower || set.has_follower();
+    out.sets.emplace_back(cl.ramp, std::move(set));
+  }
+  return out;
+}
+
 std::vector<PrescribedDof> prescribed_at(const FormingCase& spec, const Model& model, double lambda) {
   return targets(prescriptions(spec, model), lambda);
 }
@@ -312,6 +382,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   const Model model = build_model(spec);
   const std::vector<Prescription> prescribed = prescriptions(spec, model);
   const Tool tool = find_tool(spec, model);
+  const CaseLoads loads = build_loads(spec, model);
   const VecX X = model.reference_positions();
   const double t_build = seconds_since(t_start);
 
@@ -357,7 +428,13 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   for (int k = 1; k <= n_steps; ++k) {
     const double lambda = double(k) / n_steps;
     const Clock::time_point t0 = Clock::now();
-    const StaticResult r = solve_static(model, x, targets(prescribed, lambda), VecX(), so);
+    // Within the step the solver's factor s in [0, 1] runs from the previous load
+    // factor to this one.
+    const double lambda_prev = double(k - 1) / n_steps;
+    const LoadFunction step_load = [&](double sub, const VecX& xs, bool want_tangent) {
+      return loads.at(model, lambda_prev + sub * (lambda - lambda_prev), xs, want_tangent);
+    };
+    const StaticResult r = solve_static(model, x, targets(prescribed, lambda), step_load, loads.follower, so);
     t_solve += seconds_since(t0);
     report.total_iterations += r.report.total_iterations;
     if (!r.report.ok()) {
@@ -379,6 +456,13 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
       }
     const ToolState ts = history_row(k, lambda, x, r.reactions, r.report.total_iterations, r.report.n_cutbacks,
                                      residual);
+    report.max_displacement.setZero();
+    for (int b = 0; b < model.n_bodies(); ++b)
+      for (Index nd = 0; nd < model.ply(b).n_nodes(); ++nd) {
+        Vec3 u;
+        for (int c = 0; c < 3; ++c) u[c] = x[model.dof(b, nd, 0, c)] - X[model.dof(b, nd, 0, c)];
+        if (u.norm() > report.max_displacement.norm()) report.max_displacement = u;
+      }
     report.steps_converged = k;
     report.load_factor = lambda;
     report.final_residual = residual;
@@ -387,7 +471,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     std::ostringstream os;
     os << "simform: step " << k << "/" << n_steps << "  load factor " << lambda << "  Newton "
        << r.report.total_iterations << (r.report.n_cutbacks ? " (" + std::to_string(r.report.n_cutbacks) + " cut-backs)" : "")
-       << "  |r| " << sci(residual) << " N";
+       << "  |r| " << sci(residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
     cli::status(options.quiet, os.str());
     if (k % spec.output.every == 0 || k == n_steps) {
       write_frame(k, lambda, x);
@@ -413,7 +497,8 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   j["command_line"] = options.command_line;
   j["inputs"] = {{"case", spec.file}};
   j["parameters"] = parameters_json(spec, model);
-  j["analysis"] = "quasi-static (no contact, no dynamics, no exact constraints)";
+  j["analysis"] = loads.follower ? "quasi-static, follower loads (no contact, no dynamics)"
+                                 : "quasi-static (no contact, no dynamics)";
   j["status"] = report.ok() ? "converged" : "not_converged";
   j["message"] = report.ok() ? report.brief() : report.message;
   j["steps"] = {{"requested", n_steps}, {"converged", report.steps_converged}, {"written", frames.size()}};
@@ -423,6 +508,28 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   j["tool_edge"] = {{"edge", tool.label},
                {"displacement", {report.tool_displacement.x(), report.tool_displacement.y(), report.tool_displacement.z()}},
                {"force", {report.tool_force.x(), report.tool_force.y(), report.tool_force.z()}}};
+  j["max_displacement"] = {report.max_displacement.x(), report.max_displacement.y(), report.max_displacement.z()};
+  nlohmann::json lj = nlohmann::json::array();
+  for (const CaseLoad& l : spec.loads) {
+    nlohmann::json e;
+    switch (l.kind) {
+      case CaseLoad::Kind::kPressure:
+        e = {{"pressure_MPa", l.value}, {"ply", l.ply}, {"face", l.top ? "top" : "bottom"}, {"follower", l.follower}};
+        break;
+      case CaseLoad::Kind::kGravity:
+        e = {{"gravity_mm_s2", {l.vector.x(), l.vector.y(), l.vector.z()}}};
+        break;
+      case CaseLoad::Kind::kEdgeForce:
+        e = {{"edge_force_N", {l.vector.x(), l.vector.y(), l.vector.z()}}, {"ply", l.ply}, {"edge", to_string(l.side)}};
+        break;
+      case CaseLoad::Kind::kPointForce:
+        e = {{"point_force_N", {l.vector.x(), l.vector.y(), l.vector.z()}}, {"ply", l.ply}, {"node", {l.node_i, l.node_j}}};
+        break;
+    }
+    e["ramp"] = to_string(l.ramp);
+    lj.push_back(e);
+  }
+  j["loads"] = lj;
   j["timings_s"] = {{"build", t_build}, {"solve", t_solve}, {"write", t_write}, {"total", report.seconds}};
   nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json"};
   for (const auto& f : frames) outputs.push_back(f.second);

@@ -31,6 +31,7 @@
 
 #include "common/core/types.hpp"
 #include "forming/case.hpp"
+#include "forming/loads.hpp"
 #include "forming/static_solver.hpp"
 
 namespace sf::forming {
@@ -56,6 +57,7 @@ struct RunReport {
   int total_iterations = 0;
   Vec3 tool_displacement = Vec3::Zero();  // last converged step, mm
   Vec3 tool_force = Vec3::Zero();         // N
+  Vec3 max_displacement = Vec3::Zero();   // displacement of largest magnitude over the nodes, mm
   double seconds = 0.0;
   bool ok() const { return status == Status::kConverged; }
   std::string brief() const;
@@ -64,6 +66,15 @@ struct RunReport {
 // Model of a case: its plies in order (body b = ply b), one material instance per ply
 // (fibre direction from the layup angle).
 Model build_model(const FormingCase& spec);
+// The case's loads (forming/loads.hpp), each with its ramp: f_ext(lambda, x) =
+// sum_i ramp_i(lambda) f_i(x).
+struct CaseLoads {
+  std::vector<std::pair<Ramp, LoadSet>> sets;
+  bool follower = false;  // some load follows the deformation (unsymmetric tangent)
+  bool empty() const { return sets.empty(); }
+  ExternalLoad at(const Model& model, double lambda, const VecX& x, bool want_tangent) const;
+};
+CaseLoads build_loads(const FormingCase& spec, const Model& model);
 // Prescribed dofs at load factor lambda (global numbering of build_model()).
 std::vector<PrescribedDof> prescribed_at(const FormingCase& spec, const Model& model, double lambda);
 

@@ -65,6 +65,20 @@ std::vector<bool> Model::used_dofs() const {
   return used;
 }
 
+Model::ElementDofs Model::element_dofs(int body, Index e) const {
+  const Body& b = bodies_[body];
+  const BrickMap map = b.ply.element_map(e);
+  ElementDofs out;
+  for (int k = 0; k < kBrickFunctions; ++k)
+    for (int t = 0; t < map.n_terms[k]; ++t)
+      for (int i = 0; i < 3; ++i) {
+        out.dofs.push_back(b.offset + 3 * map.terms[k][t].dof + i);
+        out.coefs.push_back(map.terms[k][t].coef);
+        out.local.push_back(3 * k + i);
+      }
+  return out;
+}
+
 Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) const {
   SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
   Assembly out;
@@ -75,9 +89,6 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) con
     for (const Body& b : bodies_) n_el += b.ply.n_elements();
     triplets.reserve(n_el * kBrickDofs * kBrickDofs);
   }
-  std::vector<Index> dofs;
-  std::vector<double> coefs;
-  std::vector<int> local;
   MatX block;
   for (int body = 0; body < n_bodies(); ++body) {
     const Body& b = bodies_[body];
@@ -96,17 +107,10 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) con
       out.energy += r.energy;
       // Expanded local -> global list: one entry per (function, map term, coordinate);
       // duplicates (collapsed elements) are summed by the assembler.
-      const BrickMap map = b.ply.element_map(e);
-      dofs.clear();
-      coefs.clear();
-      local.clear();
-      for (int k = 0; k < kBrickFunctions; ++k)
-        for (int t = 0; t < map.n_terms[k]; ++t)
-          for (int i = 0; i < 3; ++i) {
-            dofs.push_back(b.offset + 3 * map.terms[k][t].dof + i);
-            coefs.push_back(map.terms[k][t].coef);
-            local.push_back(3 * k + i);
-          }
+      const ElementDofs ed = element_dofs(body, e);
+      const std::vector<Index>& dofs = ed.dofs;
+      const std::vector<double>& coefs = ed.coefs;
+      const std::vector<int>& local = ed.local;
       const int m = static_cast<int>(dofs.size());
       for (int a = 0; a < m; ++a) out.force(dofs[a]) += coefs[a] * r.force(local[a]);
       if (!want_tangent) continue;
@@ -186,6 +190,23 @@ std::string StaticReport::brief() const {
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
                           const std::vector<PrescribedDof>& prescribed, const VecX& f_ext,
                           const StaticOptions& options) {
+  if (f_ext.size() != 0 && f_ext.size() != model.n_dofs()) {
+    StaticResult result;
+    result.positions = x_start;
+    result.reactions = VecX::Zero(model.n_dofs());
+    result.report.status = StaticReport::Status::kInvalidStart;
+    result.report.message = "external force has " + std::to_string(f_ext.size()) + " entries, expected " +
+                            std::to_string(model.n_dofs());
+    return result;
+  }
+  const VecX dead = f_ext.size() == 0 ? VecX::Zero(model.n_dofs()) : f_ext;
+  const LoadFunction load = [&dead](double lambda, const VecX&, bool) { return ExternalLoad{lambda * dead, {}}; };
+  return solve_static(model, x_start, prescribed, load, false, options);
+}
+
+StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
+                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load_at,
+                          bool unsymmetric, const StaticOptions& options) {
   options.validate();
   const Index n = model.n_dofs();
   StaticResult result;
@@ -200,10 +221,23 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   if (x_start.size() != n)
     return invalid("start positions have " + std::to_string(x_start.size()) + " entries, expected " +
                    std::to_string(n));
-  if (f_ext.size() != 0 && f_ext.size() != n)
-    return invalid("external force has " + std::to_string(f_ext.size()) + " entries, expected " +
-                   std::to_string(n));
-  const VecX load = f_ext.size() == 0 ? VecX::Zero(n) : f_ext;
+  // Residual and (optionally) tangent at lambda, x: internal minus external.
+  struct State {
+    Assembly a;
+    VecX residual;
+    double scale = 0.0;  // max(|f_int|, |f_ext|)
+  };
+  auto evaluate = [&](double lam, const VecX& xs, bool want_tangent) {
+    State st;
+    st.a = model.assemble(xs, want_tangent);
+    if (!st.a.ok) return st;
+    ExternalLoad ext = load_at(lam, xs, want_tangent);
+    SF_ASSERT(ext.force.size() == n, "external load must have n_dofs entries");
+    st.residual = st.a.force - ext.force;
+    st.scale = std::max(st.a.force.norm(), ext.force.norm());
+    if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
+    return st;
+  };
 
   // Dof classes: free, prescribed, held (used by no element).
   enum : char { kFree, kPrescribed, kHeld };
@@ -239,7 +273,8 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (!a0.ok) return invalid("start state: " + a0.message);
   }
 
-  linalg::LinearSolver solver(options.linear_solver, linalg::MatrixProperty::kSymmetricIndefinite);
+  linalg::LinearSolver solver(options.linear_solver, unsymmetric ? linalg::MatrixProperty::kUnsymmetric
+                                                                 : linalg::MatrixProperty::kSymmetricIndefinite);
   VecX x = x_start;
   double lambda = 0.0;
   double increment = std::min(options.initial_increment, options.max_increment);
@@ -273,11 +308,12 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     VecX xt = x;
     bool failed = false;
     {
-      const Assembly a = model.assemble(x, true);
+      const State st = evaluate(lam_new, x, true);
+      const Assembly& a = st.a;
+      if (!a.ok) return invalid("converged state became inadmissible: " + a.message);
       const VecX x_new = prescribed_at(lam_new);
       const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
-      const VecX r = a.force - lam_new * load;
-      const VecX rhs = -free_part(r + a.tangent * dxp);
+      const VecX rhs = -free_part(st.residual + a.tangent * dxp);
       const linalg::SparseMatrix kff = select.transpose() * a.tangent * select;
       if (nf > 0) {
         const linalg::SolveReport& sr = solver.factorize(kff);
@@ -296,17 +332,17 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     // Corrector.
     double first_norm = -1.0;
     while (!failed) {
-      const Assembly a = model.assemble(xt, true);
+      const State st = evaluate(lam_new, xt, true);
+      const Assembly& a = st.a;
       if (!a.ok) {
         rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + a.message;
         failed = true;
         break;
       }
-      const VecX r = a.force - lam_new * load;
-      const VecX rf = free_part(r);
+      const VecX rf = free_part(st.residual);
       const double rnorm = rf.norm();
       rec.residual_norms.push_back(rnorm);
-      const double scale = std::max(a.force.norm(), (lam_new * load).norm());
+      const double scale = st.scale;
       if (first_norm < 0.0) first_norm = rnorm;
       if (rnorm <= std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) {
         rec.converged = true;
@@ -352,9 +388,9 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
         double best_alpha = -1.0, best_norm = std::numeric_limits<double>::infinity();
         bool accepted = false;
         for (int ls = 0; ls <= options.max_line_search; ++ls, alpha *= 0.5) {
-          const Assembly trial = model.assemble(xt + alpha * dx, false);
-          if (!trial.ok) continue;
-          const double tn = free_part(trial.force - lam_new * load).norm();
+          const State trial = evaluate(lam_new, xt + alpha * dx, false);
+          if (!trial.a.ok) continue;
+          const double tn = free_part(trial.residual).norm();
           if (tn <= (1.0 - kSufficientDecrease * alpha) * rnorm) {
             accepted = true;
             break;
@@ -403,8 +439,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   }
   report.load_factor = lambda;
   result.positions = x;
-  const Assembly a = model.assemble(x, false);
-  result.reactions = a.force - lambda * load;
+  result.reactions = evaluate(lambda, x, false).residual;
   return result;
 }
 

@@ -30,6 +30,7 @@
 //
 // Units: positions mm, forces N, stiffness N/mm (any consistent set).
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,6 +71,16 @@ class Model {
     return offset(body) + PlyMesh::dof(node, d, coord);
   }
   const ElementRule& rule() const { return rule_; }
+
+  // Global dofs of brick e of `body`, expanded per (function, map term, coordinate):
+  // element-vector entry local[a] (= 3 k + i) contributes coefs[a] times to global dof
+  // dofs[a]; repeated dofs (collapsed elements) are summed by the caller.
+  struct ElementDofs {
+    std::vector<Index> dofs;
+    std::vector<double> coefs;
+    std::vector<int> local;
+  };
+  ElementDofs element_dofs(int body, Index e) const;
 
   // Reference positions of all bodies (n_dofs, mm).
   VecX reference_positions() const;
@@ -159,10 +170,25 @@ struct StaticResult {
   StaticReport report;
 };
 
+// External force at load factor lambda and positions x, and (when asked for) its
+// derivative d f_ext / dx (empty when the load does not depend on x). See
+// forming/loads.hpp for the loads that build one.
+struct ExternalLoad {
+  VecX force;                    // n_dofs, N
+  linalg::SparseMatrix tangent;  // n_dofs x n_dofs or empty, N/mm
+};
+using LoadFunction = std::function<ExternalLoad(double lambda, const VecX& x, bool want_tangent)>;
+
 // Solves the static problem from x_start (n_dofs). f_ext: n_dofs dead load at lambda = 1
 // (empty = none). Dofs no element uses are held at their start values.
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
                           const std::vector<PrescribedDof>& prescribed, const VecX& f_ext,
                           const StaticOptions& options = {});
+// The same with a general load r(x) = f_int(x) - load(lambda, x).force and tangent
+// K_int - load.tangent. `unsymmetric`: the load's tangent is not symmetric (follower
+// pressure), so the linear solves use an unsymmetric factorisation (UMFPACK).
+StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
+                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
+                          bool unsymmetric, const StaticOptions& options = {});
 
 }  // namespace sf::forming

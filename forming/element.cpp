@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <sstream>
 
@@ -42,16 +43,102 @@ Mat3 deformation_gradient(const Eigen::Matrix<double, Basis::kNumFunctions, D>& 
   return F;
 }
 
+// Running integrals of the element-mean constraints (element.hpp header): the
+// reference volume, V_e g, V_e dg/dx and (with the tangent) V_e d2g/dx2.
+template <int NF, int D>
+struct ConstraintAccumulator {
+  static constexpr int ND = D * NF;
+  bool incompressible = false, inextensible = false, want_tangent = false;
+  Vec3 a0 = Vec3::Zero();
+  double volume = 0.0;
+  double int_j = 0.0, int_t = 0.0;  // integrals of J - 1 and (I4 - 1)/2
+  Eigen::Matrix<double, ND, 1> grad_j = Eigen::Matrix<double, ND, 1>::Zero();
+  Eigen::Matrix<double, ND, 1> grad_t = Eigen::Matrix<double, ND, 1>::Zero();
+  MatX hess_j;                                                     // ND x ND
+  Eigen::Matrix<double, NF, NF> hess_t_ss = Eigen::Matrix<double, NF, NF>::Zero();  // integral s s^T
+
+  ConstraintAccumulator(const ConstraintTerms& c, const Vec3& fibre, bool tangent)
+      : incompressible(c.incompressible), inextensible(c.inextensible), want_tangent(tangent), a0(fibre) {
+    if (incompressible && want_tangent) hess_j = MatX::Zero(ND, ND);
+  }
+
+  void add_point(const Mat3& F, double det_f, const Eigen::Matrix<double, NF, 3>& dn_dX, double dv) {
+    volume += dv;
+    if (incompressible) {
+      int_j += (det_f - 1.0) * dv;
+      const Mat3 f_inv = F.inverse();
+      // n(k, i) = dN_k/dx_i = sum_J dN_k/dX_J Finv_Ji.
+      const Eigen::Matrix<double, NF, 3> n = dn_dX * f_inv;
+      const double w = dv * det_f;
+      for (int k = 0; k < NF; ++k)
+        for (int i = 0; i < D; ++i) grad_j(D * k + i) += w * n(k, i);
+      if (want_tangent) {
+        for (int l = 0; l < NF; ++l)
+          for (int j = 0; j < D; ++j)
+            for (int k = 0; k < NF; ++k)
+              for (int i = 0; i < D; ++i)
+                hess_j(D * k + i, D * l + j) += w * (n(k, i) * n(l, j) - n(k, j) * n(l, i));
+      }
+    }
+    if (inextensible) {
+      const Vec3 a = F * a0;
+      int_t += 0.5 * (a.squaredNorm() - 1.0) * dv;
+      const Eigen::Matrix<double, NF, 1> s = dn_dX * a0;  // s_k = dN_k/dX . a0
+      for (int k = 0; k < NF; ++k)
+        for (int i = 0; i < D; ++i) grad_t(D * k + i) += dv * a(i) * s(k);
+      if (want_tangent) hess_t_ss.noalias() += dv * (s * s.transpose());
+    }
+  }
+
+  // Adds Pi_c and its derivatives to r and fills the constraint fields.
+  void finish(const ConstraintTerms& c, ElementResult& r) const {
+    r.volume = volume;
+    double pi = 0.0;
+    if (incompressible) {
+      r.g_J = int_j / volume;
+      r.p_eff = c.p - c.kappa * r.g_J;
+      pi += volume * (-c.p * r.g_J + 0.5 * c.kappa * r.g_J * r.g_J);
+      r.force.noalias() -= r.p_eff * grad_j;  // grad_j = V_e dg_J/dx
+      if (want_tangent) {
+        r.tangent.noalias() += (c.kappa / volume) * (grad_j * grad_j.transpose());
+        r.tangent.noalias() -= r.p_eff * hess_j;
+      }
+    }
+    if (inextensible) {
+      r.g_T = int_t / volume;
+      r.T_eff = c.T + c.k_fibre * r.g_T;
+      pi += volume * (c.T * r.g_T + 0.5 * c.k_fibre * r.g_T * r.g_T);
+      r.force.noalias() += r.T_eff * grad_t;
+      if (want_tangent) {
+        r.tangent.noalias() += (c.k_fibre / volume) * (grad_t * grad_t.transpose());
+        for (int l = 0; l < NF; ++l)
+          for (int k = 0; k < NF; ++k)
+            for (int i = 0; i < D; ++i) r.tangent(D * k + i, D * l + i) += r.T_eff * hess_t_ss(k, l);
+      }
+    }
+    r.constraint_energy = pi;
+    r.energy += pi;
+  }
+};
+
 template <class Basis, int D>
 ElementResult integrate(const Eigen::Matrix<double, Basis::kNumFunctions, D>& X_e,
                         const Eigen::Matrix<double, Basis::kNumFunctions, D>& x_e, const Material& material,
-                        const quadrature::TensorRule<D>& rule, bool want_tangent) {
+                        const quadrature::TensorRule<D>& rule, bool want_tangent,
+                        const ConstraintTerms& constraints) {
   constexpr int NF = Basis::kNumFunctions;
   constexpr int ND = D * NF;
+  constraints.validate();
+  const Vec3 a0 = material.fibre_direction();
+  if (constraints.inextensible && !(a0.norm() > 0.0))
+    throw InputError("constraint terms: fibre inextensibility needs a material with a fibre direction (" +
+                     material.name() + " has none)");
   ElementResult r;
   r.force = VecX::Zero(ND);
   if (want_tangent) r.tangent = MatX::Zero(ND, ND);
   r.min_det_f = std::numeric_limits<double>::infinity();
+  const bool constrained = constraints.active();
+  ConstraintAccumulator<NF, D> acc(constraints, a0, want_tangent && constrained);
   Eigen::Matrix<double, 6, ND> B;
   for (int q = 0; q < rule.size(); ++q) {
     const PointGeometry<Basis, D> pg = point_geometry<Basis, D>(X_e, rule.points[q]);
@@ -72,6 +159,7 @@ ElementResult integrate(const Eigen::Matrix<double, Basis::kNumFunctions, D>& X_
     const MaterialResponse resp = material.evaluate(C, want_tangent);
     const double dv = rule.weights[q] * pg.det_g;
     r.energy += resp.energy * dv;
+    if (constrained) acc.add_point(F, det_f, pg.dn_dX, dv);
     const Mat3 P = F * resp.stress;
     // f_{ki} = P_iJ dN_k/dX_J dV
     const Eigen::Matrix<double, NF, 3> pn = pg.dn_dX * P.transpose();  // (k, i) = sum_J dN_k/dX_J P_iJ
@@ -98,6 +186,7 @@ ElementResult integrate(const Eigen::Matrix<double, Basis::kNumFunctions, D>& X_
       for (int l = 0; l < NF; ++l)
         for (int i = 0; i < D; ++i) r.tangent(D * k + i, D * l + i) += dv * geo(k, l);
   }
+  if (constrained) acc.finish(constraints, r);
   return r;
 }
 
@@ -129,6 +218,21 @@ void ElementRule::validate() const {
   check("n_thickness", n_thickness);
 }
 
+void ConstraintTerms::validate() const {
+  auto check = [](const char* name, double v, bool non_negative) {
+    if (!std::isfinite(v) || (non_negative && v < 0.0)) {
+      std::ostringstream os;
+      os << "constraint terms " << name << ": expected a finite" << (non_negative ? " non-negative" : "")
+         << " value, found " << v;
+      throw InputError(os.str());
+    }
+  };
+  check("kappa", kappa, true);
+  check("p", p, false);
+  check("k_fibre", k_fibre, true);
+  check("T", T, false);
+}
+
 quadrature::TensorRule<3> ElementRule::brick() const {
   validate();
   return quadrature::gauss_3d(n_inplane, n_inplane, n_thickness);
@@ -140,13 +244,15 @@ quadrature::TensorRule<2> ElementRule::plane() const {
 }
 
 ElementResult brick_element(const BrickParams& X_e, const BrickParams& x_e, const Material& material,
-                            const quadrature::TensorRule<3>& rule, bool want_tangent) {
-  return integrate<basis::BicubicHermiteLinear, 3>(X_e, x_e, material, rule, want_tangent);
+                            const quadrature::TensorRule<3>& rule, bool want_tangent,
+                            const ConstraintTerms& constraints) {
+  return integrate<basis::BicubicHermiteLinear, 3>(X_e, x_e, material, rule, want_tangent, constraints);
 }
 
 ElementResult plane_element(const PlaneParams& X_e, const PlaneParams& x_e, const Material& material,
-                            const quadrature::TensorRule<2>& rule, bool want_tangent) {
-  return integrate<basis::CubicHermiteLinear, 2>(X_e, x_e, material, rule, want_tangent);
+                            const quadrature::TensorRule<2>& rule, bool want_tangent,
+                            const ConstraintTerms& constraints) {
+  return integrate<basis::CubicHermiteLinear, 2>(X_e, x_e, material, rule, want_tangent, constraints);
 }
 
 std::vector<Mat3> brick_deformation_gradients(const BrickParams& X_e, const BrickParams& x_e,

@@ -34,6 +34,56 @@
 //
 // Inverted points (det G <= 0 or det F <= 0) are a numerical outcome: the result's
 // status says so and the caller (Newton) backs off; energy is +inf there.
+//
+// Constraint terms (optional, ConstraintTerms; default off = the plain kernel above):
+// incompressibility J = 1 and fibre inextensibility I4 = 1 imposed on the ELEMENT MEAN
+// with one multiplier per element and constraint (discontinuous, element-constant
+// pressure p and fibre tension T, statically condensed: no global unknowns; Q1/P0 /
+// mean-dilatation style). With V_e = integral of dV (reference volume, mm^3, D = 3;
+// mm^2 per unit depth for the plane element) and a0 = material.fibre_direction():
+//   g_J = (1/V_e) integral (J - 1) dV,          J = det F,
+//   g_T = (1/V_e) integral (I4 - 1)/2 dV,       I4 = a0 . C a0 = |F a0|^2,
+//   Pi_c = V_e [ -p g_J + kappa/2 g_J^2 ]        (if incompressible)
+//        + V_e [  T g_T + k_fibre/2 g_T^2 ]      (if inextensible)
+// is added to the element energy. SIGN CONVENTION (that of the notes, section 3.1,
+// and of materials.hpp cauchy_stress): p is the PRESSURE (positive in compression),
+// T the fibre TENSION (positive in tension); the element adds to S
+//   -p_eff J C^-1 + T_eff a0 (x) a0,  i.e. sigma = -p_eff I + ... + (T_eff/J) a (x) a,
+// with the effective (reported) multipliers
+//   p_eff = p - kappa g_J,    T_eff = T + k_fibre g_T.
+// With p = T = 0 this is the penalty / perturbed-Lagrangian form (kappa: bulk-like
+// penalty, MPa; k_fibre: fibre penalty, MPa; expansion g_J > 0 gives p_eff < 0, i.e.
+// tension). Augmented Lagrangian (Uzawa): after each converged solve set
+//   p <- p_eff = p - kappa g_J,    T <- T_eff = T + k_fibre g_T
+// (i.e. copy ElementResult::p_eff / T_eff back into the element's ConstraintTerms);
+// this drives g_J, g_T -> 0 and p, T to the exact multipliers. NOTE the minus sign for
+// p: it is the physical pressure, not the Lagrange multiplier of +g_J.
+// Because only the element mean is constrained, a linear-through-thickness element
+// can still bend (J - 1 and I4 - 1 vary through the thickness with zero mean), which
+// avoids volumetric and fibre (extensional) locking; a pointwise penalty locks.
+// Force and exact tangent (dg = dg/dx_e, d2g = d2g/dx_e^2, both integrals of
+// per-point terms; n_k = F^-T dN_k/dX the spatial gradient, s_k = dN_k/dX . a0,
+// a = F a0):
+//   V_e dg_J/dx_{ki}       = integral J n_{k,i} dV
+//   V_e d2g_J/dx_{ki}dx_{lj} = integral J (n_{k,i} n_{l,j} - n_{k,j} n_{l,i}) dV
+//   V_e dg_T/dx_{ki}       = integral a_i s_k dV
+//   V_e d2g_T/dx_{ki}dx_{lj} = integral delta_ij s_k s_l dV
+//   force   += V_e (-p_eff dg_J + T_eff dg_T)
+//   tangent += V_e (kappa dg_J dg_J^T - p_eff d2g_J + k_fibre dg_T dg_T^T + T_eff d2g_T)
+// (a rank-one update per constraint plus the multiplier-weighted second derivative;
+// still symmetric and the exact derivative of the force). The plane element uses the
+// same formulas with F_33 = 1 (a0 may have a z component; it enters I4 as a constant).
+// With the incompressible TransverselyIsotropic law the reference state is stress free
+// at p = mu_T (materials.hpp), so start the Uzawa loop from p = mu_T there.
+// CAUTION (measured in tests/forming/constraint_test.cpp, ConstraintLocking): only the
+// element mean of J is constrained, so the zero-mean part of the dilatation is resisted
+// by the material alone. The incompressible law has no volumetric energy, and with
+// p = mu_T its linearised effective Lame constant is -mu_T (bulk -mu_T/3): one linear
+// layer through the thickness then bends with E_b = mu_T in plane strain (1/4 of the
+// exact 4 mu_T) and has an almost zero-energy synclastic bending mode with a free
+// width. Use a base law with positive pointwise bulk modulus (compressible ply law,
+// lambda > 0) and let the mean constraint drive the mean J to 1; one linear layer then
+// bends with E_b = lambda + 2 mu_T (plane strain; eps33 is constant through it).
 
 #include <Eigen/Core>
 #include <string>
@@ -55,6 +105,20 @@ struct ElementRule {
   quadrature::TensorRule<2> plane() const;
 };
 
+// Element-mean constraint terms (see header). Units: kappa, k_fibre, p, T in MPa.
+struct ConstraintTerms {
+  bool incompressible = false;  // add the J = 1 (mean) term
+  double kappa = 0.0;           // volumetric penalty, MPa (>= 0)
+  double p = 0.0;               // element pressure multiplier, MPa (positive = compression)
+  bool inextensible = false;    // add the I4 = 1 (mean) term
+  double k_fibre = 0.0;         // fibre penalty, MPa (>= 0)
+  double T = 0.0;               // element fibre-tension multiplier, MPa (positive = tension)
+  bool active() const { return incompressible || inextensible; }
+  // Throws sf::InputError naming the field when a penalty is negative or a value not
+  // finite.
+  void validate() const;
+};
+
 struct ElementResult {
   enum class Status {
     kOk,
@@ -66,18 +130,30 @@ struct ElementResult {
   VecX force;           // D NF, N (internal force, dE/dx)
   MatX tangent;         // D NF x D NF, N/mm (empty unless asked for)
   double min_det_f = 0.0;  // smallest det F over the Gauss points
+  // Constraint terms (zero unless ConstraintTerms::active(); the energy, force and
+  // tangent above already include them):
+  double volume = 0.0;             // V_e = integral of dV, mm^3 (mm^2 for the plane element)
+  double g_J = 0.0;                // element mean of J - 1 (computed whenever active)
+  double g_T = 0.0;                // element mean of (I4 - 1)/2 (computed whenever active)
+  double p_eff = 0.0;              // p - kappa g_J, MPa (incompressible), the Uzawa update
+  double T_eff = 0.0;              // T + k_fibre g_T, MPa (inextensible), the Uzawa update
+  double constraint_energy = 0.0;  // Pi_c, N mm (part of energy)
   bool ok() const { return status == Status::kOk; }
 };
 
 using BrickParams = Eigen::Matrix<double, 32, 3>;
 using PlaneParams = Eigen::Matrix<double, 8, 2>;
 
-// Brick element: reference and current xi-parameters (32 x 3, mm).
+// Brick element: reference and current xi-parameters (32 x 3, mm). `constraints`
+// (default: none) adds the element-mean constraint terms; it is validated, and
+// inextensibility with a material without a fibre direction throws sf::InputError.
 ElementResult brick_element(const BrickParams& X_e, const BrickParams& x_e, const Material& material,
-                            const quadrature::TensorRule<3>& rule, bool want_tangent);
+                            const quadrature::TensorRule<3>& rule, bool want_tangent,
+                            const ConstraintTerms& constraints = ConstraintTerms{});
 // Plane-strain element (per unit depth: energy N mm/mm, force N/mm).
 ElementResult plane_element(const PlaneParams& X_e, const PlaneParams& x_e, const Material& material,
-                            const quadrature::TensorRule<2>& rule, bool want_tangent);
+                            const quadrature::TensorRule<2>& rule, bool want_tangent,
+                            const ConstraintTerms& constraints = ConstraintTerms{});
 
 // Deformation gradient at every point of the rule (order of rule.points); the plane
 // element's F is embedded in 3 x 3 with F_33 = 1.

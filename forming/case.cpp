@@ -187,17 +187,29 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   CaseMaterial m;
   m.name = name;
   m.place = place_of(key);
-  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic", "density"})) return;
-  const bool has_density = body["density"].IsDefined();
-  if (has_density) {
+  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic", "density", "incompressible", "inextensible"}))
+    return;
+  std::size_t extras = 0;
+  if (body["density"].IsDefined()) {
+    ++extras;
     if (const auto rho = r.positive(body["density"], what + " density", "t/mm^3, e.g. 1.5e-9 for GF/PP")) m.density = *rho;
   }
-  if (body.size() != (has_density ? 2u : 1u)) {
+  for (const char* flag : {"incompressible", "inextensible"}) {
+    if (!body[flag].IsDefined()) continue;
+    ++extras;
+    if (const auto v = r.boolean(body[flag], what + " " + flag))
+      (std::string(flag) == "incompressible" ? m.incompressible : m.inextensible) = *v;
+  }
+  if (body.size() != extras + 1) {
     r.problem(key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
     return;
   }
   auto law = body.begin();
-  if (law->first.Scalar() == "density") ++law;
+  while (law != body.end() && law->first.Scalar() != "neo_hookean" && law->first.Scalar() != "transversely_isotropic")
+    ++law;
+  if (law == body.end()) return;
+  if (m.inextensible && law->first.Scalar() == "neo_hookean")
+    r.problem(body["inextensible"], what + ": inextensible needs fibres (a transversely_isotropic law)");
   const std::string law_name = law->first.Scalar();
   const YAML::Node p = law->second;
   if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
@@ -573,7 +585,16 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
 }
 
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
-  if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment"})) return;
+  if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment",
+                               "constraint_tolerance"}))
+    return;
+  if (n["constraint_tolerance"].IsDefined()) {
+    const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
+    if (v && !(*v > 0.0 && *v < 0.1))
+      r.problem(n["constraint_tolerance"], "solver constraint_tolerance: expected a value in (0, 0.1), found " +
+                                               n["constraint_tolerance"].Scalar());
+    else if (v) s.constraint_tolerance = *v;
+  }
   if (n["steps"].IsDefined())
     if (const auto v = r.integer(n["steps"], "solver steps", 1, 100000)) s.steps = *v;
   if (n["max_iterations"].IsDefined())

@@ -60,6 +60,8 @@ struct CaseMaterial {
   TransverselyIsotropicParams ti;    // kTransverselyIsotropic (compressible)
   std::string given_as;              // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
   double density = 0.0;              // t/mm^3 (0 = not given; gravity and dynamics need it)
+  bool incompressible = false;       // element-mean J = 1, exact (augmented Lagrangian)
+  bool inextensible = false;         // element-mean I4 = 1 (transversely isotropic only)
   SourcePlace place;
 };
 
@@ -123,6 +125,7 @@ struct CaseSolver {
   double tolerance = 1e-8;    // residual, relative to the force scale
   bool line_search = true;
   double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
+  double constraint_tolerance = 1e-8;  // |mean J - 1|, |mean (I4 - 1)/2| after the multiplier updates
 };
 
 struct CaseOutput {

@@ -36,6 +36,11 @@ std::string sci(double v) {
   return buf;
 }
 
+// Penalties of the augmented-Lagrangian constraints, relative to the law's own
+// volumetric / fibre stiffness: each multiplier update reduces the constraint
+// violation by about this factor.
+constexpr double kConstraintPenalty = 100.0;
+
 // A prescribed dof with its reference value and load-factor dependence.
 struct Prescription {
   Index dof = 0;
@@ -130,10 +135,14 @@ io::VolumeMesh tessellate(const FormingCase& spec, const Model& model, const Vec
   const int ns = spec.output.samples_inplane, nt = spec.output.samples_thickness;
   io::VolumeMesh mesh;
   std::vector<Vec3> points;
-  std::vector<double> disp, stress, fibre, stretch, body_id;
+  std::vector<double> disp, stress, fibre, stretch, body_id, pressure, tension;
+  bool constrained = false;
+  for (int b = 0; b < model.n_bodies(); ++b) constrained = constrained || model.constrained(b);
   for (int b = 0; b < model.n_bodies(); ++b) {
     const PlyMesh& ply = model.ply(b);
     const Material& material = model.material(b);
+    // Element pressure and fibre tension of a constrained ply (sigma gains -p I + T/J a a).
+    const std::vector<Model::ConstraintState> cs = model.constraint_state(b, x);
     const Vec3 a0 = ply.fibre_direction();
     const MatX xb = PlyMesh::unflatten(x.segment(model.offset(b), ply.n_dofs()));
     for (Index e = 0; e < ply.n_elements(); ++e) {
@@ -159,9 +168,20 @@ io::VolumeMesh tessellate(const FormingCase& spec, const Model& model, const Vec
             const Mat3 C = s.F.transpose() * s.F;
             Mat3 sigma = Mat3::Constant(std::nan(""));
             if (s.F.determinant() > 0.0) sigma = cauchy_stress(s.F, material.evaluate(C, false).stress);
+            const Vec3 a = s.F * a0;
+            double p_e = 0.0, t_e = 0.0;
+            if (!cs.empty()) {
+              const ConstraintTerms& ct = model.constraints(b);
+              p_e = ct.incompressible ? cs[static_cast<std::size_t>(e)].p_eff : 0.0;
+              t_e = ct.inextensible ? cs[static_cast<std::size_t>(e)].T_eff : 0.0;
+              sigma += -p_e * Mat3::Identity() + (t_e / s.F.determinant()) * a * a.transpose();
+            }
+            if (constrained) {
+              pressure.push_back(p_e);
+              tension.push_back(t_e);
+            }
             const Vec6 v = voigt_stress(sigma);
             for (int c = 0; c < 6; ++c) stress.push_back(v[c]);
-            const Vec3 a = s.F * a0;
             const double lam = a.norm();
             for (int c = 0; c < 3; ++c) fibre.push_back(lam > 0.0 ? a[c] / lam : 0.0);
             stretch.push_back(lam);
@@ -176,6 +196,10 @@ io::VolumeMesh tessellate(const FormingCase& spec, const Model& model, const Vec
   mesh.cell_data.push_back({"fibre_direction", 3, std::move(fibre)});
   mesh.cell_data.push_back({"fibre_stretch", 1, std::move(stretch)});
   mesh.cell_data.push_back({"ply", 1, std::move(body_id)});
+  if (constrained) {
+    mesh.cell_data.push_back({"pressure", 1, std::move(pressure)});
+    mesh.cell_data.push_back({"fibre_tension", 1, std::move(tension)});
+  }
   return mesh;
 }
 
@@ -288,11 +312,20 @@ Model build_model(const FormingCase& spec) {
     PlyMesh ply(std::move(s), p.thickness, p.angle_deg, PlyPlacement::kBottom);
     const CaseMaterial& m = spec.materials.at(static_cast<std::size_t>(p.material_index));
     std::shared_ptr<const Material> law;
-    if (m.kind == CaseMaterial::Kind::kNeoHookean)
+    ConstraintTerms ct;
+    if (m.kind == CaseMaterial::Kind::kNeoHookean) {
       law = std::make_shared<NeoHookean>(m.neo_hookean);
-    else
+      ct.kappa = kConstraintPenalty * (m.neo_hookean.lambda + 2.0 * m.neo_hookean.mu);
+    } else {
       law = std::make_shared<TransverselyIsotropic>(m.ti, ply.fibre_direction());
-    model.add_ply(std::move(ply), std::move(law));
+      ct.kappa = kConstraintPenalty * (m.ti.lambda + 2.0 * m.ti.mu_T);
+      ct.k_fibre = kConstraintPenalty * (2.0 * m.ti.kappa_f + m.ti.lambda + 2.0 * m.ti.mu_T);
+    }
+    ct.incompressible = m.incompressible;
+    ct.inextensible = m.inextensible && m.kind == CaseMaterial::Kind::kTransverselyIsotropic;
+    if (!ct.incompressible) ct.kappa = 0.0;
+    if (!ct.inextensible) ct.k_fibre = 0.0;
+    model.add_ply(std::move(ply), std::move(law), ct);
   }
   return model;
 }
@@ -379,7 +412,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     if (grid_body < 0) throw UsageError("--grid-ply: no ply named '" + options.grid_ply + "' in " + spec.file);
   }
 
-  const Model model = build_model(spec);
+  Model model = build_model(spec);
   const std::vector<Prescription> prescribed = prescriptions(spec, model);
   const Tool tool = find_tool(spec, model);
   const CaseLoads loads = build_loads(spec, model);
@@ -392,6 +425,8 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   so.line_search = spec.solver.line_search;
   so.min_increment = spec.solver.min_increment;
   so.validate();
+  UzawaOptions uzawa;
+  uzawa.tolerance = spec.solver.constraint_tolerance;
 
   io::AtomicOutputDir out(options.out_dir);
   std::vector<std::pair<double, std::string>> frames;
@@ -434,7 +469,10 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     const LoadFunction step_load = [&](double sub, const VecX& xs, bool want_tangent) {
       return loads.at(model, lambda_prev + sub * (lambda - lambda_prev), xs, want_tangent);
     };
-    const StaticResult r = solve_static(model, x, targets(prescribed, lambda), step_load, loads.follower, so);
+    UzawaReport uz;
+    const StaticResult r = solve_static_constrained(model, x, targets(prescribed, lambda), step_load, loads.follower, so,
+                                                    uzawa, &uz);
+    report.multiplier_updates += uz.updates;
     t_solve += seconds_since(t0);
     report.total_iterations += r.report.total_iterations;
     if (!r.report.ok()) {
@@ -499,6 +537,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   j["parameters"] = parameters_json(spec, model);
   j["analysis"] = loads.follower ? "quasi-static, follower loads (no contact, no dynamics)"
                                  : "quasi-static (no contact, no dynamics)";
+  j["multiplier_updates"] = report.multiplier_updates;
   j["status"] = report.ok() ? "converged" : "not_converged";
   j["message"] = report.ok() ? report.brief() : report.message;
   j["steps"] = {{"requested", n_steps}, {"converged", report.steps_converged}, {"written", frames.size()}};

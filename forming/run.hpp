@@ -55,6 +55,7 @@ struct RunReport {
   double load_factor = 0.0;
   double final_residual = 0.0;  // N
   int total_iterations = 0;
+  int multiplier_updates = 0;  // Uzawa updates of the constraint multipliers
   Vec3 tool_displacement = Vec3::Zero();  // last converged step, mm
   Vec3 tool_force = Vec3::Zero();         // N
   Vec3 max_displacement = Vec3::Zero();   // displacement of largest magnitude over the nodes, mm

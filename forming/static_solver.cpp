@@ -38,12 +38,51 @@ constexpr double kSufficientDecrease = 1e-4;
 
 Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()) {}
 
-int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material) {
+int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
   if (!material) throw InputError("model: ply added without a material");
+  constraints.validate();
+  if (constraints.inextensible && material->fibre_direction().isZero(0.0))
+    throw InputError("model: fibre inextensibility asked for a material without fibres (" + material->name() + ")");
   const Index n = ply.n_dofs();
-  bodies_.push_back(Body{std::move(ply), std::move(material), n_dofs_});
+  const Index ne = ply.n_elements();
+  Body b{std::move(ply), std::move(material), n_dofs_, constraints, {}, {}};
+  if (constraints.active()) {
+    b.p.assign(static_cast<std::size_t>(ne), constraints.p);
+    b.T.assign(static_cast<std::size_t>(ne), constraints.T);
+  }
+  bodies_.push_back(std::move(b));
   n_dofs_ += n;
   return n_bodies() - 1;
+}
+
+void Model::set_multipliers(int body, std::vector<double> p, std::vector<double> T) {
+  Body& b = bodies_.at(static_cast<std::size_t>(body));
+  SF_ASSERT(static_cast<Index>(p.size()) == b.ply.n_elements() && static_cast<Index>(T.size()) == b.ply.n_elements(),
+            "one multiplier per element");
+  b.p = std::move(p);
+  b.T = std::move(T);
+}
+
+ConstraintTerms Model::element_constraints(const Body& b, Index e) const {
+  ConstraintTerms c = b.constraints;
+  if (c.active()) {
+    c.p = b.p[static_cast<std::size_t>(e)];
+    c.T = b.T[static_cast<std::size_t>(e)];
+  }
+  return c;
+}
+
+std::vector<Model::ConstraintState> Model::constraint_state(int body, const Eigen::Ref<const VecX>& x) const {
+  const Body& b = bodies_.at(static_cast<std::size_t>(body));
+  std::vector<ConstraintState> out;
+  if (!b.constraints.active()) return out;
+  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+  for (Index e = 0; e < b.ply.n_elements(); ++e) {
+    const ElementResult r = brick_element(b.ply.element_parameters(e, b.ply.reference()), b.ply.element_parameters(e, xb),
+                                          *b.material, brick_rule_, false, element_constraints(b, e));
+    out.push_back({r.g_J, r.g_T, r.p_eff, r.T_eff, r.volume});
+  }
+  return out;
 }
 
 VecX Model::reference_positions() const {
@@ -96,7 +135,7 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) con
     for (Index e = 0; e < b.ply.n_elements(); ++e) {
       const BrickParams X_e = b.ply.element_parameters(e, b.ply.reference());
       const BrickParams x_e = b.ply.element_parameters(e, xb);
-      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent);
+      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent, element_constraints(b, e));
       if (!r.ok()) {
         out.ok = false;
         out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
@@ -441,6 +480,61 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   result.positions = x;
   result.reactions = evaluate(lambda, x, false).residual;
   return result;
+}
+
+StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>& x_start,
+                                      const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
+                                      bool unsymmetric, const StaticOptions& options, const UzawaOptions& uzawa,
+                                      UzawaReport* report) {
+  UzawaReport rep;
+  StaticResult r = solve_static(model, x_start, prescribed, load, unsymmetric, options);
+  bool any = false;
+  for (int b = 0; b < model.n_bodies(); ++b) any = any || model.constrained(b);
+  auto measure = [&](const VecX& x) {
+    rep.max_g_J = rep.max_g_T = 0.0;
+    for (int b = 0; b < model.n_bodies(); ++b)
+      for (const Model::ConstraintState& c : model.constraint_state(b, x)) {
+        if (model.constraints(b).incompressible) rep.max_g_J = std::max(rep.max_g_J, std::abs(c.g_J));
+        if (model.constraints(b).inextensible) rep.max_g_T = std::max(rep.max_g_T, std::abs(c.g_T));
+      }
+    return std::max(rep.max_g_J, rep.max_g_T);
+  };
+  if (any && r.report.ok()) {
+    // Every repeat starts where the last one ended, with the targets already reached:
+    // its prescribed dofs do not move.
+    while (measure(r.positions) > uzawa.tolerance) {
+      if (rep.updates >= uzawa.max_updates) {
+        rep.converged = false;
+        r.report.status = StaticReport::Status::kStepFailed;
+        r.report.message = "constraints not met after " + std::to_string(uzawa.max_updates) +
+                           " multiplier updates (max |mean J - 1| " + fmt(rep.max_g_J) + ", max |mean (I4 - 1)/2| " +
+                           fmt(rep.max_g_T) + ", tolerance " + fmt(uzawa.tolerance) + ")";
+        break;
+      }
+      for (int b = 0; b < model.n_bodies(); ++b) {
+        if (!model.constrained(b)) continue;
+        std::vector<double> p, t;
+        for (const Model::ConstraintState& c : model.constraint_state(b, r.positions)) {
+          p.push_back(c.p_eff);
+          t.push_back(c.T_eff);
+        }
+        model.set_multipliers(b, std::move(p), std::move(t));
+      }
+      ++rep.updates;
+      const LoadFunction full = [&load](double, const VecX& x, bool want_tangent) { return load(1.0, x, want_tangent); };
+      const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, options);
+      const int iterations = r.report.total_iterations + again.report.total_iterations;
+      r = again;
+      r.report.total_iterations = iterations;
+      if (!r.report.ok()) {
+        rep.converged = false;
+        break;
+      }
+    }
+  }
+  if (any && !r.report.ok()) rep.converged = false;
+  if (report) *report = rep;
+  return r;
 }
 
 }  // namespace sf::forming

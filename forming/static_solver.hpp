@@ -59,7 +59,24 @@ class Model {
 
   // Adds a ply; returns its body index. The material is shared (several plies may use
   // one law); for the TI law its fibre direction should be ply.fibre_direction().
-  int add_ply(PlyMesh ply, std::shared_ptr<const Material> material);
+  // `constraints`: element-mean incompressibility / fibre inextensibility of this ply
+  // (forming/element.hpp ConstraintTerms: the flags and the penalties kappa, k_fibre;
+  // its p and T are the starting multipliers of every element).
+  int add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints = {});
+
+  // Element multipliers (pressure p and fibre tension T, MPa) of a constrained body.
+  bool constrained(int body) const { return bodies_[body].constraints.active(); }
+  const ConstraintTerms& constraints(int body) const { return bodies_[body].constraints; }
+  const std::vector<double>& pressures(int body) const { return bodies_[body].p; }
+  const std::vector<double>& tensions(int body) const { return bodies_[body].T; }
+  void set_multipliers(int body, std::vector<double> p, std::vector<double> T);
+
+  // Per element of `body` at positions x: mean constraint values and the effective
+  // multipliers p_eff = p - kappa g_J, T_eff = T + k_fibre g_T (the Uzawa update).
+  struct ConstraintState {
+    double g_J = 0.0, g_T = 0.0, p_eff = 0.0, T_eff = 0.0, volume = 0.0;
+  };
+  std::vector<ConstraintState> constraint_state(int body, const Eigen::Ref<const VecX>& x) const;
 
   int n_bodies() const { return static_cast<int>(bodies_.size()); }
   Index n_dofs() const { return n_dofs_; }
@@ -99,7 +116,10 @@ class Model {
     PlyMesh ply;
     std::shared_ptr<const Material> material;
     Index offset = 0;
+    ConstraintTerms constraints;  // flags and penalties
+    std::vector<double> p, T;     // per element multipliers (when constrained)
   };
+  ConstraintTerms element_constraints(const Body& b, Index e) const;
   ElementRule rule_;
   quadrature::TensorRule<3> brick_rule_;
   std::vector<Body> bodies_;
@@ -179,6 +199,19 @@ struct ExternalLoad {
 };
 using LoadFunction = std::function<ExternalLoad(double lambda, const VecX& x, bool want_tangent)>;
 
+// Augmented Lagrangian (Uzawa) iterations for constrained bodies: solve, then set every
+// element's multipliers to their effective values, until max |g_J|, |g_T| <= tolerance
+// (or max_updates). Without constrained bodies this is one solve_static().
+struct UzawaOptions {
+  double tolerance = 1e-8;  // on the element-mean constraint values (dimensionless)
+  int max_updates = 30;
+};
+struct UzawaReport {
+  int updates = 0;
+  double max_g_J = 0.0, max_g_T = 0.0;  // after the last solve
+  bool converged = true;
+};
+
 // Solves the static problem from x_start (n_dofs). f_ext: n_dofs dead load at lambda = 1
 // (empty = none). Dofs no element uses are held at their start values.
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
@@ -190,5 +223,11 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
                           const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
                           bool unsymmetric, const StaticOptions& options = {});
+// solve_static() repeated with Uzawa updates of `model`'s multipliers (see UzawaOptions).
+// Each repeat starts from the previous solution with the same targets and loads.
+StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>& x_start,
+                                      const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
+                                      bool unsymmetric, const StaticOptions& options, const UzawaOptions& uzawa,
+                                      UzawaReport* report = nullptr);
 
 }  // namespace sf::forming

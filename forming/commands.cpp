@@ -83,6 +83,11 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--grid-marks", args->options.grid_marks, "Marks per side of that grid (default 21)")
             ->check(CLI::Range(2, 10000));
         app.add_option("--grid-ply", args->options.grid_ply, "Ply carrying the grid (default: the first)");
+        app.add_flag("--restart", args->options.restart,
+                     "Continue from the last written step (OUT/restart.json, written with every frame)");
+        app.add_option("--stop-after", args->options.stop_after,
+                       "Stop cleanly after this many steps (status 'stopped'; continue with --restart)")
+            ->check(CLI::NonNegativeNumber);
       },
       [args, prog] { return run_run(*args, prog->common().quiet); });
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -296,7 +297,9 @@ void RunOptions::validate() const {
 
 std::string RunReport::brief() const {
   std::ostringstream os;
-  if (ok())
+  if (status == Status::kStopped)
+    os << message;
+  else if (ok())
     os << "converged: " << steps_converged << " steps, " << total_iterations << " Newton iterations, |r| "
        << sci(final_residual) << " N";
   else
@@ -403,6 +406,75 @@ std::vector<PrescribedDof> prescribed_at(const FormingCase& spec, const Model& m
   return targets(prescriptions(spec, model), lambda);
 }
 
+namespace {
+
+// What a restart file must match: the model's size and the plies' definitions.
+std::string model_fingerprint(const FormingCase& spec, const Model& model) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "dofs " << model.n_dofs();
+  for (const CasePly& p : spec.plies)
+    os << "; ply " << p.name << " " << p.origin.transpose() << " " << p.length_x << " " << p.length_y << " "
+       << p.thickness << " " << p.n1 << "x" << p.n2 << " " << p.angle_deg << " " << p.material;
+  return os.str();
+}
+
+struct RestartState {
+  int step = 0;
+  double load_factor = 0.0;
+  VecX positions;
+  std::vector<std::vector<double>> p, t;  // per body
+  std::string history_rows;
+  std::vector<std::pair<double, std::string>> frames;
+};
+
+void write_restart(const std::string& path, const FormingCase& spec, const Model& model, const RestartState& s) {
+  nlohmann::json j;
+  j["format"] = "simform-restart-1";
+  j["case"] = spec.file;
+  j["fingerprint"] = model_fingerprint(spec, model);
+  j["step"] = s.step;
+  j["load_factor"] = s.load_factor;
+  j["positions"] = std::vector<double>(s.positions.data(), s.positions.data() + s.positions.size());
+  nlohmann::json m = nlohmann::json::array();
+  for (int b = 0; b < model.n_bodies(); ++b) m.push_back({{"p", model.pressures(b)}, {"T", model.tensions(b)}});
+  j["multipliers"] = m;
+  j["history_rows"] = s.history_rows;
+  nlohmann::json f = nlohmann::json::array();
+  for (const auto& [lam, name] : s.frames) f.push_back({lam, name});
+  j["frames"] = f;
+  io::write_file_atomic(path, j.dump());
+}
+
+RestartState read_restart(const std::string& path, const FormingCase& spec, Model& model) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": no restart file (a run writes it with every frame; run without --restart first)");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": not a readable restart file (" + e.what() + ")");
+  }
+  if (j.value("format", "") != "simform-restart-1") throw InputError(path + ": not a simform restart file");
+  if (j.value("fingerprint", "") != model_fingerprint(spec, model))
+    throw InputError(path + ": written for a different model (plies, meshes or materials changed since; only solver, "
+                            "loads and output settings may change for a restart)");
+  RestartState s;
+  s.step = j.at("step").get<int>();
+  s.load_factor = j.at("load_factor").get<double>();
+  const std::vector<double> x = j.at("positions").get<std::vector<double>>();
+  s.positions = Eigen::Map<const VecX>(x.data(), static_cast<Index>(x.size()));
+  const nlohmann::json& m = j.at("multipliers");
+  for (int b = 0; b < model.n_bodies() && b < static_cast<int>(m.size()); ++b)
+    if (model.constrained(b))
+      model.set_multipliers(b, m[b].at("p").get<std::vector<double>>(), m[b].at("T").get<std::vector<double>>());
+  s.history_rows = j.value("history_rows", "");
+  for (const auto& f : j.at("frames")) s.frames.emplace_back(f.at(0).get<double>(), f.at(1).get<std::string>());
+  return s;
+}
+
+}  // namespace
+
 RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   options.validate();
   const Clock::time_point t_start = Clock::now();
@@ -434,6 +506,9 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   auto write_frame = [&](int k, double lambda, const VecX& x) {
     const Clock::time_point t0 = Clock::now();
     io::write_vtu(out.path(step_name(k)), tessellate(spec, model, x));
+    // A restarted run with other step counts may reuse a name: the new frame replaces it.
+    frames.erase(std::remove_if(frames.begin(), frames.end(), [&](const auto& f) { return f.second == step_name(k); }),
+                 frames.end());
     frames.emplace_back(lambda, step_name(k));
     t_write += seconds_since(t0);
   };
@@ -452,20 +527,60 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     return ts;
   };
 
+  // Restart state, written straight into the final folder with every frame (so it
+  // survives a run that is killed before its outputs are committed).
+  const std::string restart_path = (std::filesystem::path(options.out_dir) / "restart.json").string();
+  RestartState restart;
   VecX x = X;
-  history_row(0, 0.0, x, VecX::Zero(model.n_dofs()), 0, 0, 0.0);
-  write_frame(0, 0.0, x);
+  double lambda_start = 0.0;
+  const int n_steps = spec.solver.steps;
+  int first_step = 1;
+  if (options.restart) {
+    restart = read_restart(restart_path, spec, model);
+    if (restart.positions.size() != model.n_dofs()) throw InputError(restart_path + ": wrong number of positions");
+    x = restart.positions;
+    lambda_start = restart.load_factor;
+    while (first_step <= n_steps && double(first_step) / n_steps <= lambda_start * (1.0 + 1e-12)) ++first_step;
+    // Earlier frames still present in the folder stay in the collection.
+    for (const auto& [lam, name] : restart.frames)
+      if (std::filesystem::exists(std::filesystem::path(options.out_dir) / name)) frames.emplace_back(lam, name);
+    history << restart.history_rows;
+    cli::status(options.quiet, "simform: restarting from load factor " + std::to_string(lambda_start) + " (step " +
+                                   std::to_string(restart.step) + " of the earlier run)");
+  } else {
+    history_row(0, 0.0, x, VecX::Zero(model.n_dofs()), 0, 0, 0.0);
+    write_frame(0, 0.0, x);
+  }
+  const std::string header_line = "step,load_factor,";  // rows after the header go into restart.json
+  auto save_restart = [&](int k, double lambda) {
+    const std::string all = history.str();
+    std::string rows;
+    std::istringstream lines(all);
+    for (std::string line; std::getline(lines, line);)
+      if (line.rfind(header_line, 0) != 0) rows += line + "\n";
+    restart.step = k;
+    restart.load_factor = lambda;
+    restart.positions = x;
+    restart.history_rows = rows;
+    restart.frames = frames;
+    std::error_code ec;
+    std::filesystem::create_directories(options.out_dir, ec);
+    write_restart(restart_path, spec, model, restart);
+  };
 
   RunReport report;
   report.status = RunReport::Status::kConverged;
-  const int n_steps = spec.solver.steps;
   int last_written = 0;
-  for (int k = 1; k <= n_steps; ++k) {
+  if (first_step > n_steps) {
+    report.steps_converged = n_steps;
+    report.load_factor = lambda_start;
+  }
+  for (int k = first_step; k <= n_steps; ++k) {
     const double lambda = double(k) / n_steps;
     const Clock::time_point t0 = Clock::now();
     // Within the step the solver's factor s in [0, 1] runs from the previous load
     // factor to this one.
-    const double lambda_prev = double(k - 1) / n_steps;
+    const double lambda_prev = k == first_step ? lambda_start : double(k - 1) / n_steps;
     const LoadFunction step_load = [&](double sub, const VecX& xs, bool want_tangent) {
       return loads.at(model, lambda_prev + sub * (lambda - lambda_prev), xs, want_tangent);
     };
@@ -511,19 +626,32 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
        << r.report.total_iterations << (r.report.n_cutbacks ? " (" + std::to_string(r.report.n_cutbacks) + " cut-backs)" : "")
        << "  |r| " << sci(residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
     cli::status(options.quiet, os.str());
-    if (k % spec.output.every == 0 || k == n_steps) {
+    const bool stop_now = options.stop_after > 0 && k - first_step + 1 >= options.stop_after && k < n_steps;
+    if (k % spec.output.every == 0 || k == n_steps || stop_now) {
       write_frame(k, lambda, x);
       last_written = k;
+      save_restart(k, lambda);
+    }
+    if (stop_now) {
+      report.status = RunReport::Status::kStopped;
+      report.message = "stopped after step " + std::to_string(k) + " of " + std::to_string(n_steps) +
+                       " (--stop-after); continue with --restart";
+      cli::status(options.quiet, "simform: " + report.message);
+      break;
     }
   }
-  if (!report.ok() && report.steps_converged > last_written) write_frame(report.steps_converged, report.load_factor, x);
+  if (!report.ok() && report.steps_converged > last_written) {
+    write_frame(report.steps_converged, report.load_factor, x);
+    save_restart(report.steps_converged, report.load_factor);
+  }
 
   const Clock::time_point t_out = Clock::now();
   io::write_pvd(out.path("result.pvd"), frames);
   io::write_file_atomic(out.path("history.csv"), history.str());
   // The grid file is written after the folder is committed (it may lie inside it).
-  const bool write_grid_file = !options.grid_out.empty() && report.ok();
-  if (!options.grid_out.empty() && !report.ok())
+  const bool finished = report.status == RunReport::Status::kConverged;
+  const bool write_grid_file = !options.grid_out.empty() && finished;
+  if (!options.grid_out.empty() && !finished)
     cli::status(options.quiet, "simform: not writing " + options.grid_out + " (the run did not converge)");
   const std::string grid_note = write_grid_file ? options.grid_out : std::string();
   t_write += seconds_since(t_out);
@@ -538,8 +666,9 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   j["analysis"] = loads.follower ? "quasi-static, follower loads (no contact, no dynamics)"
                                  : "quasi-static (no contact, no dynamics)";
   j["multiplier_updates"] = report.multiplier_updates;
-  j["status"] = report.ok() ? "converged" : "not_converged";
-  j["message"] = report.ok() ? report.brief() : report.message;
+  j["status"] = finished ? "converged" : report.ok() ? "stopped" : "not_converged";
+  j["message"] = finished ? report.brief() : report.message;
+  j["restart"] = {{"file", "restart.json"}, {"restarted", options.restart}, {"from_load_factor", lambda_start}};
   j["steps"] = {{"requested", n_steps}, {"converged", report.steps_converged}, {"written", frames.size()}};
   j["load_factor"] = report.load_factor;
   j["final_residual"] = report.final_residual;

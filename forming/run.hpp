@@ -42,13 +42,15 @@ struct RunOptions {
   int grid_marks = 21;     // marks per side (>= 2)
   std::string grid_ply;    // empty: the first ply
   bool quiet = false;      // no progress lines on stderr
+  bool restart = false;    // continue from out_dir/restart.json (the last written step)
+  int stop_after = 0;      // > 0: stop cleanly after this many steps of this run (restart later)
   std::string command_line = "simform run";
   // Throws sf::UsageError naming the option.
   void validate() const;
 };
 
 struct RunReport {
-  enum class Status { kConverged, kNotConverged };
+  enum class Status { kConverged, kNotConverged, kStopped };  // kStopped: --stop-after reached
   Status status = Status::kNotConverged;
   std::string message;  // names the step on failure
   int steps_converged = 0;
@@ -60,7 +62,7 @@ struct RunReport {
   Vec3 tool_force = Vec3::Zero();         // N
   Vec3 max_displacement = Vec3::Zero();   // displacement of largest magnitude over the nodes, mm
   double seconds = 0.0;
-  bool ok() const { return status == Status::kConverged; }
+  bool ok() const { return status != Status::kNotConverged; }  // converged or stopped on request
   std::string brief() const;
 };
 

@@ -586,8 +586,33 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
 
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment",
-                               "constraint_tolerance"}))
+                               "constraint_tolerance", "analysis", "end_time", "time_step", "integrator", "rho_inf"}))
     return;
+  if (const YAML::Node a = n["analysis"]; a.IsDefined()) {
+    if (a.IsScalar() && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
+      s.dynamic = a.Scalar() == "dynamic";
+    else
+      r.problem(a, "solver analysis: expected static or dynamic, found " + describe(a));
+  }
+  if (n["end_time"].IsDefined())
+    if (const auto v = r.positive(n["end_time"], "solver end_time", "s")) s.end_time = *v;
+  if (n["time_step"].IsDefined())
+    if (const auto v = r.positive(n["time_step"], "solver time_step", "s")) s.time_step = *v;
+  if (const YAML::Node i = n["integrator"]; i.IsDefined()) {
+    if (i.IsScalar() && (i.Scalar() == "generalized-alpha" || i.Scalar() == "hht-alpha" || i.Scalar() == "newmark"))
+      s.integrator = i.Scalar();
+    else
+      r.problem(i, "solver integrator: expected generalized-alpha, hht-alpha or newmark, found " + describe(i));
+  }
+  if (n["rho_inf"].IsDefined()) {
+    const auto v = r.number(n["rho_inf"], "solver rho_inf");
+    if (v && !(*v >= 0.0 && *v <= 1.0))
+      r.problem(n["rho_inf"], "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
+    else if (v) s.rho_inf = *v;
+  }
+  for (const char* key : {"end_time", "time_step", "integrator", "rho_inf"})
+    if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !n["analysis"].IsScalar()))
+      r.problem(n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
   if (n["constraint_tolerance"].IsDefined()) {
     const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
     if (v && !(*v > 0.0 && *v < 0.1))
@@ -722,6 +747,16 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
     }
   }
   if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
+  if (spec.solver.dynamic) {
+    const YAML::Node at = root["solver"]["analysis"];
+    for (const CaseMaterial& m : spec.materials) {
+      if (!(m.density > 0.0))
+        r.problem(at, "solver analysis dynamic: material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
+      if (m.incompressible || m.inextensible)
+        r.problem(at, "solver analysis dynamic: material '" + m.name +
+                          "' is incompressible/inextensible; exact constraints are quasi-static only for now");
+    }
+  }
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
 }
 

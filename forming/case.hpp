@@ -126,6 +126,13 @@ struct CaseSolver {
   bool line_search = true;
   double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
   double constraint_tolerance = 1e-8;  // |mean J - 1|, |mean (I4 - 1)/2| after the multiplier updates
+  // analysis: dynamic (inertia; forming/dynamics.hpp). The load factor is then t/end_time
+  // and the steps are output intervals of end_time/steps.
+  bool dynamic = false;
+  double end_time = 1.0;         // s
+  double time_step = 0.0;        // s, first (and largest) time step; 0 = end_time / (10 steps)
+  std::string integrator = "generalized-alpha";  // | hht-alpha | newmark
+  double rho_inf = 0.8;          // generalised-alpha high-frequency spectral radius
 };
 
 struct CaseOutput {

@@ -20,6 +20,7 @@
 #include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "common/mesh/surface_mesh.hpp"
+#include "forming/dynamics.hpp"
 #include "forming/materials.hpp"
 
 namespace sf::forming {
@@ -423,6 +424,7 @@ struct RestartState {
   int step = 0;
   double load_factor = 0.0;
   VecX positions;
+  VecX velocities;  // dynamic runs (mm/s); empty for static ones
   std::vector<std::vector<double>> p, t;  // per body
   std::string history_rows;
   std::vector<std::pair<double, std::string>> frames;
@@ -436,6 +438,7 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   j["step"] = s.step;
   j["load_factor"] = s.load_factor;
   j["positions"] = std::vector<double>(s.positions.data(), s.positions.data() + s.positions.size());
+  j["velocities"] = std::vector<double>(s.velocities.data(), s.velocities.data() + s.velocities.size());
   nlohmann::json m = nlohmann::json::array();
   for (int b = 0; b < model.n_bodies(); ++b) m.push_back({{"p", model.pressures(b)}, {"T", model.tensions(b)}});
   j["multipliers"] = m;
@@ -464,6 +467,10 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
   s.load_factor = j.at("load_factor").get<double>();
   const std::vector<double> x = j.at("positions").get<std::vector<double>>();
   s.positions = Eigen::Map<const VecX>(x.data(), static_cast<Index>(x.size()));
+  if (j.contains("velocities")) {
+    const std::vector<double> v = j.at("velocities").get<std::vector<double>>();
+    s.velocities = Eigen::Map<const VecX>(v.data(), static_cast<Index>(v.size()));
+  }
   const nlohmann::json& m = j.at("multipliers");
   for (int b = 0; b < model.n_bodies() && b < static_cast<int>(m.size()); ++b)
     if (model.constrained(b))
@@ -527,6 +534,25 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     return ts;
   };
 
+  // Dynamics: mass matrix, integrator settings, velocities (start at rest).
+  const bool dynamic = spec.solver.dynamic;
+  linalg::SparseMatrix mass;
+  DynamicOptions dyn;
+  VecX v = VecX::Zero(model.n_dofs());
+  if (dynamic) {
+    std::vector<double> density;
+    for (const CasePly& p : spec.plies) density.push_back(spec.materials.at(static_cast<std::size_t>(p.material_index)).density);
+    mass = mass_matrix(model, density);
+    dyn.integrator = parse_integrator(spec.solver.integrator, "solver integrator");
+    dyn.rho_inf = spec.solver.rho_inf;
+    dyn.initial_dt = spec.solver.time_step > 0.0 ? spec.solver.time_step : spec.solver.end_time / (10.0 * spec.solver.steps);
+    dyn.max_dt = dyn.initial_dt;
+    dyn.min_dt = dyn.initial_dt * spec.solver.min_increment * 1e-2;
+    dyn.max_iterations = spec.solver.max_iterations;
+    dyn.residual_tol_rel = spec.solver.tolerance;
+    dyn.line_search = spec.solver.line_search;
+    dyn.keep_step_records = true;
+  }
   // Restart state, written straight into the final folder with every frame (so it
   // survives a run that is killed before its outputs are committed).
   const std::string restart_path = (std::filesystem::path(options.out_dir) / "restart.json").string();
@@ -539,6 +565,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     restart = read_restart(restart_path, spec, model);
     if (restart.positions.size() != model.n_dofs()) throw InputError(restart_path + ": wrong number of positions");
     x = restart.positions;
+    if (dynamic && restart.velocities.size() == model.n_dofs()) v = restart.velocities;
     lambda_start = restart.load_factor;
     while (first_step <= n_steps && double(first_step) / n_steps <= lambda_start * (1.0 + 1e-12)) ++first_step;
     // Earlier frames still present in the folder stay in the collection.
@@ -561,6 +588,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     restart.step = k;
     restart.load_factor = lambda;
     restart.positions = x;
+    restart.velocities = dynamic ? v : VecX();
     restart.history_rows = rows;
     restart.frames = frames;
     std::error_code ec;
@@ -584,10 +612,43 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     const LoadFunction step_load = [&](double sub, const VecX& xs, bool want_tangent) {
       return loads.at(model, lambda_prev + sub * (lambda - lambda_prev), xs, want_tangent);
     };
-    UzawaReport uz;
-    const StaticResult r = solve_static_constrained(model, x, targets(prescribed, lambda), step_load, loads.follower, so,
-                                                    uzawa, &uz);
-    report.multiplier_updates += uz.updates;
+    StaticResult r;
+    if (dynamic) {
+      // Inertia: integrate over the output interval [t_prev, t], load factor t / end_time.
+      DynamicOptions d = dyn;
+      d.start_time = lambda_prev * spec.solver.end_time;
+      d.end_time = lambda * spec.solver.end_time;
+      std::vector<TimedDof> moving;
+      for (const Prescription& p : prescribed)
+        moving.push_back({p.dof, [p, T = spec.solver.end_time](double t) {
+                            return p.reference + p.displacement * ramp_value(p.ramp, std::clamp(t / T, 0.0, 1.0));
+                          }});
+      const ExternalForceFn ext = [&](double t, const VecX& xs, bool want_tangent) {
+        return loads.at(model, t / spec.solver.end_time, xs, want_tangent);
+      };
+      const DynamicResult dr = solve_dynamic(model, mass, x, v, moving, ext, d);
+      r.positions = dr.positions;
+      r.reactions = dr.reactions;
+      r.report.total_iterations = dr.report.total_iterations;
+      r.report.n_cutbacks = dr.report.n_cutbacks;
+      r.report.status = dr.report.ok() ? StaticReport::Status::kConverged : StaticReport::Status::kStepFailed;
+      r.report.message = dr.report.ok() ? std::string() : dr.report.message;
+      double last = 0.0;
+      for (auto it = dr.report.steps.rbegin(); it != dr.report.steps.rend(); ++it)
+        if (it->converged && !it->residual_norms.empty()) {
+          last = it->residual_norms.back();
+          break;
+        }
+      StepRecord rec;
+      rec.converged = dr.report.ok();
+      rec.residual_norms.push_back(last);
+      r.report.steps.push_back(rec);
+      if (dr.report.ok()) v = dr.velocities;
+    } else {
+      UzawaReport uz;
+      r = solve_static_constrained(model, x, targets(prescribed, lambda), step_load, loads.follower, so, uzawa, &uz);
+      report.multiplier_updates += uz.updates;
+    }
     t_solve += seconds_since(t0);
     report.total_iterations += r.report.total_iterations;
     if (!r.report.ok()) {
@@ -622,7 +683,12 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     report.tool_displacement = ts.displacement;
     report.tool_force = ts.force;
     std::ostringstream os;
-    os << "simform: step " << k << "/" << n_steps << "  load factor " << lambda << "  Newton "
+    os << "simform: step " << k << "/" << n_steps;
+    if (dynamic)
+      os << "  t " << lambda * spec.solver.end_time << " s";
+    else
+      os << "  load factor " << lambda;
+    os << "  Newton "
        << r.report.total_iterations << (r.report.n_cutbacks ? " (" + std::to_string(r.report.n_cutbacks) + " cut-backs)" : "")
        << "  |r| " << sci(residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
     cli::status(options.quiet, os.str());
@@ -663,8 +729,10 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   j["command_line"] = options.command_line;
   j["inputs"] = {{"case", spec.file}};
   j["parameters"] = parameters_json(spec, model);
-  j["analysis"] = loads.follower ? "quasi-static, follower loads (no contact, no dynamics)"
-                                 : "quasi-static (no contact, no dynamics)";
+  j["analysis"] = dynamic ? "dynamic (" + spec.solver.integrator + ", no contact)"
+                 : loads.follower ? "quasi-static, follower loads (no contact)"
+                                  : "quasi-static (no contact)";
+  if (dynamic) j["time"] = {{"end_time_s", spec.solver.end_time}, {"time_s", report.load_factor * spec.solver.end_time}};
   j["multiplier_updates"] = report.multiplier_updates;
   j["status"] = finished ? "converged" : report.ok() ? "stopped" : "not_converged";
   j["message"] = finished ? report.brief() : report.message;

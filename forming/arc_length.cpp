@@ -57,17 +57,11 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
   for (Index d = 0; d < n; ++d)
     if (free_dof[d]) free.push_back(d);
   const Index nf = static_cast<Index>(free.size());
-  linalg::SparseMatrix select(n, nf);
-  {
-    std::vector<Eigen::Triplet<double, int>> t;
-    for (Index j = 0; j < nf; ++j) t.emplace_back(static_cast<int>(free[j]), static_cast<int>(j), 1.0);
-    select.setFromTriplets(t.begin(), t.end());
-  }
-  auto free_part = [&](const VecX& v) {
-    VecX out(nf);
-    for (Index j = 0; j < nf; ++j) out(j) = v(free[j]);
-    return out;
-  };
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
+  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
+  const FreeDofs free_dofs(is_free);
+  const linalg::SparseMatrix& select = free_dofs.select;
+  auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
 
   // Residual, load shape and tangent on the free dofs at (x, lambda).
   struct State {

@@ -710,6 +710,17 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
   if (const YAML::Node ps = root["plies"]; ps.IsSequence())
     for (const YAML::Node& p : ps)
       if (p.IsMap() && p["name"].IsScalar()) ply_names.insert(p["name"].Scalar());
+  // A condition or load naming a ply that exists but was bad: the ply's own problem is enough.
+  auto drop_unknown_ply_problems = [&](std::size_t from) {
+    for (std::size_t k = from; k < problems.size(); ++k) {
+      const std::string& msg = problems[k].message;
+      const auto pos = msg.find("unknown ply '");
+      if (pos == std::string::npos) continue;
+      const auto start = pos + 13;
+      if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
+        problems.erase(problems.begin() + static_cast<long>(k--));
+    }
+  };
   if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
     if (!bs.IsSequence() || bs.size() == 0) {
       r.problem(bs, "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
@@ -717,14 +728,7 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
       for (std::size_t i = 0; i < bs.size(); ++i) {
         const std::size_t before = problems.size();
         read_boundary(r, bs[i], static_cast<int>(i), spec);
-        for (std::size_t k = before; k < problems.size(); ++k) {
-          const std::string& msg = problems[k].message;
-          const auto pos = msg.find("unknown ply '");
-          if (pos == std::string::npos) continue;
-          const auto start = pos + 13;
-          if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
-            problems.erase(problems.begin() + static_cast<long>(k--));
-        }
+        drop_unknown_ply_problems(before);
       }
     }
   }
@@ -735,14 +739,7 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
       for (std::size_t i = 0; i < ls.size(); ++i) {
         const std::size_t before = problems.size();
         read_load(r, ls[i], static_cast<int>(i), spec);
-        for (std::size_t k = before; k < problems.size(); ++k) {
-          const std::string& msg = problems[k].message;
-          const auto pos = msg.find("unknown ply '");
-          if (pos == std::string::npos) continue;
-          const auto start = pos + 13;
-          if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
-            problems.erase(problems.begin() + static_cast<long>(k--));
-        }
+        drop_unknown_ply_problems(before);
       }
     }
   }

@@ -277,18 +277,11 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
     if (kind[d] == kFree) free.push_back(d);
   }
   const Index nf = static_cast<Index>(free.size());
-  linalg::SparseMatrix select(n, nf);  // n x nf: column j = unit vector of free dof j
-  {
-    std::vector<Eigen::Triplet<double, int>> t;
-    t.reserve(nf);
-    for (Index j = 0; j < nf; ++j) t.emplace_back(static_cast<int>(free[j]), static_cast<int>(j), 1.0);
-    select.setFromTriplets(t.begin(), t.end());
-  }
-  auto free_part = [&](const VecX& v) {
-    VecX out(nf);
-    for (Index j = 0; j < nf; ++j) out(j) = v(free[j]);
-    return out;
-  };
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
+  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
+  const FreeDofs free_dofs(is_free);
+  const linalg::SparseMatrix& select = free_dofs.select;
+  auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
   // Sets the prescribed dofs of y to their positions at time t; false (and a message)
   // when a position is not finite.
   auto set_prescribed = [&](double t, VecX& y, std::string& why) {

@@ -223,6 +223,23 @@ std::string StaticReport::brief() const {
   return os.str();
 }
 
+FreeDofs::FreeDofs(const std::vector<bool>& is_free) {
+  const Index n = static_cast<Index>(is_free.size());
+  for (Index d = 0; d < n; ++d)
+    if (is_free[static_cast<std::size_t>(d)]) index.push_back(d);
+  select.resize(n, size());
+  std::vector<Eigen::Triplet<double, int>> t;
+  t.reserve(index.size());
+  for (Index j = 0; j < size(); ++j) t.emplace_back(static_cast<int>(index[j]), static_cast<int>(j), 1.0);
+  select.setFromTriplets(t.begin(), t.end());
+}
+
+VecX FreeDofs::restrict(const VecX& v) const {
+  VecX out(size());
+  for (Index j = 0; j < size(); ++j) out(j) = v(index[j]);
+  return out;
+}
+
 // ---------------------------------------------------------------------------------
 // Newton solver
 
@@ -296,13 +313,10 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (kind[d] == kFree) free.push_back(d);
   }
   const Index nf = static_cast<Index>(free.size());
-  linalg::SparseMatrix select(n, nf);  // n x nf: column j = unit vector of free dof j
-  {
-    std::vector<Eigen::Triplet<double, int>> t;
-    t.reserve(nf);
-    for (Index j = 0; j < nf; ++j) t.emplace_back(static_cast<int>(free[j]), static_cast<int>(j), 1.0);
-    select.setFromTriplets(t.begin(), t.end());
-  }
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
+  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
+  const FreeDofs free_dofs(is_free);
+  const linalg::SparseMatrix& select = free_dofs.select;
   double length_scale = 0.0;
   for (Index d = 0; d < n; ++d) length_scale = std::max(length_scale, std::abs(x_start(d)));
   length_scale = std::max(length_scale, 1e-300);
@@ -323,11 +337,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       if (kind[d] == kPrescribed) v(d) = x_start(d) + lam * (target(d) - x_start(d));
     return v;
   };
-  auto free_part = [&](const VecX& v) {
-    VecX out(nf);
-    for (Index j = 0; j < nf; ++j) out(j) = v(free[j]);
-    return out;
-  };
+  auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
 
   int attempts = 0;
   while (lambda < 1.0) {

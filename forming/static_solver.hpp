@@ -126,6 +126,16 @@ class Model {
   Index n_dofs_ = 0;
 };
 
+// The free dofs of a solve, in ascending order, and the n x nf selection matrix S
+// (column j = unit vector of free dof j): K_ff = S^T K S, x += S dx_f.
+struct FreeDofs {
+  std::vector<Index> index;
+  linalg::SparseMatrix select;
+  explicit FreeDofs(const std::vector<bool>& is_free);
+  Index size() const { return static_cast<Index>(index.size()); }
+  VecX restrict(const VecX& v) const;  // the free entries of v (n_dofs)
+};
+
 // A prescribed dof: its position at load factor 1 (mm; for derivative parameters the
 // arc-length derivative, dimensionless).
 struct PrescribedDof {

@@ -586,8 +586,27 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
 
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment",
-                               "constraint_tolerance", "analysis", "end_time", "time_step", "integrator", "rho_inf"}))
+                               "constraint_tolerance", "analysis", "end_time", "time_step", "integrator", "rho_inf",
+                               "control", "arc_length", "stop_displacement"}))
     return;
+  bool arc = false;
+  if (const YAML::Node c = n["control"]; c.IsDefined()) {
+    if (c.IsScalar() && (c.Scalar() == "load" || c.Scalar() == "arc_length"))
+      arc = c.Scalar() == "arc_length";
+    else
+      r.problem(c, "solver control: expected load or arc_length, found " + describe(c));
+  }
+  if (arc) {
+    const YAML::Node a = n["arc_length"];
+    if (!a.IsDefined())
+      r.problem(n["control"], "solver control arc_length: give arc_length (the path length per step, mm)");
+    else if (const auto v = r.positive(a, "solver arc_length", "mm")) s.arc_length = *v;
+    if (n["stop_displacement"].IsDefined())
+      if (const auto v = r.positive(n["stop_displacement"], "solver stop_displacement", "mm")) s.stop_displacement = *v;
+  } else {
+    for (const char* key : {"arc_length", "stop_displacement"})
+      if (n[key].IsDefined()) r.problem(n[key], std::string("solver ") + key + ": only used with control: arc_length");
+  }
   if (const YAML::Node a = n["analysis"]; a.IsDefined()) {
     if (a.IsScalar() && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
       s.dynamic = a.Scalar() == "dynamic";
@@ -744,6 +763,22 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
     }
   }
   if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
+  if (spec.solver.arc_length > 0.0) {
+    const YAML::Node at = root["solver"]["control"];
+    if (spec.solver.dynamic) r.problem(at, "solver control arc_length: static analysis only");
+    for (const CaseBoundary& bc : spec.boundaries)
+      if (bc.kind == CaseBoundary::Kind::kDisplacement)
+        r.problem(bc.place, "solver control arc_length: prescribed displacements cannot follow the arc length "
+                            "(hold edges with clamp or symmetry; drive the case by loads)");
+    for (const CaseLoad& l : spec.loads)
+      if (l.ramp != Ramp::kLinear)
+        r.problem(l.place, "solver control arc_length: loads must be proportional to the load factor (ramp: linear)");
+    for (const CaseMaterial& m : spec.materials)
+      if (m.incompressible || m.inextensible)
+        r.problem(at, "solver control arc_length: material '" + m.name +
+                          "' is incompressible/inextensible; exact constraints need load control for now");
+    if (spec.loads.empty()) r.problem(at, "solver control arc_length: there is no load to scale");
+  }
   if (spec.solver.dynamic) {
     const YAML::Node at = root["solver"]["analysis"];
     for (const CaseMaterial& m : spec.materials) {

@@ -133,6 +133,11 @@ struct CaseSolver {
   double time_step = 0.0;        // s, first (and largest) time step; 0 = end_time / (10 steps)
   std::string integrator = "generalized-alpha";  // | hht-alpha | newmark
   double rho_inf = 0.8;          // generalised-alpha high-frequency spectral radius
+  // control: arc_length (static only): the load factor is an unknown and each step
+  // advances a fixed path length (mm) through limit points (forming/arc_length.hpp);
+  // steps is then the maximum number of arc-length steps, the run ends past lambda 1.
+  double arc_length = 0.0;       // mm; 0 = load control
+  double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
 };
 
 struct CaseOutput {

@@ -20,6 +20,7 @@
 #include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "common/mesh/surface_mesh.hpp"
+#include "forming/arc_length.hpp"
 #include "forming/dynamics.hpp"
 #include "forming/materials.hpp"
 
@@ -596,6 +597,17 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     write_restart(restart_path, spec, model, restart);
   };
 
+  // Displacement of largest magnitude over the nodes (mm).
+  const auto max_displacement = [&](const VecX& xs) {
+    Vec3 largest = Vec3::Zero();
+    for (int b = 0; b < model.n_bodies(); ++b)
+      for (Index nd = 0; nd < model.ply(b).n_nodes(); ++nd) {
+        Vec3 u;
+        for (int c = 0; c < 3; ++c) u[c] = xs[model.dof(b, nd, 0, c)] - X[model.dof(b, nd, 0, c)];
+        if (u.norm() > largest.norm()) largest = u;
+      }
+    return largest;
+  };
   RunReport report;
   report.status = RunReport::Status::kConverged;
   int last_written = 0;
@@ -603,7 +615,61 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     report.steps_converged = n_steps;
     report.load_factor = lambda_start;
   }
-  for (int k = first_step; k <= n_steps; ++k) {
+  if (spec.solver.arc_length > 0.0) {
+    // Arc-length control: one continuation through the whole load history.
+    if (options.restart) throw UsageError("--restart: not available with solver control arc_length");
+    ArcLengthOptions ao;
+    ao.arc_length = spec.solver.arc_length;
+    ao.max_arc = 10.0 * spec.solver.arc_length;
+    ao.min_arc = spec.solver.arc_length * spec.solver.min_increment;
+    ao.max_steps = n_steps;
+    ao.max_attempts = 4 * n_steps;
+    ao.max_iterations = spec.solver.max_iterations;
+    ao.residual_tol_rel = spec.solver.tolerance;
+    ao.max_load_factor = 1.0;
+    const LoadFunction proportional = [&](double lam, const VecX& xs, bool want_tangent) {
+      return loads.at(model, lam, xs, want_tangent);
+    };
+    int k = 0;
+    const auto on_point = [&](const ArcLengthPoint& pt) {
+      ++k;
+      x = pt.x;
+      const VecX reactions = model.assemble(x, false).force - loads.at(model, pt.lambda, x, false).force;
+      const ToolState ts = history_row(k, pt.lambda, x, reactions, pt.iterations, 0, pt.residual);
+      report.steps_converged = k;
+      report.load_factor = pt.lambda;
+      report.final_residual = pt.residual;
+      report.total_iterations += pt.iterations;
+      report.tool_displacement = ts.displacement;
+      report.tool_force = ts.force;
+      report.max_displacement = max_displacement(x);
+      std::ostringstream os;
+      os << "simform: arc-length step " << k << "  load factor " << pt.lambda << "  Newton " << pt.iterations
+         << "  |r| " << sci(pt.residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
+      cli::status(options.quiet, os.str());
+      if (k % spec.output.every == 0) {
+        write_frame(k, pt.lambda, x);
+        last_written = k;
+        save_restart(k, pt.lambda);
+      }
+      return spec.solver.stop_displacement > 0.0 && max_displacement(x).norm() >= spec.solver.stop_displacement;
+    };
+    const ArcLengthResult ar = solve_arc_length(model, x, targets(prescribed, 0.0), proportional, loads.follower, ao,
+                                                on_point);
+    const bool reached = report.load_factor >= 1.0 ||
+                         (spec.solver.stop_displacement > 0.0 && max_displacement(x).norm() >= spec.solver.stop_displacement);
+    if (!(ar.completed && reached)) {
+      report.status = RunReport::Status::kNotConverged;
+      report.message = "arc-length continuation ended at load factor " + std::to_string(report.load_factor) + ": " +
+                       ar.message + "; results up to arc-length step " + std::to_string(report.steps_converged) +
+                       " are written. Try a smaller arc_length or more steps";
+    } else if (last_written != k) {
+      write_frame(k, report.load_factor, x);
+      last_written = k;
+      save_restart(k, report.load_factor);
+    }
+  }
+  for (int k = first_step; k <= n_steps && spec.solver.arc_length == 0.0; ++k) {
     const double lambda = double(k) / n_steps;
     const Clock::time_point t0 = Clock::now();
     // Within the step the solver's factor s in [0, 1] runs from the previous load
@@ -670,13 +736,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
       }
     const ToolState ts = history_row(k, lambda, x, r.reactions, r.report.total_iterations, r.report.n_cutbacks,
                                      residual);
-    report.max_displacement.setZero();
-    for (int b = 0; b < model.n_bodies(); ++b)
-      for (Index nd = 0; nd < model.ply(b).n_nodes(); ++nd) {
-        Vec3 u;
-        for (int c = 0; c < 3; ++c) u[c] = x[model.dof(b, nd, 0, c)] - X[model.dof(b, nd, 0, c)];
-        if (u.norm() > report.max_displacement.norm()) report.max_displacement = u;
-      }
+    report.max_displacement = max_displacement(x);
     report.steps_converged = k;
     report.load_factor = lambda;
     report.final_residual = residual;

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <memory>
 #include <vector>
 
@@ -20,6 +23,7 @@
 #include "forming/loads.hpp"
 #include "forming/materials.hpp"
 #include "forming/ply_mesh.hpp"
+#include "forming/run.hpp"
 #include "forming/static_solver.hpp"
 
 namespace sf::forming {
@@ -229,6 +233,32 @@ TEST(ArcLength, ShallowArchSnapsThroughItsLimitPoint) {
   std::printf("shallow arch: limit pressure %.6g MPa at crown deflection %.4f mm, falls to %.3g of it; %zu points, "
               "%d cut-backs; load control to 1.05 p_limit stalls at %.4f p_limit\n",
               p_max, crown_at_max, p_min_after / p_max, r.path.size(), r.cutbacks, s.report.load_factor * 1.05);
+}
+
+// The diaphragm-inflation sample (control: arc_length in the case file): the load
+// factor rises to a maximum and falls while the bulge grows; the run ends at the
+// requested displacement, converged.
+TEST(ArcLength, DiaphragmSamplePassesThePressureMaximum) {
+  const FormingCase spec = load_case(std::string(SF_SOURCE_DIR) + "/data/forming/diaphragm_inflation.yaml");
+  RunOptions o;
+  o.quiet = true;
+  o.out_dir = (std::filesystem::temp_directory_path() / "sf_arc_diaphragm").string();
+  const RunReport r = run_case(spec, o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_GE(r.max_displacement.norm(), 150.0);
+  std::ifstream h(o.out_dir + "/history.csv");
+  std::string line;
+  std::getline(h, line);  // header
+  double peak = 0.0, last = 0.0;
+  while (std::getline(h, line)) {
+    const double lam = std::stod(line.substr(line.find(',') + 1));
+    peak = std::max(peak, lam);
+    last = lam;
+  }
+  EXPECT_GT(peak, 0.5);
+  EXPECT_LT(last, 0.8 * peak);
+  std::printf("diaphragm: peak load factor %.4f (%.4f MPa), %.4f at 150 mm\n", peak, 0.02 * peak, last);
+  std::filesystem::remove_all(o.out_dir);
 }
 
 TEST(ArcLength, BadOptionsAreInputErrors) {

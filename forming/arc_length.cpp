@@ -90,8 +90,7 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
     return s;
   };
 
-  linalg::LinearSolver solver(options.linear_solver, unsymmetric ? linalg::MatrixProperty::kUnsymmetric
-                                                                 : linalg::MatrixProperty::kSymmetricIndefinite);
+  TangentSolver solver(options.linear_solver, unsymmetric);
   ArcLengthResult result;
   VecX x = x_start;
   double lambda = 0.0;

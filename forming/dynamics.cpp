@@ -357,8 +357,7 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
   if (on_step) on_step(t, x, v);
 
   // Effective-tangent solver: symmetric until an external tangent has nonzeros.
-  std::unique_ptr<linalg::LinearSolver> solver =
-      std::make_unique<linalg::LinearSolver>(options.linear_solver, linalg::MatrixProperty::kSymmetricIndefinite);
+  std::unique_ptr<TangentSolver> solver = std::make_unique<TangentSolver>(options.linear_solver, false);
   bool unsymmetric = false;
 
   std::vector<double> hits;
@@ -440,8 +439,7 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
           ev.tangent -= (1.0 - af) * ext.tangent;
           if (!unsymmetric) {
             try {
-              solver = std::make_unique<linalg::LinearSolver>(options.linear_solver,
-                                                              linalg::MatrixProperty::kUnsymmetric);
+              solver = std::make_unique<TangentSolver>(options.linear_solver, true);
             } catch (const InputError& e) {
               why = std::string("the external load has an unsymmetric tangent: ") + e.what();
               fatal = true;

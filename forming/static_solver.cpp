@@ -223,6 +223,37 @@ std::string StaticReport::brief() const {
   return os.str();
 }
 
+TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric) {
+  const bool try_cholesky = kind == linalg::SolverKind::kAuto && !unsymmetric &&
+                            linalg::solver_available(linalg::SolverKind::kCholmod);
+  if (try_cholesky)
+    spd_ = std::make_unique<linalg::LinearSolver>(linalg::SolverKind::kCholmod,
+                                                  linalg::MatrixProperty::kSymmetricPositiveDefinite);
+  general_ = std::make_unique<linalg::LinearSolver>(
+      kind, unsymmetric ? linalg::MatrixProperty::kUnsymmetric : linalg::MatrixProperty::kSymmetricIndefinite);
+}
+
+const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& k) {
+  if (spd_ && skip_cholesky_ > 0) {
+    --skip_cholesky_;
+  } else if (spd_) {
+    const linalg::SolveReport& r = spd_->factorize(k);
+    if (r.ok()) {
+      active_ = spd_.get();
+      return r;
+    }
+    skip_cholesky_ = 4;
+  }
+  const linalg::SolveReport& r = general_->factorize(k);
+  active_ = r.ok() ? general_.get() : nullptr;
+  return r;
+}
+
+Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
+  SF_ASSERT(active_ != nullptr, "TangentSolver::solve() needs a successful factorize()");
+  return active_->solve(b);
+}
+
 FreeDofs::FreeDofs(const std::vector<bool>& is_free) {
   const Index n = static_cast<Index>(is_free.size());
   for (Index d = 0; d < n; ++d)
@@ -326,8 +357,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (!a0.ok) return invalid("start state: " + a0.message);
   }
 
-  linalg::LinearSolver solver(options.linear_solver, unsymmetric ? linalg::MatrixProperty::kUnsymmetric
-                                                                 : linalg::MatrixProperty::kSymmetricIndefinite);
+  TangentSolver solver(options.linear_solver, unsymmetric);
   VecX x = x_start;
   double lambda = 0.0;
   double increment = std::min(options.initial_increment, options.max_increment);

@@ -136,6 +136,23 @@ struct FreeDofs {
   VecX restrict(const VecX& v) const;  // the free entries of v (n_dofs)
 };
 
+// Linear solves with a Newton tangent. With kAuto and a symmetric tangent: Cholesky
+// (CHOLMOD) while the tangent is positive definite, as it is at stable equilibria, and
+// a general LU (UMFPACK) for a factorisation where the Cholesky breaks down (past a
+// limit point, under compressive instability). Unsymmetric tangents (follower loads)
+// and an explicit solver kind go straight to that one.
+class TangentSolver {
+ public:
+  TangentSolver(linalg::SolverKind kind, bool unsymmetric);
+  const linalg::SolveReport& factorize(const linalg::SparseMatrix& k);
+  Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+
+ private:
+  std::unique_ptr<linalg::LinearSolver> spd_, general_;
+  const linalg::LinearSolver* active_ = nullptr;
+  int skip_cholesky_ = 0;  // after a breakdown, the next few factorisations go to the LU
+};
+
 // A prescribed dof: its position at load factor 1 (mm; for derivative parameters the
 // arc-length derivative, dimensionless).
 struct PrescribedDof {

@@ -5,22 +5,13 @@
 #include <sstream>
 
 #include "common/core/error.hpp"
+#include "forming/solver_messages.hpp"
 
 namespace sf::forming {
 namespace {
 
 [[noreturn]] void bad_option(const std::string& name, const std::string& expected, double found) {
-  std::ostringstream os;
-  os.precision(10);
-  os << "arc-length " << name << ": expected " << expected << ", found " << found;
-  throw InputError(os.str());
-}
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(4);
-  os << v;
-  return os.str();
+  detail::bad_solver_option("arc-length", name, expected, found);
 }
 
 }  // namespace
@@ -53,13 +44,8 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
     if (p.dof < 0 || p.dof >= n) throw InputError("arc-length: prescribed dof " + std::to_string(p.dof) + " out of range");
     free_dof[p.dof] = false;
   }
-  std::vector<Index> free;
-  for (Index d = 0; d < n; ++d)
-    if (free_dof[d]) free.push_back(d);
-  const Index nf = static_cast<Index>(free.size());
-  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
-  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
-  const FreeDofs free_dofs(is_free);
+  const FreeDofs free_dofs(free_dof);
+  const Index nf = free_dofs.size();
   const linalg::SparseMatrix& select = free_dofs.select;
   auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
 
@@ -104,7 +90,7 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
   int attempts = 0;
   while (static_cast<int>(result.path.size()) - 1 < options.max_steps) {
     if (attempts++ >= options.max_attempts) {
-      result.message = "max_attempts reached at lambda " + fmt(lambda);
+      result.message = "max_attempts reached at lambda " + detail::short_number(lambda);
       return result;
     }
     // Predictor along the tangent.
@@ -162,14 +148,14 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
         dlambda += first ? l1 : l2;
       }
       if (!converged && failure.empty())
-        failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " + fmt(rnorm) + ")";
+        failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " + detail::short_number(rnorm) + ")";
     }
     if (!converged) {
       ++result.cutbacks;
       arc *= 0.5;
       if (arc < options.min_arc) {
-        result.message = "step from lambda " + fmt(lambda) + " failed (" + failure + "); arc length below min_arc " +
-                         fmt(options.min_arc);
+        result.message = "step from lambda " + detail::short_number(lambda) + " failed (" + failure + "); arc length below min_arc " +
+                         detail::short_number(options.min_arc);
         return result;
       }
       continue;
@@ -181,17 +167,17 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
     if (iterations <= options.easy_iterations) arc = std::min(options.max_arc, arc * 1.5);
     if (lambda > options.max_load_factor) {
       result.completed = true;
-      result.message = "load factor " + fmt(lambda) + " passed max_load_factor";
+      result.message = "load factor " + detail::short_number(lambda) + " passed max_load_factor";
       return result;
     }
     if (stop && stop(result.path.back())) {
       result.completed = true;
-      result.message = "stopped by the caller at lambda " + fmt(lambda);
+      result.message = "stopped by the caller at lambda " + detail::short_number(lambda);
       return result;
     }
   }
   result.completed = true;
-  result.message = "max_steps reached at lambda " + fmt(lambda);
+  result.message = "max_steps reached at lambda " + detail::short_number(lambda);
   return result;
 }
 

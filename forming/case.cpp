@@ -374,6 +374,38 @@ std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string
   return std::nullopt;
 }
 
+// The required key "ply" of a condition or load: its name and index; false (with a
+// problem recorded) when missing, not a name or not a ply of the case.
+bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, const FormingCase& spec, std::string& name,
+            int& index) {
+  const YAML::Node p = r.required(b, "ply", what);
+  if (!p.IsDefined()) return false;
+  const auto text = r.text(p, what + " ply");
+  if (!text) return false;
+  name = *text;
+  index = spec.find_ply(*text);
+  if (index < 0) {
+    r.problem(p, what + ": unknown ply '" + *text + "'");
+    return false;
+  }
+  return true;
+}
+
+// The optional key "ramp" (linear or smooth) into `ramp`; false on a bad value.
+bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ramp& ramp) {
+  const YAML::Node rp = b["ramp"];
+  if (!rp.IsDefined()) return true;
+  if (rp.IsScalar() && rp.Scalar() == "linear") {
+    ramp = Ramp::kLinear;
+  } else if (rp.IsScalar() && rp.Scalar() == "smooth") {
+    ramp = Ramp::kSmooth;
+  } else {
+    r.problem(rp, what + " ramp: expected linear or smooth, found " + describe(rp));
+    return false;
+  }
+  return true;
+}
+
 void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   const std::string what = "boundary condition " + std::to_string(index + 1);
   if (!r.mapping(n, what, {"clamp", "displacement", "symmetry"})) return;
@@ -400,17 +432,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     keys.push_back("plane");
   }
   if (!r.mapping(b, bw, keys)) return;
-  bool ok = true;
-  if (const YAML::Node p = r.required(b, "ply", bw); p.IsDefined()) {
-    if (const auto name = r.text(p, bw + " ply")) {
-      bc.ply = *name;
-      bc.ply_index = spec.find_ply(*name);
-      if (bc.ply_index < 0) {
-        r.problem(p, bw + ": unknown ply '" + *name + "'");
-        ok = false;
-      }
-    } else ok = false;
-  } else ok = false;
+  bool ok = ply_of(r, b, bw, spec, bc.ply, bc.ply_index);
   const bool symmetry = bc.kind == CaseBoundary::Kind::kSymmetry;
   const std::string side_key = symmetry ? "plane" : "edge";
   if (const YAML::Node s = r.required(b, side_key, bw); s.IsDefined()) {
@@ -435,14 +457,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
         }
       }
     } else ok = false;
-    if (const YAML::Node rp = b["ramp"]; rp.IsDefined()) {
-      if (rp.IsScalar() && rp.Scalar() == "linear") bc.ramp = Ramp::kLinear;
-      else if (rp.IsScalar() && rp.Scalar() == "smooth") bc.ramp = Ramp::kSmooth;
-      else {
-        r.problem(rp, bw + " ramp: expected linear or smooth, found " + describe(rp));
-        ok = false;
-      }
-    }
+    if (!ramp_of(r, b, bw, bc.ramp)) ok = false;
   }
   if (ok) spec.boundaries.push_back(bc);
 }
@@ -491,19 +506,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
     keys.insert(keys.end(), {"ply", "node", "layer", "force"});
   }
   if (!r.mapping(b, lw, keys)) return;
-  bool ok = true;
-  if (load.kind != CaseLoad::Kind::kGravity) {
-    if (const YAML::Node p = r.required(b, "ply", lw); p.IsDefined()) {
-      if (const auto name = r.text(p, lw + " ply")) {
-        load.ply = *name;
-        load.ply_index = spec.find_ply(*name);
-        if (load.ply_index < 0) {
-          r.problem(p, lw + ": unknown ply '" + *name + "'");
-          ok = false;
-        }
-      } else ok = false;
-    } else ok = false;
-  }
+  bool ok = load.kind == CaseLoad::Kind::kGravity || ply_of(r, b, lw, spec, load.ply, load.ply_index);
   switch (load.kind) {
     case CaseLoad::Kind::kPressure: {
       if (const YAML::Node f = r.required(b, "face", lw); f.IsDefined()) {
@@ -573,14 +576,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
       break;
     }
   }
-  if (const YAML::Node rp = b["ramp"]; rp.IsDefined()) {
-    if (rp.IsScalar() && rp.Scalar() == "linear") load.ramp = Ramp::kLinear;
-    else if (rp.IsScalar() && rp.Scalar() == "smooth") load.ramp = Ramp::kSmooth;
-    else {
-      r.problem(rp, lw + " ramp: expected linear or smooth, found " + describe(rp));
-      ok = false;
-    }
-  }
+  if (!ramp_of(r, b, lw, load.ramp)) ok = false;
   if (ok) spec.loads.push_back(load);
 }
 

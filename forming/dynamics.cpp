@@ -10,22 +10,13 @@
 
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
+#include "forming/solver_messages.hpp"
 
 namespace sf::forming {
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(4);
-  os << v;
-  return os.str();
-}
-
 [[noreturn]] void bad_option(const std::string& name, const std::string& expected, double found) {
-  std::ostringstream os;
-  os.precision(10);
-  os << "dynamic solver " << name << ": expected " << expected << ", found " << found;
-  throw InputError(os.str());
+  detail::bad_solver_option("dynamic solver", name, expected, found);
 }
 
 // Relative size of a Newton correction below which the state is converged even when
@@ -88,7 +79,7 @@ linalg::SparseMatrix mass_matrix(const Model& model, const std::vector<double>& 
         const double det_g = G.determinant();
         if (!(det_g > 0.0))
           throw InputError("mass matrix: body " + std::to_string(b) + " element " + std::to_string(e) +
-                           " has an inverted reference geometry (det G " + fmt(det_g) + " at a Gauss point)");
+                           " has an inverted reference geometry (det G " + detail::short_number(det_g) + " at a Gauss point)");
         m_e.noalias() += (rho * rule.weights[q] * det_g) * (values[q].value * values[q].value.transpose());
       }
       const BrickMap map = ply.element_map(e);
@@ -217,10 +208,10 @@ std::string DynamicReport::brief() const {
   std::ostringstream os;
   os << to_string(status) << ": t " << time << " in " << n_converged_steps << " steps (" << n_cutbacks
      << " cut-backs), " << total_iterations << " Newton iterations";
-  if (n_converged_steps > 0) os << ", dt " << fmt(min_dt_used) << ".." << fmt(max_dt_used);
+  if (n_converged_steps > 0) os << ", dt " << detail::short_number(min_dt_used) << ".." << detail::short_number(max_dt_used);
   for (auto it = steps.rbegin(); it != steps.rend(); ++it)
     if (it->converged && !it->residual_norms.empty()) {
-      os << ", |R| " << fmt(it->residual_norms.back());
+      os << ", |R| " << detail::short_number(it->residual_norms.back());
       break;
     }
   if (!message.empty()) os << "; " << message;
@@ -271,15 +262,13 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
     kind[p.dof] = kPrescribed;
   }
   const std::vector<bool> used = model.used_dofs();
-  std::vector<Index> free;
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
   for (Index d = 0; d < n; ++d) {
     if (!used[d] && kind[d] == kFree) kind[d] = kHeld;
-    if (kind[d] == kFree) free.push_back(d);
+    is_free[static_cast<std::size_t>(d)] = kind[d] == kFree;
   }
-  const Index nf = static_cast<Index>(free.size());
-  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
-  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
   const FreeDofs free_dofs(is_free);
+  const Index nf = free_dofs.size();
   const linalg::SparseMatrix& select = free_dofs.select;
   auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
   // Sets the prescribed dofs of y to their positions at time t; false (and a message)
@@ -288,7 +277,7 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
     for (const TimedDof& p : prescribed) {
       const double value = p.position(t);
       if (!std::isfinite(value)) {
-        why = "prescribed dof " + std::to_string(p.dof) + " has a non-finite position at t = " + fmt(t);
+        why = "prescribed dof " + std::to_string(p.dof) + " has a non-finite position at t = " + detail::short_number(t);
         return false;
       }
       y(p.dof) = value;
@@ -308,7 +297,7 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
       return false;
     }
     if (!out.force.allFinite()) {
-      why = "external force is not finite at t = " + fmt(t);
+      why = "external force is not finite at t = " + detail::short_number(t);
       return false;
     }
     if (out.tangent.nonZeros() > 0 && (out.tangent.rows() != n || out.tangent.cols() != n)) {
@@ -373,7 +362,7 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
   while (t < options.end_time) {
     if (attempts >= options.max_steps) {
       report.status = DynamicReport::Status::kStepFailed;
-      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted time steps reached at t = " + fmt(t);
+      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted time steps reached at t = " + detail::short_number(t);
       break;
     }
     ++attempts;
@@ -471,13 +460,13 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
         break;
       }
       if (rnorm > options.divergence_factor * std::max(first_norm, 1e-300)) {
-        rec.failure = "diverged: |R| " + fmt(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
+        rec.failure = "diverged: |R| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
         failed = true;
         break;
       }
       if (rec.iterations >= options.max_iterations) {
         rec.failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|R| " +
-                      fmt(rnorm) + ", tolerance " + fmt(tol) + ")";
+                      detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
         failed = true;
         break;
       }
@@ -579,14 +568,14 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
     if (options.keep_step_records) report.steps.push_back(std::move(rec));
     if (fatal) {
       report.status = DynamicReport::Status::kStepFailed;
-      report.message = "time step from t = " + fmt(t) + " failed: " + why;
+      report.message = "time step from t = " + detail::short_number(t) + " failed: " + why;
       break;
     }
     dt = std::min(dt, h) * options.cutback_factor;
     if (dt < options.min_dt) {
       report.status = DynamicReport::Status::kStepFailed;
-      report.message = "time step from t = " + fmt(t) + " failed (" + why + "); dt cut back below min_dt " +
-                       fmt(options.min_dt);
+      report.message = "time step from t = " + detail::short_number(t) + " failed (" + why + "); dt cut back below min_dt " +
+                       detail::short_number(options.min_dt);
       break;
     }
   }

@@ -117,7 +117,8 @@ double kinetic_energy(const linalg::SparseMatrix& mass, const Eigen::Ref<const V
 using ExternalForce = ExternalLoad;
 // Called with the time, the positions at which the load acts (x_{n+1-af} during a step,
 // x0 at the start) and whether the tangent is wanted. An empty function = no load.
-using ExternalForceFn = std::function<ExternalForce(double time, const VecX& x, bool want_tangent)>;
+// (The static solver's LoadFunction, with the time in place of the load factor.)
+using ExternalForceFn = LoadFunction;
 
 // A prescribed dof: position(t) (mm; dimensionless for a derivative parameter).
 struct TimedDof {

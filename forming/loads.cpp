@@ -26,6 +26,15 @@ struct FaceMap {
   int s_dir, t_dir;
 };
 
+// The brick point of face parameters (s, t).
+Vec3 face_point(const FaceMap& fm, double s, double t) {
+  Vec3 xi;
+  xi[fm.fixed_dir] = fm.fixed_at;
+  xi[fm.s_dir] = s;
+  xi[fm.t_dir] = t;
+  return xi;
+}
+
 FaceMap face_map(BrickFace f) {
   switch (f) {
     case BrickFace::kBottom:
@@ -110,10 +119,7 @@ ExternalLoad LoadSet::assemble(const Model& model, const Eigen::Ref<const VecX>&
     const bool with_tangent = tangent && !traction && follower;
     for (std::size_t a = 0; a < line.points.size(); ++a)
       for (std::size_t b = 0; b < line.points.size(); ++b) {
-        Vec3 xi;
-        xi[fm.fixed_dir] = fm.fixed_at;
-        xi[fm.s_dir] = line.points[a];
-        xi[fm.t_dir] = line.points[b];
+        const Vec3 xi = face_point(fm, line.points[a], line.points[b]);
         const double w = line.weights[a] * line.weights[b];
         const basis::BrickValues bv = basis::BicubicHermiteLinear::evaluate(xi, basis::kValues | basis::kFirst);
         const Eigen::Matrix<double, kBrickFunctions, 1> ns = bv.first.col(fm.s_dir), nt = bv.first.col(fm.t_dir);
@@ -180,10 +186,7 @@ double face_area(const Model& model, const std::vector<FaceRef>& faces, const Ei
     const FaceMap fm = face_map(f.face);
     for (std::size_t a = 0; a < line.points.size(); ++a)
       for (std::size_t b = 0; b < line.points.size(); ++b) {
-        Vec3 xi;
-        xi[fm.fixed_dir] = fm.fixed_at;
-        xi[fm.s_dir] = line.points[a];
-        xi[fm.t_dir] = line.points[b];
+        const Vec3 xi = face_point(fm, line.points[a], line.points[b]);
         const basis::BrickValues bv = basis::BicubicHermiteLinear::evaluate(xi, basis::kFirst);
         const Vec3 xs = xe.transpose() * bv.first.col(fm.s_dir), xt = xe.transpose() * bv.first.col(fm.t_dir);
         area += line.weights[a] * line.weights[b] * xs.cross(xt).norm();

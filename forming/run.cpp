@@ -524,6 +524,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   std::ostringstream history;
   io::CsvWriter h(history, {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy", "tool_fz",
                             "strain_energy", "newton_iterations", "cutbacks", "residual"});
+  const std::size_t history_header = history.str().size();  // rows after it go into restart.json
   auto history_row = [&](int k, double lambda, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
                          double residual) {
     const ToolState ts = tool_state(tool, x, X, reactions);
@@ -579,18 +580,12 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     history_row(0, 0.0, x, VecX::Zero(model.n_dofs()), 0, 0, 0.0);
     write_frame(0, 0.0, x);
   }
-  const std::string header_line = "step,load_factor,";  // rows after the header go into restart.json
   auto save_restart = [&](int k, double lambda) {
-    const std::string all = history.str();
-    std::string rows;
-    std::istringstream lines(all);
-    for (std::string line; std::getline(lines, line);)
-      if (line.rfind(header_line, 0) != 0) rows += line + "\n";
     restart.step = k;
     restart.load_factor = lambda;
     restart.positions = x;
     restart.velocities = dynamic ? v : VecX();
-    restart.history_rows = rows;
+    restart.history_rows = history.str().substr(history_header);
     restart.frames = frames;
     std::error_code ec;
     std::filesystem::create_directories(options.out_dir, ec);
@@ -611,6 +606,23 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   RunReport report;
   report.status = RunReport::Status::kConverged;
   int last_written = 0;
+  // A converged step k at load factor lambda: its history row and the report fields.
+  const auto record_step = [&](int k, double lambda, const VecX& reactions, int iterations, int cutbacks,
+                               double residual) {
+    const ToolState ts = history_row(k, lambda, x, reactions, iterations, cutbacks, residual);
+    report.max_displacement = max_displacement(x);
+    report.steps_converged = k;
+    report.load_factor = lambda;
+    report.final_residual = residual;
+    report.tool_displacement = ts.displacement;
+    report.tool_force = ts.force;
+  };
+  // Frame k of the current state, and the restart file that points at it.
+  const auto write_step = [&](int k, double lambda) {
+    write_frame(k, lambda, x);
+    last_written = k;
+    save_restart(k, lambda);
+  };
   if (first_step > n_steps) {
     report.steps_converged = n_steps;
     report.load_factor = lambda_start;
@@ -635,23 +647,13 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
       ++k;
       x = pt.x;
       const VecX reactions = model.assemble(x, false).force - loads.at(model, pt.lambda, x, false).force;
-      const ToolState ts = history_row(k, pt.lambda, x, reactions, pt.iterations, 0, pt.residual);
-      report.steps_converged = k;
-      report.load_factor = pt.lambda;
-      report.final_residual = pt.residual;
+      record_step(k, pt.lambda, reactions, pt.iterations, 0, pt.residual);
       report.total_iterations += pt.iterations;
-      report.tool_displacement = ts.displacement;
-      report.tool_force = ts.force;
-      report.max_displacement = max_displacement(x);
       std::ostringstream os;
       os << "simform: arc-length step " << k << "  load factor " << pt.lambda << "  Newton " << pt.iterations
          << "  |r| " << sci(pt.residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
       cli::status(options.quiet, os.str());
-      if (k % spec.output.every == 0) {
-        write_frame(k, pt.lambda, x);
-        last_written = k;
-        save_restart(k, pt.lambda);
-      }
+      if (k % spec.output.every == 0) write_step(k, pt.lambda);
       return spec.solver.stop_displacement > 0.0 && max_displacement(x).norm() >= spec.solver.stop_displacement;
     };
     const ArcLengthResult ar = solve_arc_length(model, x, targets(prescribed, 0.0), proportional, loads.follower, ao,
@@ -664,9 +666,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
                        ar.message + "; results up to arc-length step " + std::to_string(report.steps_converged) +
                        " are written. Try a smaller arc_length or more steps";
     } else if (last_written != k) {
-      write_frame(k, report.load_factor, x);
-      last_written = k;
-      save_restart(k, report.load_factor);
+      write_step(k, report.load_factor);
     }
   }
   for (int k = first_step; k <= n_steps && spec.solver.arc_length == 0.0; ++k) {
@@ -734,14 +734,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
         residual = it->residual_norms.back();
         break;
       }
-    const ToolState ts = history_row(k, lambda, x, r.reactions, r.report.total_iterations, r.report.n_cutbacks,
-                                     residual);
-    report.max_displacement = max_displacement(x);
-    report.steps_converged = k;
-    report.load_factor = lambda;
-    report.final_residual = residual;
-    report.tool_displacement = ts.displacement;
-    report.tool_force = ts.force;
+    record_step(k, lambda, r.reactions, r.report.total_iterations, r.report.n_cutbacks, residual);
     std::ostringstream os;
     os << "simform: step " << k << "/" << n_steps;
     if (dynamic)
@@ -753,11 +746,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
        << "  |r| " << sci(residual) << " N  max |u| " << sci(report.max_displacement.norm()) << " mm";
     cli::status(options.quiet, os.str());
     const bool stop_now = options.stop_after > 0 && k - first_step + 1 >= options.stop_after && k < n_steps;
-    if (k % spec.output.every == 0 || k == n_steps || stop_now) {
-      write_frame(k, lambda, x);
-      last_written = k;
-      save_restart(k, lambda);
-    }
+    if (k % spec.output.every == 0 || k == n_steps || stop_now) write_step(k, lambda);
     if (stop_now) {
       report.status = RunReport::Status::kStopped;
       report.message = "stopped after step " + std::to_string(k) + " of " + std::to_string(n_steps) +
@@ -767,8 +756,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
     }
   }
   if (!report.ok() && report.steps_converged > last_written) {
-    write_frame(report.steps_converged, report.load_factor, x);
-    save_restart(report.steps_converged, report.load_factor);
+    write_step(report.steps_converged, report.load_factor);
   }
 
   const Clock::time_point t_out = Clock::now();

@@ -7,22 +7,13 @@
 #include <utility>
 
 #include "common/core/error.hpp"
+#include "forming/solver_messages.hpp"
 
 namespace sf::forming {
 namespace {
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(4);
-  os << v;
-  return os.str();
-}
-
 [[noreturn]] void bad_option(const std::string& name, const std::string& expected, double found) {
-  std::ostringstream os;
-  os.precision(10);
-  os << "static solver " << name << ": expected " << expected << ", found " << found;
-  throw InputError(os.str());
+  detail::bad_solver_option("static solver", name, expected, found);
 }
 
 // Relative size of the last Newton correction below which the state is converged even
@@ -139,7 +130,7 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) con
       if (!r.ok()) {
         out.ok = false;
         out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
-                      to_string(r.status) + " (min det F " + fmt(r.min_det_f) + ")";
+                      to_string(r.status) + " (min det F " + detail::short_number(r.min_det_f) + ")";
         out.energy = std::numeric_limits<double>::infinity();
         return out;
       }
@@ -216,7 +207,7 @@ std::string StaticReport::brief() const {
      << n_cutbacks << " cut-backs), " << total_iterations << " Newton iterations";
   for (auto it = steps.rbegin(); it != steps.rend(); ++it)
     if (it->converged && !it->residual_norms.empty()) {
-      os << ", |r| " << fmt(it->residual_norms.back());
+      os << ", |r| " << detail::short_number(it->residual_norms.back());
       break;
     }
   if (!message.empty()) os << "; " << message;
@@ -338,15 +329,13 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     target(p.dof) = p.value;
   }
   const std::vector<bool> used = model.used_dofs();
-  std::vector<Index> free;
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
   for (Index d = 0; d < n; ++d) {
     if (!used[d] && kind[d] == kFree) kind[d] = kHeld;
-    if (kind[d] == kFree) free.push_back(d);
+    is_free[static_cast<std::size_t>(d)] = kind[d] == kFree;
   }
-  const Index nf = static_cast<Index>(free.size());
-  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
-  for (Index d : free) is_free[static_cast<std::size_t>(d)] = true;
   const FreeDofs free_dofs(is_free);
+  const Index nf = free_dofs.size();
   const linalg::SparseMatrix& select = free_dofs.select;
   double length_scale = 0.0;
   for (Index d = 0; d < n; ++d) length_scale = std::max(length_scale, std::abs(x_start(d)));
@@ -374,7 +363,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (attempts >= options.max_steps) {
       report.status = StaticReport::Status::kStepFailed;
       report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted load steps reached at lambda " +
-                       fmt(lambda);
+                       detail::short_number(lambda);
       break;
     }
     ++attempts;
@@ -429,14 +418,14 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
         break;
       }
       if (!std::isfinite(rnorm) || rnorm > options.divergence_factor * std::max(first_norm, 1e-300)) {
-        rec.failure = "diverged: |r| " + fmt(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
+        rec.failure = "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
         failed = true;
         break;
       }
       if (rec.iterations >= options.max_iterations) {
         rec.failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " +
-                      fmt(rnorm) + ", tolerance " +
-                      fmt(std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) + ")";
+                      detail::short_number(rnorm) + ", tolerance " +
+                      detail::short_number(std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) + ")";
         failed = true;
         break;
       }
@@ -507,8 +496,8 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     increment *= 0.5;
     if (increment < options.min_increment) {
       report.status = StaticReport::Status::kStepFailed;
-      report.message = "load step from lambda " + fmt(lambda) + " failed (" + why +
-                       "); increment cut back below min_increment " + fmt(options.min_increment);
+      report.message = "load step from lambda " + detail::short_number(lambda) + " failed (" + why +
+                       "); increment cut back below min_increment " + detail::short_number(options.min_increment);
       break;
     }
   }
@@ -547,8 +536,8 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
         rep.converged = false;
         r.report.status = StaticReport::Status::kStepFailed;
         r.report.message = "constraints not met after " + std::to_string(uzawa.max_updates) +
-                           " multiplier updates (max |mean J - 1| " + fmt(rep.max_g_J) + ", max |mean (I4 - 1)/2| " +
-                           fmt(rep.max_g_T) + ", tolerance " + fmt(uzawa.tolerance) + ")";
+                           " multiplier updates (max |mean J - 1| " + detail::short_number(rep.max_g_J) + ", max |mean (I4 - 1)/2| " +
+                           detail::short_number(rep.max_g_T) + ", tolerance " + detail::short_number(uzawa.tolerance) + ")";
         break;
       }
       for (int b = 0; b < model.n_bodies(); ++b) {

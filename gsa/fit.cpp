@@ -144,14 +144,20 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
   return {k1.compress(), k2.compress(), k3.compress(), k4.compress()};
 }
 
-linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
-                                        const std::vector<MeshLocation>& locations) {
-  // Row d = b(xi_d)^T T_e (the element's 16 local functions mapped to its global
-  // dofs), written straight into row-major storage: one row per point, in order.
-  const Index n_points = static_cast<Index>(locations.size());
+namespace {
+
+std::vector<fe::ElementDofMap> element_dof_maps(const mesh::SurfaceMesh& mesh) {
   std::vector<fe::ElementDofMap> maps(mesh.n_elements());
   for (Index e = 0; e < mesh.n_elements(); ++e) maps[e] = fe::element_dof_map(mesh.element_map(e));
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows(n_points, mesh.n_dofs());
+  return maps;
+}
+
+// Row d = b(xi_d)^T T_e (the element's 16 local functions mapped to its global dofs),
+// written straight into row-major storage: one row per point, in order.
+linalg::SparseMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
+                                 const std::vector<MeshLocation>& locations) {
+  const Index n_points = static_cast<Index>(locations.size());
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows(n_points, n_dofs);
   Eigen::VectorXi per_row(n_points);
   for (Index d = 0; d < n_points; ++d)
     per_row[d] = locations[d].element < 0 ? 0 : static_cast<int>(maps[locations[d].element].dofs.size());
@@ -169,6 +175,13 @@ linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
   return out;
 }
 
+}  // namespace
+
+linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
+                                        const std::vector<MeshLocation>& locations) {
+  return collocation(element_dof_maps(mesh), mesh.n_dofs(), locations);
+}
+
 struct FitSystem::Impl {
   const mesh::SurfaceMesh* mesh;
   linalg::SparseMatrix phi, wphi, normal;
@@ -180,21 +193,12 @@ struct FitSystem::Impl {
   MatX probes, probes_rhs;
 };
 
-FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi, const VecX& weights)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->mesh = &mesh;
-  impl_->phi = phi;
-  impl_->w = weights.size() ? weights : VecX::Ones(phi.rows());
-  impl_->wphi = impl_->w.asDiagonal() * phi;
-  impl_->normal = linalg::SparseMatrix(phi.transpose()) * impl_->wphi;
-  impl_->used = mesh.used_dofs();
-}
-
 FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocation>& locations,
                      const VecX& weights)
     : impl_(std::make_unique<Impl>()) {
   impl_->mesh = &mesh;
-  impl_->phi = collocation_matrix(mesh, locations);
+  const std::vector<fe::ElementDofMap> maps = element_dof_maps(mesh);
+  impl_->phi = collocation(maps, mesh.n_dofs(), locations);
   impl_->w = weights.size() ? weights : VecX::Ones(impl_->phi.rows());
   impl_->wphi = impl_->w.asDiagonal() * impl_->phi;
   impl_->used = mesh.used_dofs();
@@ -210,7 +214,7 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocati
   linalg::TripletAssembler normal(mesh.n_dofs(), mesh.n_dofs());
   for (Index e = 0; e < mesh.n_elements(); ++e) {
     const Eigen::Matrix<double, 16, 16> a = local[e].selfadjointView<Eigen::Lower>();
-    add_element_block(normal, fe::element_dof_map(mesh.element_map(e)), a);
+    add_element_block(normal, maps[e], a);
   }
   impl_->normal = normal.compress();
 }
@@ -281,14 +285,6 @@ FitResult FitSystem::solve(const Eigen::Ref<const MatX>& values, const linalg::S
   out.ok = out.parameters.allFinite();
   if (!out.ok) out.message = "surface fit: the solution is not finite";
   return out;
-}
-
-FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
-                    const Eigen::Ref<const MatX>& values, const VecX& weights,
-                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
-                    int trace_probes) {
-  FitSystem system(mesh, phi, weights);
-  return system.solve(values, penalty, reference, trace_probes);
 }
 
 }  // namespace sf::gsa

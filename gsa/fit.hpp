@@ -82,20 +82,23 @@ struct FitResult {
   std::string message;
 };
 
-// A least-squares system (collocation and weights fixed) solved for several
-// penalties in turn: the normal matrix Phi^T W Phi is formed once and the sparse
-// factorisation's symbolic analysis is reused while the pattern stays the same.
+// A least-squares system (point locations and weights fixed) solved for several
+// penalties in turn: the normal matrix Phi^T W Phi (Phi = collocation_matrix(mesh,
+// locations)) is summed once, element by element, and the sparse factorisation's
+// symbolic analysis is reused while the pattern stays the same.
 class FitSystem {
  public:
-  FitSystem(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi, const VecX& weights);
-  // The same system from the points' locations (phi = collocation_matrix(mesh,
-  // locations)); the normal matrix is summed element by element, several times
-  // faster than the sparse product on large grids.
+  // `weights` (n_points, >= 0; 0 excludes a point) may be empty (all 1).
   FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocation>& locations, const VecX& weights);
   ~FitSystem();
   FitSystem(const FitSystem&) = delete;
   FitSystem& operator=(const FitSystem&) = delete;
-  // As fit_field() below, with this system's collocation and weights.
+  // Solves the fit of `values` (n_points x n_components) with `penalty`; `reference`
+  // is U_ref (n_dofs x n_components). Dofs no element uses are pinned to the
+  // reference. With trace_probes > 0 the effective degrees of freedom (trace of the
+  // hat matrix Phi K^-1 Phi^T W, per component) are estimated with that many
+  // Rademacher probes (Hutchinson; fixed seed, drawn once per system) from the same
+  // factorisation.
   FitResult solve(const Eigen::Ref<const MatX>& values, const linalg::SparseMatrix& penalty,
                   const Eigen::Ref<const MatX>& reference, int trace_probes = 0);
 
@@ -103,15 +106,5 @@ class FitSystem {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Solves the fit. `weights` (n_points, >= 0; 0 excludes a point) may be empty
-// (all 1). `reference` is U_ref (n_dofs x n_components). Dofs no element uses are
-// pinned to the reference. With trace_probes > 0 the effective degrees of freedom
-// (trace of the hat matrix Phi K^-1 Phi^T W, per component) are estimated with that
-// many Rademacher probes (Hutchinson; fixed seed) from the same factorisation.
-FitResult fit_field(const mesh::SurfaceMesh& mesh, const linalg::SparseMatrix& phi,
-                    const Eigen::Ref<const MatX>& values, const VecX& weights,
-                    const linalg::SparseMatrix& penalty, const Eigen::Ref<const MatX>& reference,
-                    int trace_probes = 0);
 
 }  // namespace sf::gsa

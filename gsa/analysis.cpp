@@ -1,6 +1,7 @@
 #include "gsa/analysis.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -287,16 +288,59 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   Penalty pen_d = automatic ? penalty_for_noise(res.noise_estimate) : explicit_penalty(Penalty{});
   res.penalty_deformed = pen_d;
   auto tf = Clock::now();
+  // The smoothing acts on the deviation of the deformed surface from the undeformed
+  // one moved rigidly (best fit of the marks): a rigid motion of the deformed scan
+  // then moves the fitted surface with it, exactly.
+  res.rigid = best_rigid_motion(X, x, w_d);
+  MatX reference = res.undeformed_parameters * res.rigid.rotation.transpose();
+  for (Index node = 0; node < mesh.n_nodes(); ++node)
+    reference.row(mesh::SurfaceMesh::dof(node, mesh::kValue)) += res.rigid.translation.transpose();
+  // Each mark's undeformed residual r = X - X^(xi) (the undeformed fit's denoising)
+  // is carried to the deformed state with the mark: the deformed data are x - Q r,
+  // Q the local rotation of the fitted deformation. A mark off the undeformed
+  // surface by r sits off the deformed one by Q r when the part moves rigidly, so
+  // rigid motion of a curved part gives zero strain; with independent noise the
+  // correction is along the deformed normal, where it does not affect strains.
+  const fe::SurfaceField fu(mesh, res.undeformed_parameters);
+  std::vector<Vec3> r_u(static_cast<std::size_t>(m), Vec3::Zero());
+  std::vector<Mat3> frame_u(static_cast<std::size_t>(m), Mat3::Identity());  // [X,1 X,2 N]
+  for (Index k = 0; k < m; ++k) {
+    if (!(w_d[k] > 0)) continue;
+    const fe::SurfacePoint pu = fu.evaluate3(loc[k].element, loc[k].xi, basis::kValues | basis::kFirst);
+    r_u[k] = X.row(k).transpose() - pu.x;
+    frame_u[k] << pu.dx, pu.dx.col(0).cross(pu.dx.col(1)).normalized();
+  }
+  Points3 xt(m, 3);
+  auto transport = [&](const MatX* deformed) {
+    std::optional<fe::SurfaceField> fd;
+    if (deformed) fd.emplace(mesh, *deformed);
+    for (Index k = 0; k < m; ++k) {
+      Mat3 q = res.rigid.rotation;
+      if (fd && w_d[k] > 0) {
+        const fe::SurfacePoint pd = fd->evaluate3(loc[k].element, loc[k].xi, basis::kValues | basis::kFirst);
+        Mat3 frame_d;
+        frame_d << pd.dx, pd.dx.col(0).cross(pd.dx.col(1)).normalized();
+        const Mat3 f = frame_d * frame_u[k].inverse();
+        const Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        const Mat3 polar = svd.matrixU() * svd.matrixV().transpose();
+        if (polar.determinant() > 0 && f.allFinite()) q = polar;
+      }
+      xt.row(k) = x.row(k) - (q * r_u[k]).transpose();
+    }
+  };
+  transport(nullptr);
   // One system per set of weights: rebuilt only when marks are flagged or readmitted.
   auto system = std::make_unique<FitSystem>(mesh, loc, w_d);
   linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
   auto refit = [&](bool weights_changed) {
     if (weights_changed) system = std::make_unique<FitSystem>(mesh, loc, w_d);
-    FitResult f = system->solve(x, pen_mat, res.undeformed_parameters);
+    FitResult f = system->solve(xt, pen_mat, reference);
     if (!f.ok) throw InputError(grid.sources.front() + ": " + f.message);
     return f;
   };
   FitResult fit_d = refit(false);
+  transport(&fit_d.parameters);
+  fit_d = refit(false);
   // Outliers: flag the worst marks beyond the threshold and refit, a few rounds
   // (one bad mark drags its neighbours' residuals up until it is removed).
   for (int round = 0; round < 8; ++round) {
@@ -321,7 +365,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       Penalty p;
       p.gamma = kJumpsGammaFloor * std::pow(d, 4);
       p.delta = std::pow(10.0, log_delta) * std::pow(d, 6);
-      const FitResult f = system->solve(x, penalties.combined(p), res.undeformed_parameters, probes);
+      const FitResult f = system->solve(xt, penalties.combined(p), reference, probes);
       if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
       double rss = 0.0;
       for (Index k = 0; k < m; ++k)
@@ -348,6 +392,8 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     pen_d.delta = options.smoothing_scale * kGcvStrainFactor * std::pow(10.0, res.gcv_log10_delta) * std::pow(d, 6);
     pen_mat = penalties.combined(pen_d);
     res.penalty_deformed = pen_d;
+    fit_d = refit(false);
+    transport(&fit_d.parameters);
     fit_d = refit(false);
   }
   {
@@ -377,7 +423,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
 
   // --- Strains at the marks.
   auto ts = Clock::now();
-  const fe::SurfaceField fu(mesh, res.undeformed_parameters), fd(mesh, res.deformed_parameters);
+  const fe::SurfaceField fd(mesh, res.deformed_parameters);
   for (Index k = 0; k < m; ++k) {
     PointResult& pr = res.points[used[k]];
     pr.element = loc[k].element;
@@ -385,7 +431,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     pr.residual_undeformed = fit_u.residual[k];
     if (pr.status != kStatusOk) continue;
     pr.residual = fit_d.residual[k];
-    const auto b = basis::BicubicHermite::evaluate(loc[k].xi, basis::kFirst);
+    const auto b = basis::BicubicHermite::evaluate(loc[k].xi, basis::kValues | basis::kFirst);
     const fe::SurfacePoint pu = fu.evaluate3(loc[k].element, b), pd = fd.evaluate3(loc[k].element, b);
     pr.strain = surface_strain(pu.dx, pd.dx);
     if (!pr.strain) {

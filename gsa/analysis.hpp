@@ -21,6 +21,7 @@
 #include "common/mesh/surface_mesh.hpp"
 #include "gsa/fit.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/plane.hpp"
 #include "gsa/strain.hpp"
 
 namespace sf::gsa {
@@ -80,6 +81,7 @@ struct AnalysisResult {
   mesh::SurfaceMesh mesh;
   MatX undeformed_parameters, deformed_parameters;  // n_dofs x 3
   Vec3 centroid = Vec3::Zero(), axis1 = Vec3::UnitX(), axis2 = Vec3::UnitY();
+  RigidMotion rigid;  // best-fit rigid motion of the marks, undeformed -> deformed
   int elements1 = 0, elements2 = 0;
   Penalty penalty_undeformed, penalty_deformed;
   PenaltyKind penalty_kind = PenaltyKind::kThirdOrder;

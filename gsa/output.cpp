@@ -1,5 +1,6 @@
 #include "gsa/output.hpp"
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -149,7 +150,11 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                             {"gamma", r.penalty_undeformed.gamma}, {"delta", r.penalty_undeformed.delta}};
     params["deformed"] = {{"alpha", r.penalty_deformed.alpha}, {"beta", r.penalty_deformed.beta},
                           {"gamma", r.penalty_deformed.gamma}, {"delta", r.penalty_deformed.delta},
-                          {"smooths", "displacement"}};
+                          {"smooths", "displacement less its best-fit rigid motion"}};
+    const Eigen::AngleAxisd turn(r.rigid.rotation);
+    params["rigid_motion"] = {{"rotation_deg", turn.angle() * 180.0 / kPi},
+                              {"rotation_axis", {turn.axis()[0], turn.axis()[1], turn.axis()[2]}},
+                              {"translation", {r.rigid.translation[0], r.rigid.translation[1], r.rigid.translation[2]}}};
     params["noise_estimate"] = r.noise_estimate;
     params["mark_spacing"] = r.mark_spacing;
     params["gauge_length"] = r.gauge_length;

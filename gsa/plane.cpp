@@ -1,6 +1,7 @@
 #include "gsa/plane.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -37,6 +38,34 @@ PlaneFrame best_fit_plane(const Points3& pts) {
     f.normal = -f.normal;
   }
   return f;
+}
+
+RigidMotion best_rigid_motion(const Points3& from, const Points3& to, const VecX& weight) {
+  double total = 0.0;
+  Vec3 c_from = Vec3::Zero(), c_to = Vec3::Zero();
+  for (Index i = 0; i < from.rows(); ++i) {
+    if (!(weight[i] > 0.0)) continue;
+    total += weight[i];
+    c_from += weight[i] * from.row(i).transpose();
+    c_to += weight[i] * to.row(i).transpose();
+  }
+  RigidMotion m;
+  if (!(total > 0.0)) return m;
+  c_from /= total;
+  c_to /= total;
+  Mat3 h = Mat3::Zero();  // sum w (to - c_to)(from - c_from)^T
+  for (Index i = 0; i < from.rows(); ++i)
+    if (weight[i] > 0.0)
+      h += weight[i] * (to.row(i).transpose() - c_to) * (from.row(i).transpose() - c_from).transpose();
+  const Eigen::JacobiSVD<Mat3> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Vec3 s = svd.singularValues();
+  if (s[1] > 1e-12 * s[0]) {
+    Mat3 d = Mat3::Identity();
+    d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    m.rotation = svd.matrixU() * d * svd.matrixV().transpose();
+  }
+  m.translation = c_to - m.rotation * c_from;
+  return m;
 }
 
 }  // namespace sf::gsa

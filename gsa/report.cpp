@@ -147,12 +147,16 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
       if (w.is_object())
         t.row(std::string("weights, ") + which + " fit",
               "&alpha; " + text_of(at(w, {"alpha"})) + ", &beta; " + text_of(at(w, {"beta"})) + ", &gamma; " +
-                  text_of(at(w, {"gamma"})));
+                  text_of(at(w, {"gamma"})) + ", &delta; " + text_of(at(w, {"delta"})));
     }
     const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
     if (at(p, {"noise_estimate"}).is_number()) t.row("noise estimate", text_of(at(p, {"noise_estimate"})) + unit);
     if (at(p, {"mark_spacing"}).is_number()) t.row("mark spacing", text_of(at(p, {"mark_spacing"})) + unit);
     if (at(p, {"gauge_length"}).is_number()) t.row("gauge length", text_of(at(p, {"gauge_length"})) + unit);
+    if (at(p, {"rigid_motion"}).is_object())
+      t.row("rigid motion, undeformed to deformed (best fit)",
+            "rotation " + text_of(at(p, {"rigid_motion", "rotation_deg"})) + "&deg;, translation " +
+                text_of(at(p, {"rigid_motion", "translation"})) + unit);
     t.row("outlier threshold (sigmas)", text_of(at(p, {"outlier_sigma"})));
     t.row("fibre angles (deg)", text_of(at(p, {"fibre_angles_deg"})));
     t.row("triangles", text_of(at(p, {"triangles"})));

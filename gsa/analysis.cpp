@@ -1,7 +1,6 @@
 #include "gsa/analysis.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -82,6 +81,22 @@ std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, doub
   for (Index i = 0; i < residual.size(); ++i)
     if (weight[i] > 0 && residual[i] > threshold && residual[i] >= 0.5 * worst) out.push_back(i);
   return out;
+}
+
+// Rotation of the polar decomposition F = Q U, by Newton's iteration
+// Q <- (Q + Q^-T) / 2 (quadratic convergence; a handful of steps for the
+// moderate stretches of a formed sheet). Nothing when F is not invertible with
+// a positive determinant.
+std::optional<Mat3> polar_rotation(const Mat3& f) {
+  if (!f.allFinite() || !(f.determinant() > 0)) return std::nullopt;
+  Mat3 q = f;
+  for (int it = 0; it < 30; ++it) {
+    const Mat3 next = 0.5 * (q + q.inverse().transpose());
+    const double change = (next - q).lpNorm<Eigen::Infinity>();
+    q = next;
+    if (change < 1e-14) break;
+  }
+  return q;
 }
 
 }  // namespace
@@ -227,8 +242,9 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     const int iterations = (automatic && outer == 0) ? 1 : std::max(1, options.max_projection_iterations);
     for (int it = 0; it < iterations; ++it) {
       auto tf = Clock::now();
-      FitSystem system(mesh, loc, w_u);
-      fit_u = system.solve(X, penalties.combined(pen_u), mesh.geometry());
+      FitSystem system(mesh, penalties, loc, w_u);
+      system.set_values(X);
+      fit_u = system.solve(pen_u, mesh.geometry());
       fit_time += seconds_since(tf);
       if (!fit_u.ok) throw InputError(grid.sources.front() + ": " + fit_u.message);
       res.projection_iterations = it + 1;
@@ -311,6 +327,8 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     frame_u[k] << pu.dx, pu.dx.col(0).cross(pu.dx.col(1)).normalized();
   }
   Points3 xt(m, 3);
+  // One system per set of weights: rebuilt only when marks are flagged or readmitted.
+  std::unique_ptr<FitSystem> system;
   auto transport = [&](const MatX* deformed) {
     std::optional<fe::SurfaceField> fd;
     if (deformed) fd.emplace(mesh, *deformed);
@@ -320,21 +338,22 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
         const fe::SurfacePoint pd = fd->evaluate3(loc[k].element, loc[k].xi, basis::kValues | basis::kFirst);
         Mat3 frame_d;
         frame_d << pd.dx, pd.dx.col(0).cross(pd.dx.col(1)).normalized();
-        const Mat3 f = frame_d * frame_u[k].inverse();
-        const Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-        const Mat3 polar = svd.matrixU() * svd.matrixV().transpose();
-        if (polar.determinant() > 0 && f.allFinite()) q = polar;
+        const std::optional<Mat3> polar = polar_rotation(frame_d * frame_u[k].inverse());
+        if (polar) q = *polar;
       }
       xt.row(k) = x.row(k) - (q * r_u[k]).transpose();
     }
+    if (system) system->set_values(xt);
   };
   transport(nullptr);
-  // One system per set of weights: rebuilt only when marks are flagged or readmitted.
-  auto system = std::make_unique<FitSystem>(mesh, loc, w_d);
-  linalg::SparseMatrix pen_mat = penalties.combined(pen_d);
+  system = std::make_unique<FitSystem>(mesh, penalties, loc, w_d);
+  system->set_values(xt);
   auto refit = [&](bool weights_changed) {
-    if (weights_changed) system = std::make_unique<FitSystem>(mesh, loc, w_d);
-    FitResult f = system->solve(xt, pen_mat, reference);
+    if (weights_changed) {
+      system = std::make_unique<FitSystem>(mesh, penalties, loc, w_d);
+      system->set_values(xt);
+    }
+    FitResult f = system->solve(pen_d, reference);
     if (!f.ok) throw InputError(grid.sources.front() + ": " + f.message);
     return f;
   };
@@ -355,17 +374,21 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   if (automatic && options.penalty == PenaltyKind::kJumps) {
     // Smoothing by generalised cross-validation on the deformed positions, then
     // scaled up: GCV balances position errors, and strains (derivatives) want
-    // more smoothing (docs/theory/strain.md). Golden-section search on log10(delta).
+    // more smoothing (docs/theory/strain.md). Search on log10(delta / d^6) in
+    // [-6, 6], two candidates at a time (solved in parallel): the bracket keeps
+    // the best point in its middle and halves each round.
     const double n_used = w_d.sum();
     // Hutchinson probes: the trace estimate's relative error falls as 1/sqrt(probes * N),
     // so large grids need fewer probes for the same GCV curve.
     const int probes = n_used > 20000 ? 6 : 12;
     const double tolerance = n_used > 20000 ? 0.3 : 0.2;
-    auto gcv = [&](double log_delta) {
+    auto penalty_at = [&](double log_delta) {
       Penalty p;
       p.gamma = kJumpsGammaFloor * std::pow(d, 4);
       p.delta = std::pow(10.0, log_delta) * std::pow(d, 6);
-      const FitResult f = system->solve(xt, penalties.combined(p), reference, probes);
+      return p;
+    };
+    auto gcv = [&](const FitResult& f) {
       if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
       double rss = 0.0;
       for (Index k = 0; k < m; ++k)
@@ -373,24 +396,33 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       const double a = 1.0 - f.edf / n_used;
       return rss / (3.0 * n_used) / (a * a);
     };
-    double left = -6.0, right = 6.0;
-    const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
-    double c1 = right - golden * (right - left), c2 = left + golden * (right - left);
-    double g1 = gcv(c1), g2 = gcv(c2);
-    for (int it = 0; it < 14 && right - left > tolerance; ++it) {
-      if (g1 <= g2) {
-        right = c2, c2 = c1, g2 = g1;
-        c1 = right - golden * (right - left), g1 = gcv(c1);
+    auto gcv_pair = [&](double a, double b) {
+      const std::array<FitResult, 2> f = system->solve_pair({penalty_at(a), penalty_at(b)}, reference, probes);
+      return std::array<double, 2>{gcv(f[0]), gcv(f[1])};
+    };
+    double left = -6.0, right = 6.0, best = -2.0;
+    const std::array<double, 2> g0 = gcv_pair(-2.0, 2.0);
+    double g_best = g0[0];
+    if (g0[0] <= g0[1]) {
+      right = 2.0;
+    } else {
+      left = -2.0, best = 2.0, g_best = g0[1];
+    }
+    while (right - left > tolerance) {
+      const double p1 = 0.5 * (left + best), p2 = 0.5 * (best + right);
+      const std::array<double, 2> g = gcv_pair(p1, p2);
+      if (g[0] < g_best && g[0] <= g[1]) {
+        right = best, best = p1, g_best = g[0];
+      } else if (g[1] < g_best) {
+        left = best, best = p2, g_best = g[1];
       } else {
-        left = c1, c1 = c2, g1 = g2;
-        c2 = left + golden * (right - left), g2 = gcv(c2);
+        left = p1, right = p2;
       }
     }
-    res.gcv_log10_delta = 0.5 * (left + right);
+    res.gcv_log10_delta = best;
     pen_d = Penalty{};
     pen_d.gamma = kJumpsGammaFloor * std::pow(d, 4);
     pen_d.delta = options.smoothing_scale * kGcvStrainFactor * std::pow(10.0, res.gcv_log10_delta) * std::pow(d, 6);
-    pen_mat = penalties.combined(pen_d);
     res.penalty_deformed = pen_d;
     fit_d = refit(false);
     transport(&fit_d.parameters);

@@ -3,7 +3,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <random>
+#include <thread>
 
 #include "common/basis/hermite.hpp"
 #include "common/fe/surface_field.hpp"
@@ -46,13 +48,39 @@ void add_element_block(linalg::TripletAssembler& asm_, const fe::ElementDofMap& 
   asm_.add_block(dm.dofs, dm.dofs, kg);
 }
 
-}  // namespace
 
-linalg::SparseMatrix PenaltyMatrices::combined(const Penalty& p) const {
-  linalg::SparseMatrix out = p.alpha * first + p.beta * second + p.gamma * third + p.delta * fourth;
-  out.prune(0.0);
+// Values of `a` at the entries of `pattern` (zero where `a` has none). Both are
+// compressed column-major with sorted row indices, and a's pattern lies in pattern's.
+VecX values_on(const linalg::SparseMatrix& pattern, const linalg::SparseMatrix& a) {
+  VecX out = VecX::Zero(pattern.nonZeros());
+  for (int c = 0; c < pattern.outerSize(); ++c) {
+    int p = pattern.outerIndexPtr()[c];
+    const int p_end = pattern.outerIndexPtr()[c + 1];
+    for (linalg::SparseMatrix::InnerIterator it(a, c); it; ++it) {
+      while (p < p_end && pattern.innerIndexPtr()[p] < it.row()) ++p;
+      out[p] = it.value();
+    }
+  }
   return out;
 }
+
+
+std::vector<fe::ElementDofMap> element_dof_maps(const mesh::SurfaceMesh& mesh) {
+  std::vector<fe::ElementDofMap> maps(mesh.n_elements());
+  for (Index e = 0; e < mesh.n_elements(); ++e) maps[e] = fe::element_dof_map(mesh.element_map(e));
+  return maps;
+}
+
+// Position of entry (row, col) in the values of a compressed column-major matrix
+// with sorted row indices; -1 when the entry is not stored.
+int position(const linalg::SparseMatrix& a, Index row, Index col) {
+  const int* begin = a.innerIndexPtr() + a.outerIndexPtr()[col];
+  const int* end = a.innerIndexPtr() + a.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, static_cast<int>(row));
+  return (it != end && *it == row) ? static_cast<int>(it - a.innerIndexPtr()) : -1;
+}
+
+}  // namespace
 
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
   const Index n = mesh.n_dofs();
@@ -141,141 +169,220 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
       k4.add_block(dofs, dofs, k4j);
     }
   }
-  return {k1.compress(), k2.compress(), k3.compress(), k4.compress()};
+  PenaltyMatrices out;
+  const std::array<linalg::SparseMatrix, 4> orders = {k1.compress(), k2.compress(), k3.compress(), k4.compress()};
+  linalg::SparseMatrix identity(n, n);
+  identity.setIdentity();
+  out.pattern = orders[0] + orders[1] + orders[2] + orders[3] + identity;
+  out.pattern.makeCompressed();
+  for (int i = 0; i < 4; ++i) out.order[i] = values_on(out.pattern, orders[i]);
+  out.diagonal.resize(static_cast<std::size_t>(n));
+  for (int c = 0; c < n; ++c) out.diagonal[static_cast<std::size_t>(c)] = position(out.pattern, c, c);
+  out.maps = element_dof_maps(mesh);
+  out.element_positions.resize(static_cast<std::size_t>(mesh.n_elements()));
+  for (Index e = 0; e < mesh.n_elements(); ++e) {
+    const std::vector<Index>& dofs = out.maps[e].dofs;
+    std::vector<int>& pos = out.element_positions[static_cast<std::size_t>(e)];
+    pos.resize(dofs.size() * dofs.size());
+    for (std::size_t j = 0; j < dofs.size(); ++j)
+      for (std::size_t i = 0; i < dofs.size(); ++i) pos[i + j * dofs.size()] = position(out.pattern, dofs[i], dofs[j]);
+  }
+  return out;
+}
+
+linalg::SparseMatrix PenaltyMatrices::matrix(int order_index) const {
+  linalg::SparseMatrix out = pattern;
+  Eigen::Map<VecX>(out.valuePtr(), out.nonZeros()) = order[static_cast<std::size_t>(order_index)];
+  return out;
 }
 
 namespace {
 
-std::vector<fe::ElementDofMap> element_dof_maps(const mesh::SurfaceMesh& mesh) {
-  std::vector<fe::ElementDofMap> maps(mesh.n_elements());
-  for (Index e = 0; e < mesh.n_elements(); ++e) maps[e] = fe::element_dof_map(mesh.element_map(e));
-  return maps;
-}
+using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 // Row d = b(xi_d)^T T_e (the element's 16 local functions mapped to its global dofs),
-// written straight into row-major storage: one row per point, in order.
-linalg::SparseMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
-                                 const std::vector<MeshLocation>& locations) {
+// written straight into compressed row-major storage, columns ascending.
+RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
+                      const std::vector<MeshLocation>& locations) {
+  std::vector<std::vector<int>> ascending(maps.size());
+  for (std::size_t e = 0; e < maps.size(); ++e) {
+    std::vector<int>& o = ascending[e];
+    o.resize(maps[e].dofs.size());
+    std::iota(o.begin(), o.end(), 0);
+    std::sort(o.begin(), o.end(), [&](int i, int j) { return maps[e].dofs[i] < maps[e].dofs[j]; });
+  }
   const Index n_points = static_cast<Index>(locations.size());
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows(n_points, n_dofs);
-  Eigen::VectorXi per_row(n_points);
-  for (Index d = 0; d < n_points; ++d)
-    per_row[d] = locations[d].element < 0 ? 0 : static_cast<int>(maps[locations[d].element].dofs.size());
-  rows.reserve(per_row);
+  Index nnz = 0;
+  for (const MeshLocation& loc : locations)
+    if (loc.element >= 0) nnz += static_cast<Index>(maps[loc.element].dofs.size());
+  RowMatrix rows(n_points, n_dofs);
+  rows.resizeNonZeros(nnz);
+  int* outer = rows.outerIndexPtr();
+  int* inner = rows.innerIndexPtr();
+  double* value = rows.valuePtr();
+  int p = 0;
+  outer[0] = 0;
   for (Index d = 0; d < n_points; ++d) {
     const MeshLocation& loc = locations[d];
-    if (loc.element < 0) continue;
-    const fe::ElementDofMap& dm = maps[loc.element];
-    const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
-    const Eigen::RowVectorXd row = b.transpose() * dm.t;
-    for (std::size_t j = 0; j < dm.dofs.size(); ++j) rows.insert(d, dm.dofs[j]) = row[static_cast<Index>(j)];
+    if (loc.element >= 0) {
+      const fe::ElementDofMap& dm = maps[loc.element];
+      const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+      const Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 64> row = b.transpose() * dm.t;
+      for (int j : ascending[loc.element]) {
+        inner[p] = static_cast<int>(dm.dofs[j]);
+        value[p++] = row[j];
+      }
+    }
+    outer[d + 1] = p;
   }
-  linalg::SparseMatrix out = rows;
-  out.makeCompressed();
-  return out;
+  return rows;
 }
 
 }  // namespace
 
 linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
                                         const std::vector<MeshLocation>& locations) {
-  return collocation(element_dof_maps(mesh), mesh.n_dofs(), locations);
+  linalg::SparseMatrix out = collocation(element_dof_maps(mesh), mesh.n_dofs(), locations);
+  out.makeCompressed();
+  return out;
 }
 
-struct FitSystem::Impl {
-  const mesh::SurfaceMesh* mesh;
-  linalg::SparseMatrix phi, wphi, normal;
-  VecX w;
-  std::vector<bool> used;
-  linalg::LinearSolver solver{linalg::SolverKind::kAuto, linalg::MatrixProperty::kSymmetricPositiveDefinite};
-  // Hutchinson probes z (n_points x probes) and Phi^T W z, drawn once per system
-  // (fixed seed) and reused by every solve with the same number of probes.
-  MatX probes, probes_rhs;
+// What one solve changes: K and the penalty on the common pattern, the
+// factorisation. Two of them let two penalties be solved at once: the first
+// with the default (CHOLMOD, supernodal, through BLAS), the second with Eigen's
+// own LDL^T: two CHOLMOD factorisations at once, each with its own workspace,
+// still gave wrong fits now and then (seen as flaky tests; the serial OpenBLAS
+// is the likely shared state), and Eigen's solver shares nothing.
+struct FitWorkspace {
+  explicit FitWorkspace(linalg::SolverKind kind) : solver(kind, linalg::MatrixProperty::kSymmetricPositiveDefinite) {}
+  linalg::SparseMatrix k, pen;
+  VecX factored;  // values of the K last factorised
+  linalg::LinearSolver solver;
 };
 
-FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocation>& locations,
-                     const VecX& weights)
+struct FitSystem::Impl {
+  const mesh::SurfaceMesh* mesh = nullptr;
+  const PenaltyMatrices* penalties = nullptr;
+  RowMatrix phi;  // n_points x n_dofs
+  VecX w;
+  std::vector<bool> used;
+  VecX normal_values;  // Phi^T W Phi on the penalties' pattern
+  std::array<std::unique_ptr<FitWorkspace>, 2> work;
+  MatX values, data_rhs;  // z and Phi^T W z
+  // Hutchinson probes z (n_points x probes), drawn once per system (fixed seed)
+  // and reused by every solve with the same number of probes, and Phi^T z, Phi^T W z.
+  MatX probes, probes_plain, probes_weighted;
+
+  FitWorkspace& workspace(int i) {
+    if (!work[i]) {
+      work[i] = std::make_unique<FitWorkspace>(i == 0 ? linalg::SolverKind::kAuto : linalg::SolverKind::kEigenLDLT);
+      work[i]->k = work[i]->pen = penalties->pattern;
+    }
+    return *work[i];
+  }
+  void draw_probes(int count);
+  FitResult solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
+                  int trace_probes) const;
+};
+
+FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties,
+                     const std::vector<MeshLocation>& locations, const VecX& weights)
     : impl_(std::make_unique<Impl>()) {
-  impl_->mesh = &mesh;
-  const std::vector<fe::ElementDofMap> maps = element_dof_maps(mesh);
-  impl_->phi = collocation(maps, mesh.n_dofs(), locations);
-  impl_->w = weights.size() ? weights : VecX::Ones(impl_->phi.rows());
-  impl_->wphi = impl_->w.asDiagonal() * impl_->phi;
-  impl_->used = mesh.used_dofs();
+  Impl& s = *impl_;
+  s.mesh = &mesh;
+  s.penalties = &penalties;
+  s.phi = collocation(penalties.maps, mesh.n_dofs(), locations);
+  s.w = weights.size() ? weights : VecX::Ones(s.phi.rows());
+  s.used = mesh.used_dofs();
   // Sum of w b b^T per element in the element's own basis, then mapped to the
-  // global dofs once per element.
+  // global dofs and added into the pattern's values once per element.
   std::vector<Eigen::Matrix<double, 16, 16>> local(mesh.n_elements(), Eigen::Matrix<double, 16, 16>::Zero());
   for (std::size_t d = 0; d < locations.size(); ++d) {
     const MeshLocation& loc = locations[d];
-    if (loc.element < 0 || !(impl_->w[static_cast<Index>(d)] > 0.0)) continue;
+    if (loc.element < 0 || !(s.w[static_cast<Index>(d)] > 0.0)) continue;
     const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
-    local[loc.element].selfadjointView<Eigen::Lower>().rankUpdate(b, impl_->w[static_cast<Index>(d)]);
+    local[loc.element].noalias() += (s.w[static_cast<Index>(d)] * b) * b.transpose();
   }
-  linalg::TripletAssembler normal(mesh.n_dofs(), mesh.n_dofs());
+  s.normal_values = VecX::Zero(penalties.pattern.nonZeros());
   for (Index e = 0; e < mesh.n_elements(); ++e) {
-    const Eigen::Matrix<double, 16, 16> a = local[e].selfadjointView<Eigen::Lower>();
-    add_element_block(normal, maps[e], a);
+    const fe::ElementDofMap& dm = penalties.maps[e];
+    const Eigen::MatrixXd kg = dm.t.transpose() * local[e] * dm.t;
+    const std::vector<int>& pos = penalties.element_positions[static_cast<std::size_t>(e)];
+    for (Index k = 0; k < kg.size(); ++k) s.normal_values[pos[static_cast<std::size_t>(k)]] += kg.data()[k];
   }
-  impl_->normal = normal.compress();
 }
 
 FitSystem::~FitSystem() = default;
 
-FitResult FitSystem::solve(const Eigen::Ref<const MatX>& values, const linalg::SparseMatrix& penalty,
-                           const Eigen::Ref<const MatX>& reference, int trace_probes) {
+void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
   Impl& s = *impl_;
+  s.values = values;
+  // Phi^T W z over the points with weight > 0 (the others may be NaN).
+  s.data_rhs = MatX::Zero(s.phi.cols(), values.cols());
+  for (Index d = 0; d < s.phi.rows(); ++d) {
+    if (!(s.w[d] > 0.0)) continue;
+    for (decltype(s.phi)::InnerIterator it(s.phi, d); it; ++it)
+      s.data_rhs.row(it.col()) += (s.w[d] * it.value()) * values.row(d);
+  }
+}
+
+void FitSystem::Impl::draw_probes(int count) {
+  if (probes.cols() == count) return;
+  std::mt19937_64 rng(12345);
+  probes.resize(phi.rows(), count);
+  for (Index r = 0; r < probes.rows(); ++r) {
+    std::uint64_t bits = 0;  // one draw gives the signs of 64 probes
+    for (Index c = 0; c < count; ++c) {
+      if (c % 64 == 0) bits = rng();
+      probes(r, c) = (w[r] > 0.0) ? (((bits >> (c % 64)) & 1U) ? 1.0 : -1.0) : 0.0;
+    }
+  }
+  probes_plain = phi.transpose() * probes;
+  probes_weighted = phi.transpose() * (w.asDiagonal() * probes);
+}
+
+FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
+                                 int trace_probes) const {
   FitResult out;
-  const Index n = s.mesh->n_dofs();
-  const VecX& w = s.w;
-  linalg::SparseMatrix k = s.normal + penalty;
-  MatX clean = values;  // points with weight 0 may be NaN (not digitised)
-  for (Index d = 0; d < clean.rows(); ++d)
-    if (!(w[d] > 0.0)) clean.row(d).setZero();
-  MatX rhs = s.wphi.transpose() * clean + penalty * reference;
+  const Index n = mesh->n_dofs();
+  const std::array<VecX, 4>& order = penalties->order;
+  Eigen::Map<VecX> pen_values(ws.pen.valuePtr(), ws.pen.nonZeros());
+  pen_values = penalty.alpha * order[0] + penalty.beta * order[1] + penalty.gamma * order[2] + penalty.delta * order[3];
+  Eigen::Map<VecX> k_values(ws.k.valuePtr(), ws.k.nonZeros());
+  k_values = normal_values + pen_values;
+  MatX rhs = data_rhs + ws.pen * reference;
   // Pin dofs nothing determines (unused by every element, or with an empty row).
   std::vector<Index> pinned;
   for (Index i = 0; i < n; ++i)
-    if (!s.used[i]) pinned.push_back(i);
-  for (Index i : linalg::empty_rows(k))
-    if (s.used[i]) pinned.push_back(i);
-  if (!pinned.empty()) {
-    linalg::TripletAssembler extra(n, n);
-    for (Index i : pinned) {
-      extra.add(i, i, 1.0);
-      rhs.row(i) = reference.row(i);
+    if (!used[i]) pinned.push_back(i);
+  for (Index i : linalg::empty_rows(ws.k))
+    if (used[i]) pinned.push_back(i);
+  for (Index i : pinned) {
+    k_values[penalties->diagonal[static_cast<std::size_t>(i)]] += 1.0;
+    rhs.row(i) = reference.row(i);
+  }
+  if (ws.factored.size() != k_values.size() || ws.factored != k_values) {
+    const linalg::SolveReport& rep = ws.solver.factorize(ws.k);
+    ws.factored = k_values;
+    if (!rep.ok()) {
+      ws.factored.resize(0);
+      out.message = "surface fit: the smoothed least-squares system is singular (" + rep.brief() +
+                    "); too few points for the mesh (try fewer elements), or all points on a line";
+      return out;
     }
-    k += extra.compress();
   }
-  const linalg::SolveReport& rep = s.solver.factorize(k);
-  if (!rep.ok()) {
-    out.message = "surface fit: the smoothed least-squares system is singular (" + rep.brief() +
-                  "); too few points for the mesh (try fewer elements), or all points on a line";
-    return out;
-  }
-  out.parameters = s.solver.solve(rhs);
+  out.parameters = ws.solver.solve(rhs);
   if (trace_probes > 0) {
-    if (s.probes.cols() != trace_probes) {
-      std::mt19937_64 rng(12345);
-      s.probes.resize(s.phi.rows(), trace_probes);
-      for (Index r = 0; r < s.probes.rows(); ++r) {
-        std::uint64_t bits = 0;  // one draw gives the signs of 64 probes
-        for (Index c = 0; c < trace_probes; ++c) {
-          if (c % 64 == 0) bits = rng();
-          s.probes(r, c) = (w[r] > 0.0) ? (((bits >> (c % 64)) & 1U) ? 1.0 : -1.0) : 0.0;
-        }
-      }
-      s.probes_rhs = s.wphi.transpose() * s.probes;
-    }
-    MatX b = s.probes_rhs;
+    // z^T Phi K^-1 Phi^T W z = (Phi^T z)^T K^-1 (Phi^T W z): all in dof space.
+    MatX b = probes_weighted;
     for (Index i : pinned) b.row(i).setZero();
-    const MatX hz = s.phi * s.solver.solve(b);
-    out.edf = (s.probes.array() * hz.array()).sum() / trace_probes;
+    out.edf = (probes_plain.array() * ws.solver.solve(b).array()).sum() / trace_probes;
   }
-  out.fitted = s.phi * out.parameters;
+  out.fitted = phi * out.parameters;
   out.residual = (out.fitted - values).rowwise().norm();
   double sum = 0.0;
   Index count = 0;
-  for (Index d = 0; d < s.phi.rows(); ++d) {
+  for (Index d = 0; d < phi.rows(); ++d) {
     if (w[d] <= 0.0) continue;
     sum += out.residual[d] * out.residual[d];
     out.max = std::max(out.max, out.residual[d]);
@@ -284,6 +391,30 @@ FitResult FitSystem::solve(const Eigen::Ref<const MatX>& values, const linalg::S
   out.rms = count ? std::sqrt(sum / count) : 0.0;
   out.ok = out.parameters.allFinite();
   if (!out.ok) out.message = "surface fit: the solution is not finite";
+  return out;
+}
+
+FitResult FitSystem::solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes) {
+  if (trace_probes > 0) impl_->draw_probes(trace_probes);
+  return impl_->solve(impl_->workspace(0), penalty, reference, trace_probes);
+}
+
+std::array<FitResult, 2> FitSystem::solve_pair(const std::array<Penalty, 2>& penalties,
+                                               const Eigen::Ref<const MatX>& reference, int trace_probes) {
+  Impl& s = *impl_;
+  if (trace_probes > 0) s.draw_probes(trace_probes);
+  FitWorkspace& first = s.workspace(0);
+  FitWorkspace& second = s.workspace(1);
+  std::array<FitResult, 2> out;
+  if (std::thread::hardware_concurrency() < 2) {
+    out[0] = s.solve(first, penalties[0], reference, trace_probes);
+    out[1] = s.solve(second, penalties[1], reference, trace_probes);
+    return out;
+  }
+  const MatX ref = reference;  // the other thread reads its own copy
+  std::thread other([&] { out[1] = s.solve(second, penalties[1], ref, trace_probes); });
+  out[0] = s.solve(first, penalties[0], ref, trace_probes);
+  other.join();
   return out;
 }
 

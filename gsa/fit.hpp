@@ -34,12 +34,14 @@
 // gamma mm^4 per unit data weight (all relative to the data term per point).
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/fe/surface_field.hpp"
 #include "common/linalg/sparse.hpp"
 #include "common/mesh/surface_mesh.hpp"
 
@@ -59,10 +61,18 @@ struct MeshLocation {
 };
 
 // Penalty matrices of each order (n_dofs x n_dofs, symmetric PSD), assembled once
-// and combined with weights later (automatic smoothing tries several).
+// per mesh and weighted later (automatic smoothing tries several weights). They
+// are stored as values on one sparsity pattern that also holds every element
+// block and the diagonal, so K = normal matrix + sum of weighted orders is
+// formed by adding value arrays.
 struct PenaltyMatrices {
-  linalg::SparseMatrix first, second, third, fourth;
-  linalg::SparseMatrix combined(const Penalty& p) const;
+  linalg::SparseMatrix pattern;         // union pattern (its values are not used)
+  std::array<VecX, 4> order;            // first .. fourth order, values on the pattern
+  std::vector<int> diagonal;            // position of (i, i) in the pattern's values
+  std::vector<fe::ElementDofMap> maps;  // element dof maps
+  // Per element: position in the pattern's values of (dofs[i], dofs[j]), at i + j * dofs.size().
+  std::vector<std::vector<int>> element_positions;
+  linalg::SparseMatrix matrix(int order_index) const;  // one order as a matrix (tests, diagnostics)
 };
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
 
@@ -83,24 +93,34 @@ struct FitResult {
 };
 
 // A least-squares system (point locations and weights fixed) solved for several
-// penalties in turn: the normal matrix Phi^T W Phi (Phi = collocation_matrix(mesh,
-// locations)) is summed once, element by element, and the sparse factorisation's
-// symbolic analysis is reused while the pattern stays the same.
+// penalties in turn. Built once: the collocation matrix Phi (collocation_matrix),
+// the normal matrix Phi^T W Phi (summed element by element), and one sparsity
+// pattern holding it and every penalty order, so a new set of weights only
+// rescales stored values; the sparse factorisation's symbolic analysis is reused,
+// and an unchanged matrix is not factorised again.
 class FitSystem {
  public:
   // `weights` (n_points, >= 0; 0 excludes a point) may be empty (all 1).
-  FitSystem(const mesh::SurfaceMesh& mesh, const std::vector<MeshLocation>& locations, const VecX& weights);
+  // `penalties` must outlive the system.
+  FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties,
+            const std::vector<MeshLocation>& locations, const VecX& weights);
   ~FitSystem();
   FitSystem(const FitSystem&) = delete;
   FitSystem& operator=(const FitSystem&) = delete;
-  // Solves the fit of `values` (n_points x n_components) with `penalty`; `reference`
-  // is U_ref (n_dofs x n_components). Dofs no element uses are pinned to the
-  // reference. With trace_probes > 0 the effective degrees of freedom (trace of the
-  // hat matrix Phi K^-1 Phi^T W, per component) are estimated with that many
-  // Rademacher probes (Hutchinson; fixed seed, drawn once per system) from the same
-  // factorisation.
-  FitResult solve(const Eigen::Ref<const MatX>& values, const linalg::SparseMatrix& penalty,
-                  const Eigen::Ref<const MatX>& reference, int trace_probes = 0);
+  // The data z (n_points x n_components; rows with weight 0 may be NaN). Kept
+  // until replaced: every solve() fits these.
+  void set_values(const Eigen::Ref<const MatX>& values);
+  // Fits the values with `penalty`; `reference` is U_ref (n_dofs x n_components).
+  // Dofs no element uses, and dofs nothing determines, are pinned to the
+  // reference. With trace_probes > 0 the effective degrees of freedom (trace of
+  // the hat matrix Phi K^-1 Phi^T W, per component) are estimated with that many
+  // Rademacher probes (Hutchinson; fixed seed, drawn once per system) from the
+  // same factorisation.
+  FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0);
+  // Two penalties at once, on two threads where the machine has two cores (each
+  // with its own factorisation; automatic smoothing compares pairs).
+  std::array<FitResult, 2> solve_pair(const std::array<Penalty, 2>& penalties, const Eigen::Ref<const MatX>& reference,
+                                      int trace_probes = 0);
 
  private:
   struct Impl;

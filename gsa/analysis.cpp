@@ -443,8 +443,19 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   }
   fit_time += seconds_since(tf);
   res.deformed_parameters = fit_d.parameters;
-  res.rms_deformed = fit_d.rms;
-  res.max_deformed = fit_d.max;
+  // Reported residuals: distance of each deformed mark as digitised (not the
+  // transported data) from the fitted surface at its material point.
+  const VecX residual_d = (fit_d.fitted - MatX(x)).rowwise().norm();
+  {
+    double sum = 0.0, count = 0.0;
+    for (Index k = 0; k < m; ++k)
+      if (w_d[k] > 0) {
+        sum += residual_d[k] * residual_d[k];
+        count += 1.0;
+        res.max_deformed = std::max(res.max_deformed, residual_d[k]);
+      }
+    res.rms_deformed = count > 0 ? std::sqrt(sum / count) : 0.0;
+  }
   res.times.fit = fit_time;
   res.times.project = project_time;
   const double rho = 1.0 / (d * d);
@@ -462,7 +473,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     pr.xi = loc[k].xi;
     pr.residual_undeformed = fit_u.residual[k];
     if (pr.status != kStatusOk) continue;
-    pr.residual = fit_d.residual[k];
+    pr.residual = residual_d[k];
     const auto b = basis::BicubicHermite::evaluate(loc[k].xi, basis::kValues | basis::kFirst);
     const fe::SurfacePoint pu = fu.evaluate3(loc[k].element, b), pd = fd.evaluate3(loc[k].element, b);
     pr.strain = surface_strain(pu.dx, pd.dx);

@@ -2,20 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <utility>
 
 namespace sf::gsa {
 
 StrainError strain_error(const GridData& grid, const AnalysisResult& result, const std::vector<ExactStrain>& exact,
                          int border) {
   StrainError e;
-  long imax = 0, jmax = 0;
-  for (Index p = 0; p < grid.n_points(); ++p) {
-    imax = std::max(imax, grid.i[p]);
-    jmax = std::max(jmax, grid.j[p]);
-  }
+  std::set<std::pair<long, long>> present;
+  for (Index p = 0; p < grid.n_points(); ++p) present.insert({grid.i[p], grid.j[p]});
+  // Interior: every grid position within `border` steps (a (2 border + 1)^2 window) holds a mark.
+  auto interior = [&](Index p) {
+    for (long di = -border; di <= border; ++di)
+      for (long dj = -border; dj <= border; ++dj)
+        if (!present.count({grid.i[p] + di, grid.j[p] + dj})) return false;
+    return true;
+  };
   double s1 = 0, s2 = 0, ss = 0;
   for (Index p = 0; p < grid.n_points(); ++p) {
-    if (grid.i[p] < border || grid.j[p] < border || grid.i[p] > imax - border || grid.j[p] > jmax - border) continue;
+    if (!interior(p)) continue;
     const PointResult& pr = result.points[p];
     if (!pr.strain) {
       ++e.n_missing;

@@ -17,8 +17,9 @@ struct StrainError {
   double rms() const { return std::sqrt(0.5 * (rms_e1 * rms_e1 + rms_e2 * rms_e2)); }
 };
 
-// Compares at marks whose grid (i, j) lies at least `border` rows inside the grid
-// edge (border = 1: all but the outermost ring).
+// Compares at marks at least `border` grid steps inside the grid's outline: every
+// grid position (i + di, j + dj), |di|, |dj| <= border, holds a mark (border = 1 on
+// a square grid: all but the outermost ring; on a round one, all but the rim).
 StrainError strain_error(const GridData& grid, const AnalysisResult& result, const std::vector<ExactStrain>& exact,
                          int border = 1);
 

@@ -99,6 +99,63 @@ std::optional<Mat3> polar_rotation(const Mat3& f) {
   return q;
 }
 
+
+// Area of a mesh's surface (4 x 4 Gauss points per element).
+double surface_area(const mesh::SurfaceMesh& mesh) {
+  double area = 0.0;
+  const auto rule = quadrature::gauss_2d(4, 4);
+  const fe::SurfaceField geo(mesh, mesh.geometry());
+  for (Index e = 0; e < mesh.n_elements(); ++e)
+    for (int g = 0; g < rule.size(); ++g) {
+      const Mat32 t = geo.evaluate3(e, rule.points[g], basis::kFirst).dx;
+      area += rule.weights[g] * t.col(0).cross(t.col(1)).norm();
+    }
+  return area;
+}
+
+// An automatic mesh with the marks' starting locations on it.
+struct AutoMesh {
+  mesh::SurfaceMesh mesh;
+  std::vector<MeshLocation> loc;
+  int n1 = 0, n2 = 0;
+  std::string layout;
+};
+
+// Keeps the elements of `full` that hold a mark, renumbering the locations.
+AutoMesh drop_empty_elements(const mesh::SurfaceMesh& full, std::vector<MeshLocation> loc) {
+  std::vector<bool> keep(static_cast<std::size_t>(full.n_elements()), false);
+  for (const MeshLocation& l : loc) keep[static_cast<std::size_t>(l.element)] = true;
+  std::vector<Index> emap;
+  AutoMesh out;
+  out.mesh = mesh::extract_elements(full, keep, &emap);
+  for (MeshLocation& l : loc) l.element = emap[l.element];
+  out.loc = std::move(loc);
+  return out;
+}
+
+// Structured rectangle over the marks' bounding box in the plane (st: in-plane
+// coordinates of the marks), n1 x n2 elements (0: from the number of marks).
+AutoMesh rectangle_layout(const Eigen::MatrixX2d& st, const PlaneFrame& frame, int n1, int n2) {
+  const Eigen::Vector2d lo = st.colwise().minCoeff(), hi = st.colwise().maxCoeff();
+  const double margin = 1e-6 * (hi - lo).maxCoeff();
+  const Eigen::Vector2d lo_m = lo.array() - margin, len = (hi - lo).array() + 2 * margin;
+  if (n1 == 0 || n2 == 0) choose_element_counts(st.rows(), len[0], len[1], n1, n2);
+  const Vec3 origin = frame.centroid + lo_m[0] * frame.a1 + lo_m[1] * frame.a2;
+  const mesh::SurfaceMesh full = mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2);
+  std::vector<MeshLocation> loc(static_cast<std::size_t>(st.rows()));
+  for (Index k = 0; k < st.rows(); ++k) {
+    const double u = (st(k, 0) - lo_m[0]) / len[0] * n1, v = (st(k, 1) - lo_m[1]) / len[1] * n2;
+    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
+    const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
+    loc[k] = {static_cast<Index>(j) * n1 + i, Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0))};
+  }
+  AutoMesh out = drop_empty_elements(full, std::move(loc));
+  out.n1 = n1;
+  out.n2 = n2;
+  out.layout = std::to_string(n1) + "x" + std::to_string(n2);
+  return out;
+}
+
 }  // namespace
 
 void AnalyseOptions::validate() const {
@@ -148,13 +205,6 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     st(k, 0) = d.dot(frame.a1);
     st(k, 1) = d.dot(frame.a2);
   }
-  const Eigen::Vector2d lo = st.colwise().minCoeff(), hi = st.colwise().maxCoeff();
-  const double margin = 1e-6 * (hi - lo).maxCoeff();
-  const Eigen::Vector2d lo_m = lo.array() - margin, len = (hi - lo).array() + 2 * margin;
-  int n1 = options.elements1, n2 = options.elements2;
-  if (n1 == 0 || n2 == 0) choose_element_counts(m, len[0], len[1], n1, n2);
-  res.elements1 = n1;
-  res.elements2 = n2;
   res.centroid = frame.centroid;
   res.axis1 = frame.a1;
   res.axis2 = frame.a2;
@@ -162,7 +212,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   if (!options.mesh_file.empty()) {
     // The user's mesh: marks located by projection onto it.
     res.mesh = read_mesh_file(options.mesh_file);
-    res.elements1 = res.elements2 = 0;
+    res.mesh_layout = "from " + options.mesh_file;
     const mesh::SurfaceProjector projector(res.mesh, res.mesh.geometry());
     const std::vector<mesh::Projection> proj = projector.project_all(X);
     for (Index k = 0; k < m; ++k) {
@@ -171,37 +221,15 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
                          options.mesh_file);
       loc[k] = {proj[k].element, proj[k].xi};
     }
-    double area = 0.0;
-    const auto rule = quadrature::gauss_2d(4, 4);
-    const fe::SurfaceField geo(res.mesh, res.mesh.geometry());
-    for (Index e = 0; e < res.mesh.n_elements(); ++e)
-      for (int g = 0; g < rule.size(); ++g) {
-        const Mat32 t = geo.evaluate3(e, rule.points[g], basis::kFirst).dx;
-        area += rule.weights[g] * t.col(0).cross(t.col(1)).norm();
-      }
-    res.mark_spacing = std::sqrt(area / static_cast<double>(m));
+  } else {
+    AutoMesh am = rectangle_layout(st, frame, options.elements1, options.elements2);
+    res.mesh = std::move(am.mesh);
+    loc = std::move(am.loc);
+    res.elements1 = am.n1;
+    res.elements2 = am.n2;
+    res.mesh_layout = am.layout;
   }
-  const Vec3 origin = frame.centroid + lo_m[0] * frame.a1 + lo_m[1] * frame.a2;
-  const mesh::SurfaceMesh full = options.mesh_file.empty()
-      ? mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2)
-      : mesh::SurfaceMesh();
-  std::vector<MeshLocation> loc_full(m);
-  std::vector<bool> keep(full.n_elements(), false);
-  for (Index k = 0; k < m && options.mesh_file.empty(); ++k) {
-    const double u = (st(k, 0) - lo_m[0]) / len[0] * n1, v = (st(k, 1) - lo_m[1]) / len[1] * n2;
-    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
-    const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
-    loc_full[k].element = static_cast<Index>(j) * n1 + i;
-    loc_full[k].xi = Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0));
-    keep[loc_full[k].element] = true;
-  }
-  if (options.mesh_file.empty()) {
-    std::vector<Index> emap;
-    res.mesh = mesh::extract_elements(full, keep, &emap);
-    for (Index k = 0; k < m; ++k) loc[k] = {emap[loc_full[k].element], loc_full[k].xi};
-    res.mark_spacing = std::sqrt(len[0] * len[1] * static_cast<double>(res.mesh.n_elements()) /
-                                 (static_cast<double>(n1) * n2) / static_cast<double>(m));
-  }
+  res.mark_spacing = std::sqrt(surface_area(res.mesh) / static_cast<double>(m));
   const mesh::SurfaceMesh& mesh = res.mesh;
   const PenaltyMatrices penalties = assemble_penalties(mesh);
   res.times.mesh = seconds_since(t0);

@@ -29,6 +29,7 @@ namespace sf::gsa {
 enum class Method { kSurface, kTriangles };
 enum class PenaltyKind { kThirdOrder, kSobolev, kJumps };
 
+
 struct AnalyseOptions {
   Method method = Method::kSurface;
   PenaltyKind penalty = PenaltyKind::kJumps;
@@ -83,6 +84,7 @@ struct AnalysisResult {
   Vec3 centroid = Vec3::Zero(), axis1 = Vec3::UnitX(), axis2 = Vec3::UnitY();
   RigidMotion rigid;  // best-fit rigid motion of the marks, undeformed -> deformed
   int elements1 = 0, elements2 = 0;
+  std::string mesh_layout;  // "7x7" (automatic rectangle) or "from FILE"
   Penalty penalty_undeformed, penalty_deformed;
   PenaltyKind penalty_kind = PenaltyKind::kThirdOrder;
   bool smoothing_automatic = false;

@@ -161,9 +161,7 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   std::ostringstream msg;
   msg << "gsa: " << ok << " of " << grid.n_points() << " points analysed; results in " << a.out;
   if (result.method == Method::kSurface)
-    msg << " (mesh " << (o.mesh_file.empty() ? std::to_string(result.elements1) + "x" + std::to_string(result.elements2)
-                                              : "from " + o.mesh_file)
-        << ", " << result.mesh.n_elements()
+    msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements()
         << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
         << ")";
   if (plots && plots->flc)
@@ -293,6 +291,7 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--missing", synth->grid.missing_deformed, "Fraction of marks without a deformed position");
         app.add_option("--outliers", synth->grid.outliers, "Number of marks digitised 2 mm off");
         app.add_option("--seed", synth->grid.seed, "Random seed (default 1)");
+        app.add_flag("--round", synth->grid.round, "A round blank: only the marks inside the inscribed circle");
       },
       [synth, prog] { return run_synth(*synth, prog->common().quiet); });
   program.add_command(

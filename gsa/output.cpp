@@ -133,9 +133,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   params["method"] = method_name(r.method);
   if (r.method == Method::kSurface) {
     params["mesh"] = {{"elements", r.mesh.n_elements()},
-                      {"grid", options.mesh_file.empty()
-                                   ? std::to_string(r.elements1) + "x" + std::to_string(r.elements2)
-                                   : "from " + options.mesh_file},
+                      {"grid", r.mesh_layout},
                       {"nodes", r.mesh.n_nodes()},
                       {"unknowns_per_coordinate", r.mesh.n_dofs()},
                       {"element_type", "bicubic Hermite, arc-length scale factors"},

@@ -167,6 +167,29 @@ GridData make_synthetic_grid(const SyntheticCase& c, const SyntheticGridOptions&
     const Index p = (static_cast<Index>(k) * 7919 + n / 3) % n;
     if (g.deformed.row(p).allFinite()) g.deformed(p, 2) += 2.0;
   }
+  if (o.round) {
+    // Keep the marks whose nominal position lies in the inscribed circle.
+    Index kept = 0;
+    for (Index p = 0; p < n; ++p) {
+      const double x = g.j[p] * o.spacing - half, y = g.i[p] * o.spacing - half;
+      if (std::hypot(x, y) > half * (1.0 + 1e-9)) continue;
+      g.ids[kept] = g.ids[p];
+      g.i[kept] = g.i[p];
+      g.j[kept] = g.j[p];
+      g.where[kept] = g.where[p];
+      g.undeformed.row(kept) = g.undeformed.row(p);
+      g.deformed.row(kept) = g.deformed.row(p);
+      if (exact) (*exact)[kept] = (*exact)[p];
+      ++kept;
+    }
+    g.ids.resize(kept);
+    g.i.resize(kept);
+    g.j.resize(kept);
+    g.where.resize(kept);
+    g.undeformed.conservativeResize(kept, 3);
+    g.deformed.conservativeResize(kept, 3);
+    if (exact) exact->resize(kept);
+  }
   return g;
 }
 

@@ -35,6 +35,7 @@ struct SyntheticGridOptions {
   double noise = 0.0;       // standard deviation per coordinate, both states (mm)
   double missing_deformed = 0.0;  // fraction of marks without a deformed position
   int outliers = 0;         // marks moved by 2 mm in the deformed state
+  bool round = false;       // only the marks inside the grid's inscribed circle (a round blank)
   unsigned seed = 1;
 };
 

@@ -321,6 +321,33 @@ TEST(GsaAccuracy, RigidMotionOfTheDeformedScanLeavesStrainsUnchanged) {
   EXPECT_LT(worst, tol::kObjectivity);
 }
 
+// A round blank (the marks inside the grid's inscribed circle): the rectangle mesh
+// keeps the elements holding marks, and the rim marks are fitted with their
+// neighbours on one side only. Measured on the dome, 21 marks across: noise-free
+// RMS 1.9e-5 inside the rim and 3.8e-5 over all marks; at 0.01 mm noise (seeds
+// 1, 2) 0.199 of the classical method's error inside the rim.
+TEST(GsaAccuracy, RoundBlankIsAnalysedLikeASquareOne) {
+  SyntheticGridOptions go;
+  go.round = true;
+  std::vector<ExactStrain> exact;
+  GridData g = make_synthetic_grid(synthetic_case("dome"), go, &exact);
+  ASSERT_LT(g.n_points(), 21 * 21 * 0.8);  // the corners are gone
+  const AnalysisResult res = analyse(g, {});
+  EXPECT_LT(strain_error(g, res, exact).rms(), tol::kDomeRms);
+  EXPECT_LT(strain_error(g, res, exact, /*border=*/0).rms(), 2 * tol::kDomeRms);
+  double s = 0, t = 0;
+  for (unsigned seed = 1; seed <= 2; ++seed) {
+    go.noise = tol::kNoise;
+    go.seed = seed;
+    g = make_synthetic_grid(synthetic_case("dome"), go, &exact);
+    AnalyseOptions o;
+    s += strain_error(g, analyse(g, o), exact).rms();
+    o.method = Method::kTriangles;
+    t += strain_error(g, analyse(g, o), exact).rms();
+  }
+  EXPECT_LT(s, tol::kNoisyCurvedRatio * t) << "ratio " << s / t;
+}
+
 // ---------------------------------------------------------------- noisy: surface vs triangles
 
 // Mean (over seeds 1..2) RMS error of the surface and the triangles method.

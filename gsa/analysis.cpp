@@ -25,7 +25,10 @@ constexpr double kAutoDelta = 20000.0;
 // A whisper of third-order smoothing holds elements the edge jumps alone cannot
 // (a single element, or elements with fewer marks than parameters).
 constexpr double kJumpsGammaFloor = 1e-6;
-constexpr double kGcvStrainFactor = 3.0;
+constexpr double kGcvStrainFactor = 2.0;
+// The automatic deformed fit is iterated once (two passes, iterated Tikhonov): the
+// second pass smooths towards the first one, which squares the smoothing bias.
+constexpr int kAutoFitPasses = 2;
 // The undeformed fit and projection alternate until no mark moves more than this (in xi).
 constexpr double kXiSettled = 1e-4;
 
@@ -357,6 +360,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   Points3 xt(m, 3);
   // One system per set of weights: rebuilt only when marks are flagged or readmitted.
   std::unique_ptr<FitSystem> system;
+  int passes = 1;  // of the deformed fit: kAutoFitPasses once the smoothing is chosen by GCV
   auto transport = [&](const MatX* deformed) {
     std::optional<fe::SurfaceField> fd;
     if (deformed) fd.emplace(mesh, *deformed);
@@ -381,7 +385,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       system = std::make_unique<FitSystem>(mesh, penalties, loc, w_d);
       system->set_values(xt);
     }
-    FitResult f = system->solve(pen_d, reference);
+    FitResult f = system->solve(pen_d, reference, 0, passes);
     if (!f.ok) throw InputError(grid.sources.front() + ": " + f.message);
     return f;
   };
@@ -425,7 +429,8 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       return rss / (3.0 * n_used) / (a * a);
     };
     auto gcv_pair = [&](double a, double b) {
-      const std::array<FitResult, 2> f = system->solve_pair({penalty_at(a), penalty_at(b)}, reference, probes);
+      const std::array<FitResult, 2> f =
+          system->solve_pair({penalty_at(a), penalty_at(b)}, reference, probes, kAutoFitPasses);
       return std::array<double, 2>{gcv(f[0]), gcv(f[1])};
     };
     double left = -6.0, right = 6.0, best = -2.0;
@@ -452,6 +457,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     pen_d.gamma = kJumpsGammaFloor * std::pow(d, 4);
     pen_d.delta = options.smoothing_scale * kGcvStrainFactor * std::pow(10.0, res.gcv_log10_delta) * std::pow(d, 6);
     res.penalty_deformed = pen_d;
+    passes = kAutoFitPasses;
     fit_d = refit(false);
     transport(&fit_d.parameters);
     fit_d = refit(false);

@@ -16,6 +16,17 @@ namespace sf::gsa {
 
 namespace {
 
+// Weights inside the edge-jump term P4 (docs/theory/strain.md). The jump of u,nn
+// weighs kJumpCurvatureWeight times the jump of u,nnn: the fit is held close to C2
+// and the u,nnn jumps (a fourth difference) do the smoothing, which biases smooth
+// fields less than when both jumps count alike.
+constexpr double kJumpCurvatureWeight = 30.0;
+// Edges of an element on the mesh boundary (on the side facing the edge) count
+// this much: there the smoother is one-sided and pulls the boundary element
+// towards its neighbour's polynomial, a bias that grows with the field's fourth
+// derivative at the edge.
+constexpr double kBoundaryEdgeWeight = 0.3;
+
 // Mean element sizes (arc-length scale factors) in the two xi directions.
 std::array<double, 2> element_size(const mesh::Element& el) {
   double h[2] = {0.0, 0.0};
@@ -143,6 +154,13 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         te.col(std::find(dofs.begin(), dofs.end(), dme.dofs[j]) - dofs.begin()) = dme.t.col(j);
       for (std::size_t j = 0; j < dmn.dofs.size(); ++j)
         tn.col(std::find(dofs.begin(), dofs.end(), dmn.dofs[j]) - dofs.begin()) = dmn.t.col(j);
+      // Is either element on the mesh boundary across from this edge?
+      const auto boundary_behind = [&](Index el, int ed) {
+        const int opposite = (ed + 2) % 4;
+        return mesh.neighbour(el, opposite).element < 0 &&
+               !mesh::SurfaceMesh::is_degenerate_edge(mesh.element(el), opposite);
+      };
+      const double w4 = (boundary_behind(e, edge) || boundary_behind(nb.element, nb.edge)) ? kBoundaryEdgeWeight : 1.0;
       Eigen::MatrixXd kj = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
       Eigen::MatrixXd k4j = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
       for (std::size_t g = 0; g < line.points.size(); ++g) {
@@ -153,7 +171,8 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const Eigen::Matrix<double, 16, 1> vn = bicubic_derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
         const Eigen::VectorXd j = te.transpose() * ve - tn.transpose() * vn;
         kj.noalias() += (line.weights[g] * edge_len / h_normal) * j * j.transpose();
-        k4j.noalias() += (line.weights[g] * edge_len / (h_normal * h_normal * h_normal)) * j * j.transpose();
+        k4j.noalias() += (w4 * kJumpCurvatureWeight * line.weights[g] * edge_len / (h_normal * h_normal * h_normal)) *
+                         j * j.transpose();
         // Jump of the third normal derivative. The sign of an odd derivative flips
         // with the direction of xi: the outward normal of e is +xi at edges 1, 2.
         const double se = (edge == 1 || edge == 2) ? 1.0 : -1.0;
@@ -163,7 +182,7 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const Eigen::Matrix<double, 16, 1> wn =
             bicubic_derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) * (sn / std::pow(hn[dir_n], 3));
         const Eigen::VectorXd j3 = te.transpose() * we - tn.transpose() * wn;
-        k4j.noalias() += (line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
+        k4j.noalias() += (w4 * line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
       }
       k3.add_block(dofs, dofs, kj);
       k4.add_block(dofs, dofs, k4j);
@@ -282,7 +301,7 @@ struct FitSystem::Impl {
   }
   void draw_probes(int count);
   FitResult solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
-                  int trace_probes) const;
+                  int trace_probes, int passes) const;
 };
 
 FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties,
@@ -342,7 +361,7 @@ void FitSystem::Impl::draw_probes(int count) {
 }
 
 FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
-                                 int trace_probes) const {
+                                 int trace_probes, int passes) const {
   FitResult out;
   const Index n = mesh->n_dofs();
   const std::array<VecX, 4>& order = penalties->order;
@@ -372,11 +391,24 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
     }
   }
   out.parameters = ws.solver.solve(rhs);
+  // Further passes penalise the deviation from the previous pass (same matrix).
+  for (int pass = 1; pass < passes; ++pass) {
+    MatX r = data_rhs + ws.pen * out.parameters;
+    for (Index i : pinned) r.row(i) = reference.row(i);
+    out.parameters = ws.solver.solve(r);
+  }
   if (trace_probes > 0) {
-    // z^T Phi K^-1 Phi^T W z = (Phi^T z)^T K^-1 (Phi^T W z): all in dof space.
+    // z^T Phi H Phi^T W z = (Phi^T z)^T H (Phi^T W z) with H the (iterated)
+    // smoother in dof space: all in dof space.
     MatX b = probes_weighted;
     for (Index i : pinned) b.row(i).setZero();
-    out.edf = (probes_plain.array() * ws.solver.solve(b).array()).sum() / trace_probes;
+    MatX hb = ws.solver.solve(b);
+    for (int pass = 1; pass < passes; ++pass) {
+      MatX r = b + ws.pen * hb;
+      for (Index i : pinned) r.row(i).setZero();
+      hb = ws.solver.solve(r);
+    }
+    out.edf = (probes_plain.array() * hb.array()).sum() / trace_probes;
   }
   out.fitted = phi * out.parameters;
   out.residual = (out.fitted - values).rowwise().norm();
@@ -394,26 +426,28 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
   return out;
 }
 
-FitResult FitSystem::solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes) {
+FitResult FitSystem::solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes,
+                           int passes) {
   if (trace_probes > 0) impl_->draw_probes(trace_probes);
-  return impl_->solve(impl_->workspace(0), penalty, reference, trace_probes);
+  return impl_->solve(impl_->workspace(0), penalty, reference, trace_probes, passes);
 }
 
 std::array<FitResult, 2> FitSystem::solve_pair(const std::array<Penalty, 2>& penalties,
-                                               const Eigen::Ref<const MatX>& reference, int trace_probes) {
+                                               const Eigen::Ref<const MatX>& reference, int trace_probes,
+                                               int passes) {
   Impl& s = *impl_;
   if (trace_probes > 0) s.draw_probes(trace_probes);
   FitWorkspace& first = s.workspace(0);
   FitWorkspace& second = s.workspace(1);
   std::array<FitResult, 2> out;
   if (std::thread::hardware_concurrency() < 2) {
-    out[0] = s.solve(first, penalties[0], reference, trace_probes);
-    out[1] = s.solve(second, penalties[1], reference, trace_probes);
+    out[0] = s.solve(first, penalties[0], reference, trace_probes, passes);
+    out[1] = s.solve(second, penalties[1], reference, trace_probes, passes);
     return out;
   }
   const MatX ref = reference;  // the other thread reads its own copy
-  std::thread other([&] { out[1] = s.solve(second, penalties[1], ref, trace_probes); });
-  out[0] = s.solve(first, penalties[0], ref, trace_probes);
+  std::thread other([&] { out[1] = s.solve(second, penalties[1], ref, trace_probes, passes); });
+  out[0] = s.solve(first, penalties[0], ref, trace_probes, passes);
   other.join();
   return out;
 }

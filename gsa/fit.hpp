@@ -116,11 +116,16 @@ class FitSystem {
   // the hat matrix Phi K^-1 Phi^T W, per component) are estimated with that many
   // Rademacher probes (Hutchinson; fixed seed, drawn once per system) from the
   // same factorisation.
-  FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0);
+  // With passes > 1 the fit is iterated (iterated Tikhonov): each pass penalises the
+  // deviation from the previous pass's solution instead of from the reference, so
+  // the bias (I - A)(U - U_ref) of one pass becomes (I - A)^passes (U - U_ref); the
+  // degrees of freedom are those of the iterated smoother.
+  FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0,
+                  int passes = 1);
   // Two penalties at once, on two threads where the machine has two cores (each
   // with its own factorisation; automatic smoothing compares pairs).
   std::array<FitResult, 2> solve_pair(const std::array<Penalty, 2>& penalties, const Eigen::Ref<const MatX>& reference,
-                                      int trace_probes = 0);
+                                      int trace_probes = 0, int passes = 1);
 
  private:
   struct Impl;

@@ -54,12 +54,10 @@ inline constexpr double kTrellisRangeDeg = 1.0;
 inline constexpr double kTrellisRms = 1e-4;
 // Noisy grids (0.01 mm, seeds 1..2): mean RMS error of the surface method over that
 // of the triangles method must stay below these. Measured (ratio of the means over
-// seeds 1, 2): rigid 0.086, stretch 0.075; dome 0.240, cylinder 0.260, trellis
-// 0.171 (the target, 0.3, is the bound); wavy 0.366 (target NOT met: the
-// bound records where it stands).
+// seeds 1, 2): rigid 0.086, stretch 0.076; dome 0.184, cylinder 0.219, trellis
+// 0.160, wavy 0.258 (the target, 0.3, is the bound).
 inline constexpr double kNoisyFlatRatio = 0.15;
 inline constexpr double kNoisyCurvedRatio = 0.3;
-inline constexpr double kNoisyWavyRatio = 0.4;
 // Digitisation noise (mm) of the noisy comparisons.
 inline constexpr double kNoise = 0.01;
 // Dome with 10 % of the deformed marks missing, or with 2 outliers, noise-free:
@@ -324,8 +322,8 @@ TEST(GsaAccuracy, RigidMotionOfTheDeformedScanLeavesStrainsUnchanged) {
 // A round blank (the marks inside the grid's inscribed circle): the rectangle mesh
 // keeps the elements holding marks, and the rim marks are fitted with their
 // neighbours on one side only. Measured on the dome, 21 marks across: noise-free
-// RMS 1.9e-5 inside the rim and 3.8e-5 over all marks; at 0.01 mm noise (seeds
-// 1, 2) 0.199 of the classical method's error inside the rim.
+// RMS 1.1e-5 inside the rim and 3.0e-5 over all marks; at 0.01 mm noise (seeds
+// 1, 2) 0.157 of the classical method's error inside the rim.
 TEST(GsaAccuracy, RoundBlankIsAnalysedLikeASquareOne) {
   SyntheticGridOptions go;
   go.round = true;
@@ -389,7 +387,7 @@ INSTANTIATE_TEST_SUITE_P(GsaAccuracy, Noisy,
                                            NoisyCase{"dome", tol::kNoisyCurvedRatio},
                                            NoisyCase{"cylinder", tol::kNoisyCurvedRatio},
                                            NoisyCase{"trellis", tol::kNoisyCurvedRatio},
-                                           NoisyCase{"wavy", tol::kNoisyWavyRatio}),
+                                           NoisyCase{"wavy", tol::kNoisyCurvedRatio}),
                          [](const ::testing::TestParamInfo<NoisyCase>& p) { return p.param.name; });
 
 // ---------------------------------------------------------------- triangles method

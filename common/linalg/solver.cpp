@@ -35,6 +35,7 @@ struct NamedKind {
 constexpr NamedKind kSolverNames[] = {
     {SolverKind::kAuto, "auto"},
     {SolverKind::kCholmod, "cholmod"},
+    {SolverKind::kCholmodSimplicial, "cholmod-simplicial"},
     {SolverKind::kUmfpack, "umfpack"},
     {SolverKind::kEigenLDLT, "eigen-ldlt"},
     {SolverKind::kEigenLU, "eigen-lu"},
@@ -66,11 +67,13 @@ class Backend {
 
 // Eigen's wrapper keeps the CHOLMOD factor protected; the failing column
 // (factor->minor) makes the "not positive definite" message useful.
-class CholmodLlt : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+template <class Wrapper>
+class CholmodLlt : public Wrapper {
  public:
-  const cholmod_factor* factor() const { return m_cholmodFactor; }
+  const cholmod_factor* factor() const { return this->m_cholmodFactor; }
 };
 
+template <class Wrapper>
 class CholmodBackend final : public Backend {
  public:
   CholmodBackend() { llt_.cholmod().print = 0; }  // report through SolveReport, never print
@@ -107,7 +110,7 @@ class CholmodBackend final : public Backend {
   }
 
  private:
-  CholmodLlt llt_;
+  CholmodLlt<Wrapper> llt_;
 };
 
 class UmfpackBackend final : public Backend {
@@ -217,7 +220,9 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
   switch (kind) {
 #if SF_LINALG_HAVE_SUITESPARSE
     case SolverKind::kCholmod:
-      return std::make_unique<CholmodBackend>();
+      return std::make_unique<CholmodBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>>>();
+    case SolverKind::kCholmodSimplicial:
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>();
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif
@@ -271,6 +276,7 @@ SolverKind parse_solver_kind(const std::string& name, const std::string& where) 
 bool solver_available(SolverKind kind) {
   switch (kind) {
     case SolverKind::kCholmod:
+    case SolverKind::kCholmodSimplicial:
     case SolverKind::kUmfpack:
       return SF_LINALG_HAVE_SUITESPARSE != 0;
     default:
@@ -355,7 +361,8 @@ struct LinearSolver::Impl {
 
 LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property)
     : impl_(std::make_unique<Impl>()) {
-  const bool needs_symmetry = kind == SolverKind::kCholmod || kind == SolverKind::kEigenLDLT;
+  const bool needs_symmetry =
+      kind == SolverKind::kCholmod || kind == SolverKind::kCholmodSimplicial || kind == SolverKind::kEigenLDLT;
   if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
     throw InputError(
         fmt::format("linear solver '{}' needs a symmetric matrix, but this system is unsymmetric "

@@ -37,9 +37,12 @@
 
 namespace sf::linalg {
 
-enum class SolverKind { kAuto, kCholmod, kUmfpack, kEigenLDLT, kEigenLU };
+// kCholmod: CHOLMOD's supernodal Cholesky (dense blocks through BLAS);
+// kCholmodSimplicial: its column-by-column Cholesky, which calls no BLAS and so
+// can run on several threads at once (one solver per thread).
+enum class SolverKind { kAuto, kCholmod, kCholmodSimplicial, kUmfpack, kEigenLDLT, kEigenLU };
 
-// "auto", "cholmod", "umfpack", "eigen-ldlt", "eigen-lu".
+// "auto", "cholmod", "cholmod-simplicial", "umfpack", "eigen-ldlt", "eigen-lu".
 std::string to_string(SolverKind kind);
 
 // Inverse of to_string(SolverKind) (exact, lower case). Throws sf::InputError

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -25,9 +26,9 @@ constexpr int kGridSize = 30;                 // 30 x 30 grid -> n = 900
 constexpr int kNumRhs = 4;
 constexpr unsigned kSeed = 20240611;
 
-const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto, SolverKind::kCholmod,
-                                           SolverKind::kUmfpack, SolverKind::kEigenLDLT,
-                                           SolverKind::kEigenLU};
+const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto,      SolverKind::kCholmod,
+                                           SolverKind::kCholmodSimplicial, SolverKind::kUmfpack,
+                                           SolverKind::kEigenLDLT, SolverKind::kEigenLU};
 const std::vector<SolverKind> kLuKinds = {SolverKind::kAuto, SolverKind::kUmfpack,
                                           SolverKind::kEigenLU};
 
@@ -227,6 +228,7 @@ TEST(LinalgSolverKind, UnknownNameThrowsInputErrorNamingWhere) {
 
 TEST(LinalgSolverKind, SymmetricBackendsRejectUnsymmetricProperty) {
   EXPECT_THROW(LinearSolver(SolverKind::kCholmod, MatrixProperty::kUnsymmetric), InputError);
+  EXPECT_THROW(LinearSolver(SolverKind::kCholmodSimplicial, MatrixProperty::kUnsymmetric), InputError);
   EXPECT_THROW(LinearSolver(SolverKind::kEigenLDLT, MatrixProperty::kUnsymmetric), InputError);
   EXPECT_NO_THROW(LinearSolver(SolverKind::kUmfpack, MatrixProperty::kUnsymmetric));
   EXPECT_NO_THROW(LinearSolver(SolverKind::kEigenLU, MatrixProperty::kSymmetricPositiveDefinite));
@@ -313,7 +315,7 @@ TEST(LinalgSolver, AnalyzePatternThenFactorizeReusesIt) {
 
 TEST(LinalgSolver, CholmodReportsIndefiniteMatrixAsSingularWithoutThrowing) {
   const SparseMatrix indefinite = laplacian_2d(kGridSize, -1.0);
-  for (const SolverKind kind : {SolverKind::kCholmod, SolverKind::kAuto}) {
+  for (const SolverKind kind : {SolverKind::kCholmod, SolverKind::kCholmodSimplicial, SolverKind::kAuto}) {
     SCOPED_TRACE(to_string(kind));
     LinearSolver solver(kind, MatrixProperty::kSymmetricPositiveDefinite);
     SolveReport report;
@@ -424,6 +426,33 @@ TEST(LinalgSolver, SolveAcceptsBlocksAndVectorsAndRecordsTiming) {
   EXPECT_EQ(brief.find('\n'), std::string::npos);
   EXPECT_EQ(brief.rfind("cholmod n=900 ", 0), 0u) << brief;
   EXPECT_NE(brief.find(": ok"), std::string::npos) << brief;
+}
+
+
+// gsa's fit solves two penalties at once, one simplicial CHOLMOD solver per
+// thread: concurrent runs must give exactly what one thread gives.
+TEST(LinalgSolver, SimplicialCholmodSolversRunConcurrently) {
+  constexpr int kPairs = 20;
+  constexpr SolverKind kind = SolverKind::kCholmodSimplicial;
+  std::vector<SparseMatrix> matrices;
+  for (int k = 0; k < 2 * kPairs; ++k) matrices.push_back(laplacian_2d(kGridSize, 0.5 + 0.1 * k));
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(matrices[0].rows(), 2);
+  auto solve = [&](LinearSolver& solver, const SparseMatrix& a) {
+    EXPECT_TRUE(solver.factorize(a).ok());
+    return Eigen::MatrixXd(solver.solve(b));
+  };
+  std::vector<Eigen::MatrixXd> sequential, concurrent(matrices.size());
+  {
+    LinearSolver solver(kind);
+    for (const SparseMatrix& a : matrices) sequential.push_back(solve(solver, a));
+  }
+  LinearSolver first(kind), second(kind);
+  for (int k = 0; k < kPairs; ++k) {
+    std::thread other([&] { concurrent[2 * k + 1] = solve(second, matrices[2 * k + 1]); });
+    concurrent[2 * k] = solve(first, matrices[2 * k]);
+    other.join();
+  }
+  for (std::size_t k = 0; k < matrices.size(); ++k) EXPECT_EQ(sequential[k], concurrent[k]) << "system " << k;
 }
 
 }  // namespace

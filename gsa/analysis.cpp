@@ -45,20 +45,19 @@ double median(std::vector<double> v) {
 }
 
 // Marks per element: ~9 for a few hundred marks, growing slowly up to 1e4 marks
-// (22 x 22 elements) and faster beyond, where the element count grows only as
-// N^0.2 (1e5 marks: 28 x 28, 1e6: 35 x 35). The fit-feasibility study found 6-9
-// elements a side best for 21 x 21 marks and 20-50 for 1e5 marks; on a dense grid
-// more elements only add unknowns (the factorisation's cost) while the part's
-// shape, not the mark spacing, sets the resolution it needs: measured on the
-// 100 mm dome with 1e5 marks (gsa_stages_bench), 14, 20, 30 and 51 elements a side
-// gave RMS strain errors 0.97, 1.1, 2.0 and 3.1e-4.
+// (22 x 22 elements on a square part); beyond that the element count stays. The
+// fit-feasibility study found 6-9 elements a side best for 21 x 21 marks and 20-50
+// for 1e5 marks; on a dense grid more elements only add unknowns (the
+// factorisation's cost) while the part's shape, not the mark spacing, sets the
+// resolution it needs. Measured on the 100 mm dome with 1e5 marks
+// (gsa_stages_bench 1e5 N): 16, 20, 22, 24, 28 and 34 elements a side gave RMS
+// strain errors 0.95, 1.16, 1.28, 1.42, 1.69 and 1.93e-4 and fit times 0.32,
+// 0.45, 0.45, 0.61, 0.76 and 1.46 s. Parts with features smaller than an
+// element (about a 22nd of the part) need --elements.
 void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int& n2) {
   constexpr double kDense = 1e4;
-  const double n = std::max(1.0, static_cast<double>(n_marks));
-  const auto total_for = [](double marks) {
-    return marks / (9.0 * std::pow(std::max(1.0, marks / 441.0), 0.27));
-  };
-  const double total = std::max(1.0, n <= kDense ? total_for(n) : total_for(kDense) * std::pow(n / kDense, 0.2));
+  const double n = std::clamp(static_cast<double>(n_marks), 1.0, kDense);
+  const double total = std::max(1.0, n / (9.0 * std::pow(std::max(1.0, n / 441.0), 0.27)));
   n1 = std::max(1, static_cast<int>(std::lround(std::sqrt(total * len1 / len2))));
   n2 = std::max(1, static_cast<int>(std::lround(total / n1)));
   n1 = std::min(n1, 300);
@@ -268,6 +267,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   FitResult fit_u;
   Penalty pen_u = automatic ? penalty_for_noise(0.0) : explicit_penalty(Penalty{});
   double fit_time = 0.0, project_time = 0.0;
+  bool searched = false;  // a global projection has been done
   for (int outer = 0; outer < 8; ++outer) {
     // The first round only estimates the noise: one projection is enough there.
     const int iterations = (automatic && outer == 0) ? 1 : std::max(1, options.max_projection_iterations);
@@ -280,8 +280,19 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       if (!fit_u.ok) throw InputError(grid.sources.front() + ": " + fit_u.message);
       res.projection_iterations = it + 1;
       auto tp = Clock::now();
+      // The first projection searches the whole surface; later ones start from
+      // each mark's last location (the surface moves little between fits).
       const mesh::SurfaceProjector projector(mesh, fit_u.parameters);
-      const std::vector<mesh::Projection> proj = projector.project_all(X);
+      std::vector<mesh::Projection> proj;
+      if (searched) {
+        std::vector<Index> elements(static_cast<std::size_t>(m));
+        std::vector<Vec2> xi(static_cast<std::size_t>(m));
+        for (Index k = 0; k < m; ++k) elements[k] = loc[k].element, xi[k] = loc[k].xi;
+        proj = projector.refine_all(X, elements, xi);
+      } else {
+        proj = projector.project_all(X);
+        searched = true;
+      }
       double max_dxi = 0.0;
       for (Index k = 0; k < m; ++k) {
         if (!proj[k].ok()) continue;

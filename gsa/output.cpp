@@ -6,6 +6,7 @@
 #include <fstream>
 #include <future>
 #include <limits>
+#include <sstream>
 
 #include "common/core/error.hpp"
 #include "common/fe/surface_field.hpp"
@@ -78,32 +79,43 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
       << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
       << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
       << options.units << "); thickness by incompressibility; method " << method_name(result.method) << "\n";
-  io::CsvWriter w(out, strain_columns(options));
+  const std::vector<std::string> columns = strain_columns(options);
   std::unique_ptr<fe::SurfaceField> fu;
   if (result.method == Method::kSurface) fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
-  for (Index p = 0; p < grid.n_points(); ++p) {
-    const PointResult& pr = result.points[p];
-    const Fields f = fields_of(pr.strain);
-    w.begin_row().add(grid.ids[p]).add(pr.status);
-    if (pr.element >= 0) w.add(pr.element).add(pr.xi[0]).add(pr.xi[1]);
-    else w.add(kNaN).add(kNaN).add(kNaN);
-    w.add(f.lambda1).add(f.lambda2).add(f.e1).add(f.e2).add(f.eng1).add(f.eng2).add(f.true1).add(f.true2).add(f.thick);
-    for (const Vec3* v : {&f.dir1, &f.dir2, &f.dir1u}) w.add((*v)[0]).add((*v)[1]).add((*v)[2]);
-    w.add(pr.residual).add(pr.residual_undeformed);
-    Vec3 xf = Vec3::Constant(kNaN);
-    if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
-    w.add(xf[0]).add(xf[1]).add(xf[2]);
-    if (options.fibre_angles.size() == 2) {
-      for (int k = 0; k < 2; ++k) {
-        if (pr.fibres.size() == 2 && pr.strain)
-          w.add(pr.fibres[k].direction[0]).add(pr.fibres[k].direction[1]).add(pr.fibres[k].direction[2]).add(pr.fibres[k].stretch);
-        else
-          w.add(kNaN).add(kNaN).add(kNaN).add(kNaN);
+  // Rows [begin, end) as text (formatting numbers is most of the time: large
+  // tables are formatted in two halves at once).
+  auto rows = [&](Index begin, Index end, bool header) {
+    std::ostringstream text;
+    io::CsvWriter w = header ? io::CsvWriter(text, columns) : io::CsvWriter(text, columns.size());
+    for (Index p = begin; p < end; ++p) {
+      const PointResult& pr = result.points[p];
+      const Fields f = fields_of(pr.strain);
+      w.begin_row().add(grid.ids[p]).add(pr.status);
+      if (pr.element >= 0) w.add(pr.element).add(pr.xi[0]).add(pr.xi[1]);
+      else w.add(kNaN).add(kNaN).add(kNaN);
+      w.add(f.lambda1).add(f.lambda2).add(f.e1).add(f.e2).add(f.eng1).add(f.eng2).add(f.true1).add(f.true2).add(f.thick);
+      for (const Vec3* v : {&f.dir1, &f.dir2, &f.dir1u}) w.add((*v)[0]).add((*v)[1]).add((*v)[2]);
+      w.add(pr.residual).add(pr.residual_undeformed);
+      Vec3 xf = Vec3::Constant(kNaN);
+      if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
+      w.add(xf[0]).add(xf[1]).add(xf[2]);
+      if (options.fibre_angles.size() == 2) {
+        for (int k = 0; k < 2; ++k) {
+          if (pr.fibres.size() == 2 && pr.strain)
+            w.add(pr.fibres[k].direction[0]).add(pr.fibres[k].direction[1]).add(pr.fibres[k].direction[2]).add(pr.fibres[k].stretch);
+          else
+            w.add(kNaN).add(kNaN).add(kNaN).add(kNaN);
+        }
+        w.add(pr.strain ? pr.shear_angle_deg : kNaN);
       }
-      w.add(pr.strain ? pr.shear_angle_deg : kNaN);
+      w.end_row();
     }
-    w.end_row();
-  }
+    return text.str();
+  };
+  const Index n = grid.n_points();
+  const Index half = n > 20000 ? n / 2 : n;
+  auto second = std::async(std::launch::async, [&] { return rows(half, n, false); });
+  out << rows(0, half, true) << second.get();
   if (!out) throw Error(path + ": write failed");
 }
 

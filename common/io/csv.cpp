@@ -386,6 +386,11 @@ CsvWriter::CsvWriter(std::ostream& out, std::vector<std::string> header, char de
   end_row();
 }
 
+CsvWriter::CsvWriter(std::ostream& out, std::size_t n_columns, char delimiter)
+    : out_(out), delimiter_(delimiter), n_columns_(n_columns) {
+  if (n_columns == 0) throw std::logic_error("CsvWriter: no columns");
+}
+
 CsvWriter& CsvWriter::begin_row() {
   if (in_row_) throw std::logic_error("CsvWriter: begin_row() inside a row");
   in_row_ = true;

@@ -139,6 +139,9 @@ CsvTable read_csv_string(std::string text, const std::string& name, const CsvOpt
 class CsvWriter {
  public:
   CsvWriter(std::ostream& out, std::vector<std::string> header, char delimiter = ',');
+  // More rows of a table whose header is written elsewhere (rows formatted in
+  // parallel, then concatenated after the header).
+  CsvWriter(std::ostream& out, std::size_t n_columns, char delimiter = ',');
 
   std::size_t n_columns() const { return n_columns_; }
 

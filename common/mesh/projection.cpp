@@ -562,15 +562,15 @@ SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh,
 
 Projection SurfaceProjector::project(const Vec3& p) const { return impl_->project(p); }
 
-std::vector<Projection> SurfaceProjector::project_all(
-    const Eigen::Ref<const Points3>& points) const {
-  const Index n = points.rows();
-  std::vector<Projection> out(static_cast<std::size_t>(n));
-  const std::vector<Index> order = locality_order(points);
+namespace {
+
+// fn(i) for every i in [0, n), in `order` when it is not empty, on up to
+// `threads` std::threads (0: one per core) taking blocks of 256 points.
+template <class Fn>
+void for_each_point(Index n, const std::vector<Index>& order, int threads, const Fn& fn) {
   constexpr Index kBlock = 256;
-  int n_threads = impl_->options.threads;
-  if (n_threads == 0)
-    n_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int n_threads = threads;
+  if (n_threads == 0) n_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   n_threads = static_cast<int>(std::min<Index>(n_threads, (n + kBlock - 1) / kBlock));
   std::atomic<Index> next{0};
   std::exception_ptr error;
@@ -581,10 +581,7 @@ std::vector<Projection> SurfaceProjector::project_all(
         const Index begin = next.fetch_add(kBlock);
         if (begin >= n) break;
         const Index end = std::min(n, begin + kBlock);
-        for (Index k = begin; k < end; ++k) {
-          const Index i = order.empty() ? k : order[static_cast<std::size_t>(k)];
-          out[static_cast<std::size_t>(i)] = impl_->project(points.row(i).transpose());
-        }
+        for (Index k = begin; k < end; ++k) fn(order.empty() ? k : order[static_cast<std::size_t>(k)]);
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(error_mutex);
@@ -597,6 +594,31 @@ std::vector<Projection> SurfaceProjector::project_all(
   worker();
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+std::vector<Projection> SurfaceProjector::project_all(
+    const Eigen::Ref<const Points3>& points) const {
+  std::vector<Projection> out(static_cast<std::size_t>(points.rows()));
+  for_each_point(points.rows(), locality_order(points), impl_->options.threads, [&](Index i) {
+    out[static_cast<std::size_t>(i)] = impl_->project(points.row(i).transpose());
+  });
+  return out;
+}
+
+std::vector<Projection> SurfaceProjector::refine_all(const Eigen::Ref<const Points3>& points,
+                                                     const std::vector<Index>& elements,
+                                                     const std::vector<Vec2>& xi_start) const {
+  if (elements.size() != static_cast<std::size_t>(points.rows()) || xi_start.size() != elements.size())
+    throw InputError("SurfaceProjector::refine_all: " + std::to_string(points.rows()) + " points but " +
+                     std::to_string(elements.size()) + " start elements and " + std::to_string(xi_start.size()) +
+                     " start xi");
+  std::vector<Projection> out(elements.size());
+  for_each_point(points.rows(), locality_order(points), impl_->options.threads, [&](Index i) {
+    out[static_cast<std::size_t>(i)] = refine(points.row(i).transpose(), elements[static_cast<std::size_t>(i)],
+                                              xi_start[static_cast<std::size_t>(i)]);
+  });
   return out;
 }
 

@@ -116,6 +116,10 @@ class SurfaceProjector {
   // re-project a point whose previous location is known. kFailed when element is
   // out of range or p is not finite.
   Projection refine(const Vec3& p, Index element, const Vec2& xi_start) const;
+  // refine() for every row of `points` from its own start (same length), in
+  // parallel like project_all(). Throws sf::InputError on a length mismatch.
+  std::vector<Projection> refine_all(const Eigen::Ref<const Points3>& points, const std::vector<Index>& elements,
+                                     const std::vector<Vec2>& xi_start) const;
 
   const ProjectionOptions& options() const;
   Index n_elements() const;

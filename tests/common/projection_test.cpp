@@ -463,6 +463,39 @@ TEST(ProjectionTest, RefineWalksFromWrongElement) {
   }
 }
 
+// The batch refine from the global answers of a slightly different surface (the
+// alternation of fit and projection in gsa) finds what a global search finds.
+TEST(ProjectionTest, RefineAllFromNearbyStartsMatchesTheGlobalSearch) {
+  const SurfaceMesh mesh = curved_mesh();
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> ux(0.5, 39.5), uy(0.5, 29.5), uz(-1.0, 1.0);
+  Points3 points(3000, 3);
+  for (Index i = 0; i < points.rows(); ++i) {
+    const double x = ux(rng), y = uy(rng);
+    points.row(i) = Vec3(x, y, Height::f(x, y) + uz(rng)).transpose();
+  }
+  MatX moved = mesh.geometry();
+  for (Index node = 0; node < mesh.n_nodes(); ++node)
+    moved(SurfaceMesh::dof(node, kValue), 2) += 0.05 * std::sin(0.3 * static_cast<double>(node));
+  const std::vector<Projection> before = SurfaceProjector(mesh, mesh.geometry()).project_all(points);
+  std::vector<Index> elements;
+  std::vector<Vec2> xi;
+  for (const Projection& r : before) {
+    elements.push_back(r.element);
+    xi.push_back(r.xi);
+  }
+  const SurfaceProjector projector(mesh, moved);
+  const std::vector<Projection> global = projector.project_all(points);
+  const std::vector<Projection> refined = projector.refine_all(points, elements, xi);
+  ASSERT_EQ(refined.size(), global.size());
+  for (std::size_t i = 0; i < global.size(); ++i) {
+    ASSERT_TRUE(refined[i].ok()) << refined[i].brief();
+    EXPECT_NEAR(refined[i].distance, global[i].distance, 1e-9) << i;
+    EXPECT_LT((refined[i].point - global[i].point).norm(), 1e-7) << i;
+  }
+  EXPECT_THROW(projector.refine_all(points, {}, {}), InputError);
+}
+
 TEST(ProjectionTest, BadInputFailsCleanly) {
   const SurfaceMesh mesh = flat_mesh();
   const SurfaceProjector projector(mesh, mesh.geometry());

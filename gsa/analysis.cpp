@@ -19,9 +19,11 @@ namespace sf::gsa {
 namespace {
 
 // Calibration constants of the automatic smoothing (docs/theory/strain.md).
-constexpr double kAutoGamma = 500.0;
-constexpr double kAutoBeta = 200.0;
-constexpr double kAutoDelta = 20000.0;
+// (Calibrated against a noise estimate that was sigma/sqrt(3); rescaled when the
+// estimate was corrected to sigma, so the weights did not change.)
+constexpr double kAutoGamma = 258.7;   // 500 / 3^0.6
+constexpr double kAutoBeta = 115.47;   // 200 / sqrt(3)
+constexpr double kAutoDelta = 11547.0;  // 2e4 / sqrt(3)
 // A whisper of third-order smoothing holds elements the edge jumps alone cannot
 // (a single element, or elements with fewer marks than parameters).
 constexpr double kJumpsGammaFloor = 1e-6;
@@ -64,18 +66,23 @@ void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int
   n2 = std::min(n2, 300);
 }
 
+// Median of |r| over sigma for Gaussian residuals with `dims` components: the
+// undeformed residuals are distances along the normal (projection absorbs the
+// in-plane noise into xi), the deformed ones 3-D vectors at fixed xi.
+double median_over_sigma(int dims) { return dims == 1 ? 0.6745 : 1.5382; }
+
 // Marks whose residual exceeds max(k * robust sigma, floor) and at least half the
 // largest such residual (the worst ones of this round). Robust sigma: the median
-// residual norm / 1.54 (median of a 3-D Gaussian vector's norm is 1.54 sigma).
-double outlier_threshold(const VecX& residual, const VecX& weight, double k, double floor) {
+// residual / median_over_sigma(dims).
+double outlier_threshold(const VecX& residual, const VecX& weight, int dims, double k, double floor) {
   std::vector<double> r;
   for (Index i = 0; i < residual.size(); ++i)
     if (weight[i] > 0) r.push_back(residual[i]);
-  return std::max(k * median(r) / 1.54, floor);
+  return std::max(k * median(r) / median_over_sigma(dims), floor);
 }
 
-std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, double k, double floor) {
-  const double threshold = outlier_threshold(residual, weight, k, floor);
+std::vector<Index> worst_outliers(const VecX& residual, const VecX& weight, int dims, double k, double floor) {
+  const double threshold = outlier_threshold(residual, weight, dims, k, floor);
   double worst = 0.0;
   for (Index i = 0; i < residual.size(); ++i)
     if (weight[i] > 0 && residual[i] > threshold) worst = std::max(worst, residual[i]);
@@ -305,7 +312,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     }
     // Outliers of the undeformed fit (worst first; see the deformed fit).
     bool changed = false;
-    for (Index k : worst_outliers(fit_u.residual, w_u, options.outlier_sigma, 0.02 * d)) {
+    for (Index k : worst_outliers(fit_u.residual, w_u, 1, options.outlier_sigma, 0.02 * d)) {
       w_u[k] = 0.0;
       changed = true;
     }
@@ -317,7 +324,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
       for (Index k = 0; k < m; ++k)
         if (w_u[k] > 0) rss += fit_u.residual[k] * fit_u.residual[k];
       if (outer == 0 && n_used > 1.2 * dofs) {
-        res.noise_estimate = std::sqrt(rss / (3.0 * (n_used - dofs)));
+        res.noise_estimate = std::sqrt(rss / (n_used - dofs));  // normal residuals: one component
         pen_u = penalty_for_noise(res.noise_estimate);
         changed = true;
       }
@@ -406,7 +413,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   // Outliers: flag the worst marks beyond the threshold and refit, a few rounds
   // (one bad mark drags its neighbours' residuals up until it is removed).
   for (int round = 0; round < 8; ++round) {
-    const std::vector<Index> bad = worst_outliers(fit_d.residual, w_d, options.outlier_sigma, 0.02 * d);
+    const std::vector<Index> bad = worst_outliers(fit_d.residual, w_d, 3, options.outlier_sigma, 0.02 * d);
     if (bad.empty()) break;
     for (Index k : bad) {
       w_d[k] = 0.0;
@@ -476,7 +483,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   {
     // Readmit flagged marks that the final surface fits well (good neighbours of a
     // bad mark can exceed the threshold while the bad mark still pulls the fit).
-    const double threshold = outlier_threshold(fit_d.residual, w_d, options.outlier_sigma, 0.02 * d);
+    const double threshold = outlier_threshold(fit_d.residual, w_d, 3, options.outlier_sigma, 0.02 * d);
     bool readmitted = false;
     for (Index k = 0; k < m; ++k)
       if (res.points[used[k]].status == kStatusOutlierDeformed && fit_d.residual[k] < threshold) {

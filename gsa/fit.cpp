@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <future>
 #include <random>
 #include <thread>
 
@@ -309,18 +310,23 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penal
   Impl& s = *impl_;
   s.mesh = &mesh;
   s.penalties = &penalties;
-  s.phi = collocation(penalties.maps, mesh.n_dofs(), locations);
-  s.w = weights.size() ? weights : VecX::Ones(s.phi.rows());
+  s.w = weights.size() ? weights : VecX::Ones(static_cast<Index>(locations.size()));
   s.used = mesh.used_dofs();
-  // Sum of w b b^T per element in the element's own basis, then mapped to the
-  // global dofs and added into the pattern's values once per element.
-  std::vector<Eigen::Matrix<double, 16, 16>> local(mesh.n_elements(), Eigen::Matrix<double, 16, 16>::Zero());
-  for (std::size_t d = 0; d < locations.size(); ++d) {
-    const MeshLocation& loc = locations[d];
-    if (loc.element < 0 || !(s.w[static_cast<Index>(d)] > 0.0)) continue;
-    const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
-    local[loc.element].noalias() += (s.w[static_cast<Index>(d)] * b) * b.transpose();
-  }
+  // Sum of w b b^T per element in the element's own basis (on a second thread
+  // while the collocation matrix is written), then mapped to the global dofs and
+  // added into the pattern's values once per element.
+  auto summed = std::async(std::launch::async, [&] {
+    std::vector<Eigen::Matrix<double, 16, 16>> local(mesh.n_elements(), Eigen::Matrix<double, 16, 16>::Zero());
+    for (std::size_t d = 0; d < locations.size(); ++d) {
+      const MeshLocation& loc = locations[d];
+      if (loc.element < 0 || !(s.w[static_cast<Index>(d)] > 0.0)) continue;
+      const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+      local[loc.element].noalias() += (s.w[static_cast<Index>(d)] * b) * b.transpose();
+    }
+    return local;
+  });
+  s.phi = collocation(penalties.maps, mesh.n_dofs(), locations);
+  const std::vector<Eigen::Matrix<double, 16, 16>> local = summed.get();
   s.normal_values = VecX::Zero(penalties.pattern.nonZeros());
   for (Index e = 0; e < mesh.n_elements(); ++e) {
     const fe::ElementDofMap& dm = penalties.maps[e];

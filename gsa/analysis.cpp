@@ -395,9 +395,6 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     }
     if (system) system->set_values(xt);
   };
-  transport(nullptr);
-  system = std::make_unique<FitSystem>(mesh, penalties, loc, w_d);
-  system->set_values(xt);
   auto refit = [&](bool weights_changed) {
     if (weights_changed) {
       system = std::make_unique<FitSystem>(mesh, penalties, loc, w_d);
@@ -407,7 +404,8 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     if (!f.ok) throw InputError(grid.sources.front() + ": " + f.message);
     return f;
   };
-  FitResult fit_d = refit(false);
+  transport(nullptr);
+  FitResult fit_d = refit(true);
   transport(&fit_d.parameters);
   fit_d = refit(false);
   // Outliers: flag the worst marks beyond the threshold and refit, a few rounds

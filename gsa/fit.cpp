@@ -210,11 +210,6 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
   return out;
 }
 
-linalg::SparseMatrix PenaltyMatrices::matrix(int order_index) const {
-  linalg::SparseMatrix out = pattern;
-  Eigen::Map<VecX>(out.valuePtr(), out.nonZeros()) = order[static_cast<std::size_t>(order_index)];
-  return out;
-}
 
 namespace {
 
@@ -260,12 +255,6 @@ RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
 
 }  // namespace
 
-linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
-                                        const std::vector<MeshLocation>& locations) {
-  linalg::SparseMatrix out = collocation(element_dof_maps(mesh), mesh.n_dofs(), locations);
-  out.makeCompressed();
-  return out;
-}
 
 // What one solve changes: K and the penalty on the common pattern, the
 // factorisation. Two of them let two penalties be solved at once. Both use
@@ -450,9 +439,8 @@ std::array<FitResult, 2> FitSystem::solve_pair(const std::array<Penalty, 2>& pen
     out[1] = s.solve(second, penalties[1], reference, trace_probes, passes);
     return out;
   }
-  const MatX ref = reference;  // the other thread reads its own copy
-  std::thread other([&] { out[1] = s.solve(second, penalties[1], ref, trace_probes, passes); });
-  out[0] = s.solve(first, penalties[0], ref, trace_probes, passes);
+  std::thread other([&] { out[1] = s.solve(second, penalties[1], reference, trace_probes, passes); });
+  out[0] = s.solve(first, penalties[0], reference, trace_probes, passes);
   other.join();
   return out;
 }

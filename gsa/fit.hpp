@@ -72,14 +72,9 @@ struct PenaltyMatrices {
   std::vector<fe::ElementDofMap> maps;  // element dof maps
   // Per element: position in the pattern's values of (dofs[i], dofs[j]), at i + j * dofs.size().
   std::vector<std::vector<int>> element_positions;
-  linalg::SparseMatrix matrix(int order_index) const;  // one order as a matrix (tests, diagnostics)
 };
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
 
-// Sparse collocation matrix Phi (n_points x n_dofs): row d holds the global basis
-// at (e_d, xi_d), so u(xi_d) = Phi U.
-linalg::SparseMatrix collocation_matrix(const mesh::SurfaceMesh& mesh,
-                                        const std::vector<MeshLocation>& locations);
 
 struct FitResult {
   MatX parameters;   // n_dofs x n_components
@@ -93,7 +88,7 @@ struct FitResult {
 };
 
 // A least-squares system (point locations and weights fixed) solved for several
-// penalties in turn. Built once: the collocation matrix Phi (collocation_matrix),
+// penalties in turn. Built once: the collocation matrix Phi (row d: the global basis at (e_d, xi_d)),
 // the normal matrix Phi^T W Phi (summed element by element), and one sparsity
 // pattern holding it and every penalty order, so a new set of weights only
 // rescales stored values; the sparse factorisation's symbolic analysis is reused,

@@ -242,6 +242,8 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   const mesh::SurfaceMesh& mesh = res.mesh;
   const PenaltyMatrices penalties = assemble_penalties(mesh);
   res.times.mesh = seconds_since(t0);
+  cli::status(options.quiet, "gsa: mesh " + res.mesh_layout + " (" + std::to_string(mesh.n_elements()) +
+                                 " elements); fitting the undeformed surface");
 
   // --- Smoothing weights. Automatic: from the estimated noise (see docs/theory/strain.md).
   const double d = res.mark_spacing;
@@ -350,6 +352,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
   if (w_d.sum() < 6)
     throw InputError(grid.sources.front() + ": only " + std::to_string(static_cast<long>(w_d.sum())) +
                      " points have both positions; at least 6 are needed");
+  cli::status(options.quiet, "gsa: fitting the deformed surface");
   Penalty pen_d = automatic ? penalty_for_noise(res.noise_estimate) : explicit_penalty(Penalty{});
   res.penalty_deformed = pen_d;
   auto tf = Clock::now();
@@ -425,6 +428,7 @@ AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options) {
     // more smoothing (docs/theory/strain.md). Search on log10(delta / d^6) in
     // [-6, 6], two candidates at a time (solved in parallel): the bracket keeps
     // the best point in its middle and halves each round.
+    cli::status(options.quiet, "gsa: choosing the smoothing by cross-validation");
     const double n_used = w_d.sum();
     // Hutchinson probes: the trace estimate's relative error falls as 1/sqrt(probes * N),
     // so large grids need fewer probes for the same GCV curve.

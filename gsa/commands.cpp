@@ -6,6 +6,7 @@
 #include <limits>
 #include <iostream>
 #include <optional>
+#include <iomanip>
 #include <sstream>
 
 #include "common/cli/app.hpp"
@@ -149,6 +150,7 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   AnalysisResult result = analyse(grid, o);
   result.times.read = read_s;
   io::AtomicOutputDir out(a.out);
+  cli::status(quiet, "gsa: writing results");
   write_results(out, grid, result, o, info);
   std::optional<PlotSummary> plots;
   if (!a.no_plots) {
@@ -163,7 +165,7 @@ int run_analyse(const AnalyseArgs& a, bool quiet) {
   if (result.method == Method::kSurface)
     msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements()
         << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
-        << ")";
+        << "; gauge length " << std::setprecision(3) << result.gauge_length << " " << o.units << ")";
   if (plots && plots->flc)
     msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
   cli::status(quiet, msg.str());

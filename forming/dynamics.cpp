@@ -5,11 +5,13 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
+#include "forming/line_search.hpp"
 #include "forming/solver_messages.hpp"
 
 namespace sf::forming {
@@ -24,8 +26,6 @@ namespace {
 // Measured: the round-off of f_int at positions of size L drives corrections of
 // 10..40 eps L, so the floor is set well above that.
 constexpr double kIncrementTolRel = 1e-12;
-// Armijo-type sufficient decrease of |R| in the line search.
-constexpr double kSufficientDecrease = 1e-4;
 // A step within this fraction of dt of a target time lands on the target.
 constexpr double kLandingTol = 1e-9;
 
@@ -499,38 +499,27 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
       }
       double step = 1.0;
       if (options.line_search) {
-        double best_step = -1.0, best_norm = std::numeric_limits<double>::infinity();
-        bool accepted = false;
-        for (int ls = 0; ls <= options.max_line_search; ++ls, step *= 0.5) {
-          Eval trial;
-          std::string trial_why;
-          if (!evaluate(y + step * dy, false, trial, trial_why)) {
-            if (fatal) break;
-            continue;
-          }
-          const double tn = free_part(trial.residual).norm();
-          if (tn <= (1.0 - kSufficientDecrease * step) * rnorm) {
-            accepted = true;
-            break;
-          }
-          if (tn < best_norm) {
-            best_norm = tn;
-            best_step = step;
-          }
-        }
-        if (fatal) {
+        const detail::LineSearch ls =
+            detail::backtrack(rnorm, options.max_line_search, [&](double trial_step, bool& stop) -> std::optional<double> {
+              Eval trial;
+              std::string trial_why;
+              if (!evaluate(y + trial_step * dy, false, trial, trial_why)) {
+                stop = fatal;
+                return std::nullopt;
+              }
+              return free_part(trial.residual).norm();
+            });
+        if (ls.stopped) {
           rec.failure = "iteration " + std::to_string(rec.iterations) + ": external force failed";
           failed = true;
           break;
         }
-        if (!accepted) {
-          if (best_step < 0.0) {
-            rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
-            failed = true;
-            break;
-          }
-          step = best_step;
+        if (ls.step < 0.0) {
+          rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+          failed = true;
+          break;
         }
+        step = ls.step;
       }
       y += step * dy;
       rec.step_lengths.push_back(step);

@@ -28,15 +28,20 @@ Vec3 node_normal(const MatX& geometry, Index node) {
   return d1.cross(d2);
 }
 
+// The checks both constructors make of the ply's own numbers.
+void check_ply_parameters(double thickness, double layup_angle_deg) {
+  require(std::isfinite(thickness) && thickness > 0.0, "thickness: expected a positive length (mm)",
+          thickness);
+  require(std::isfinite(layup_angle_deg), "layup angle: expected a finite angle (degrees)",
+          layup_angle_deg);
+}
+
 }  // namespace
 
 PlyMesh::PlyMesh(mesh::SurfaceMesh surface, double thickness, double layup_angle_deg,
                  PlyPlacement placement)
     : surface_(std::move(surface)), thickness_(thickness), layup_angle_deg_(layup_angle_deg) {
-  require(std::isfinite(thickness) && thickness > 0.0, "thickness: expected a positive length (mm)",
-          thickness);
-  require(std::isfinite(layup_angle_deg), "layup angle: expected a finite angle (degrees)",
-          layup_angle_deg);
+  check_ply_parameters(thickness, layup_angle_deg);
   require(surface_.n_nodes() > 0 && surface_.n_elements() > 0,
           "surface: expected at least one element; nodes", static_cast<double>(surface_.n_nodes()));
   const MatX& g = surface_.geometry();
@@ -79,10 +84,7 @@ PlyMesh::PlyMesh(mesh::SurfaceMesh surface, double thickness, double layup_angle
 PlyMesh::PlyMesh(mesh::SurfaceMesh surface, const MatX& bottom, const MatX& top, double thickness,
                  double layup_angle_deg)
     : surface_(std::move(surface)), thickness_(thickness), layup_angle_deg_(layup_angle_deg) {
-  require(std::isfinite(thickness) && thickness > 0.0, "thickness: expected a positive length (mm)",
-          thickness);
-  require(std::isfinite(layup_angle_deg), "layup angle: expected a finite angle (degrees)",
-          layup_angle_deg);
+  check_ply_parameters(thickness, layup_angle_deg);
   require(bottom.rows() == surface_.n_dofs() && bottom.cols() == 3,
           "bottom geometry: expected surface.n_dofs() x 3 rows; rows", static_cast<double>(bottom.rows()));
   require(top.rows() == surface_.n_dofs() && top.cols() == 3,

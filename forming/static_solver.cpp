@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 #include "common/core/error.hpp"
+#include "forming/line_search.hpp"
 #include "forming/solver_messages.hpp"
 
 namespace sf::forming {
@@ -19,8 +21,6 @@ namespace {
 // Relative size of the last Newton correction below which the state is converged even
 // when the residual test is not met (round-off floor of the residual).
 constexpr double kIncrementTolRel = 1e-14;
-// Armijo-type sufficient decrease of |r| in the line search.
-constexpr double kSufficientDecrease = 1e-4;
 
 }  // namespace
 
@@ -453,28 +453,15 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       }
       double alpha = 1.0;
       if (options.line_search) {
-        double best_alpha = -1.0, best_norm = std::numeric_limits<double>::infinity();
-        bool accepted = false;
-        for (int ls = 0; ls <= options.max_line_search; ++ls, alpha *= 0.5) {
-          const State trial = evaluate(lam_new, xt + alpha * dx, false);
-          if (!trial.a.ok) continue;
-          const double tn = free_part(trial.residual).norm();
-          if (tn <= (1.0 - kSufficientDecrease * alpha) * rnorm) {
-            accepted = true;
-            break;
-          }
-          if (tn < best_norm) {
-            best_norm = tn;
-            best_alpha = alpha;
-          }
-        }
-        if (!accepted) {
-          if (best_alpha < 0.0) {
-            rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
-            failed = true;
-            break;
-          }
-          alpha = best_alpha;
+        alpha = detail::backtrack(rnorm, options.max_line_search, [&](double trial_step, bool&) -> std::optional<double> {
+                  const State trial = evaluate(lam_new, xt + trial_step * dx, false);
+                  if (!trial.a.ok) return std::nullopt;
+                  return free_part(trial.residual).norm();
+                }).step;
+        if (alpha < 0.0) {
+          rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+          failed = true;
+          break;
         }
       }
       xt += alpha * dx;

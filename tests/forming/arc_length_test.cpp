@@ -19,12 +19,13 @@
 #include "common/core/error.hpp"
 #include "common/core/types.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/arc_length.hpp"
-#include "forming/loads.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/run.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/solve/arc_length.hpp"
+#include "forming/model/loads.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/run/run.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <string>
 
-#include "forming/case.hpp"
-#include "forming/run.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/case/case.hpp"
+#include "forming/run/run.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

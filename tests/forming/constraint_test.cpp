@@ -1,5 +1,5 @@
 // Element-mean incompressibility and fibre-inextensibility terms of the ply elements
-// (forming/element.hpp, ConstraintTerms):
+// (forming/element/element.hpp, ConstraintTerms):
 //   - force against central finite differences of the energy and tangent against
 //     finite differences of the force, for the constraint part alone and in total,
 //     brick and plane-strain elements, distorted reference, oblique fibres, finite
@@ -29,9 +29,10 @@
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/element.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
+#include "forming/element/element.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
 #include "tests/common/tolerances.hpp"
 
 namespace sf::forming {

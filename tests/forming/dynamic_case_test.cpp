@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <string>
 
-#include "forming/case.hpp"
-#include "forming/run.hpp"
+#include "forming/case/case.hpp"
+#include "forming/run/run.hpp"
 
 namespace sf::forming {
 namespace {

@@ -1,4 +1,4 @@
-// Implicit dynamics (forming/dynamics.hpp): consistent mass matrix, generalised-alpha /
+// Implicit dynamics (forming/solve/dynamic_solver.hpp): consistent mass matrix, generalised-alpha /
 // HHT / Newmark time integration (notes/forming-verification.md sections 2.7, 3.3).
 //
 // Plies: flat rectangles (bottom face z = 0), compressible neo-Hookean E = 1000 MPa,
@@ -34,10 +34,11 @@
 
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/dynamics.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/solve/dynamic_solver.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

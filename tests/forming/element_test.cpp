@@ -1,5 +1,5 @@
-// Total Lagrangian ply elements (forming/element.hpp) and their assembly
-// (forming/static_solver.hpp Model): tangent against central finite differences of
+// Total Lagrangian ply elements (forming/element/element.hpp) and their assembly
+// (forming/solve/static_solver.hpp Model): tangent against central finite differences of
 // the internal force and force against finite differences of the energy (neo-Hookean
 // and the compressible transversely isotropic law, random distorted reference and
 // current states, several fibre directions), zero force in the reference state and
@@ -18,10 +18,11 @@
 
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/element.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/element/element.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/solve/static_solver.hpp"
 #include "tests/common/tolerances.hpp"
 
 namespace sf::forming {

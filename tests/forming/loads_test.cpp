@@ -1,4 +1,4 @@
-// External loads (forming/loads.hpp): follower pressure and its load-correction
+// External loads (forming/model/loads.hpp): follower pressure and its load-correction
 // tangent against finite differences, totals of dead loads, and the closed form of a
 // block under pressure (follower pressure is a CAUCHY traction: sigma_33 = -p on the
 // current face; a dead pressure is a nominal one).
@@ -12,11 +12,12 @@
 
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/loads.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/run.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/model/loads.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/run/run.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

@@ -1,4 +1,4 @@
-// Hyperelastic laws of forming/materials.hpp: stress against central finite
+// Hyperelastic laws of forming/material/ (neo_hookean, transversely_isotropic): stress against central finite
 // differences of the energy and tangent against finite differences of the stress
 // (random C = F^T F, fixed seeds, several fibre angles), stress-free reference
 // states, material symmetry and objectivity, the closed-form homogeneous
@@ -20,7 +20,8 @@
 #include <vector>
 
 #include "common/core/error.hpp"
-#include "forming/materials.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
 #include "tests/common/tolerances.hpp"
 
 namespace sf::forming {

@@ -1,5 +1,5 @@
 // Finite-deformation patch tests of the ply brick (notes/forming-verification.md
-// section 2.1) solved with the static Newton solver (forming/static_solver.hpp).
+// section 2.1) solved with the static Newton solver (forming/solve/static_solver.hpp).
 //
 // Ply: 3 x 2 bricks on a graded rectangle (3 x 2 mm, thickness 0.25 mm) with every
 // node's in-plane derivative parameters skewed and cross derivatives non-zero, the
@@ -32,9 +32,10 @@
 
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

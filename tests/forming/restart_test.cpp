@@ -9,8 +9,8 @@
 #include <string>
 
 #include "common/core/error.hpp"
-#include "forming/case.hpp"
-#include "forming/run.hpp"
+#include "forming/case/case.hpp"
+#include "forming/run/run.hpp"
 
 namespace sf::forming {
 namespace {

@@ -12,7 +12,7 @@
 // library's N, mm, MPa set: mu = 0.4225 MPa, traction 0.0625 MPa.
 //
 // Material: the reference's compressible neo-Hookean is not the library's NeoHookean
-// (forming/materials.hpp: W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2); deal.II uses
+// (forming/material/neo_hookean.hpp: W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2); deal.II uses
 //   W = kappa/4 (J^2 - 1 - 2 ln J) + mu/2 (J^(-2/3) I1 - 3),
 //   kappa = 2 mu (1 + nu) / (3 (1 - 2 nu)),
 // which has the same small-strain moduli but differs at finite strain. To follow the
@@ -53,9 +53,10 @@
 #include <vector>
 
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

@@ -34,9 +34,10 @@
 #include <vector>
 
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/materials.hpp"
-#include "forming/ply_mesh.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_mesh.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 namespace {

@@ -1,4 +1,4 @@
-#include "forming/loads.hpp"
+#include "forming/model/loads.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>

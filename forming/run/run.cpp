@@ -1,4 +1,4 @@
-#include "forming/run.hpp"
+#include "forming/run/run.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -20,9 +20,10 @@
 #include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/arc_length.hpp"
-#include "forming/dynamics.hpp"
-#include "forming/materials.hpp"
+#include "forming/solve/arc_length.hpp"
+#include "forming/solve/dynamic_solver.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
 
 namespace sf::forming {
 namespace {

@@ -2,7 +2,7 @@
 // Assembly of ply bricks into a model and the quasi-static Newton-Raphson solver.
 //
 // Model: one or more plies (bodies), each a PlyMesh with its Material. Global dofs are
-// the plies' dofs (forming/ply_mesh.hpp: dof = 3 (4 node + d) + coord) one ply after
+// the plies' dofs (forming/model/ply_mesh.hpp: dof = 3 (4 node + d) + coord) one ply after
 // the other: body b owns [offset(b), offset(b) + ply(b).n_dofs()). Unknowns are
 // current POSITIONS x (not displacements), flattened like PlyMesh::flatten; the start
 // of a solve is typically Model::reference_positions().
@@ -38,9 +38,9 @@
 #include "common/core/types.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
-#include "forming/element.hpp"
-#include "forming/material.hpp"
-#include "forming/ply_mesh.hpp"
+#include "forming/element/element.hpp"
+#include "forming/material/material.hpp"
+#include "forming/model/ply_mesh.hpp"
 
 namespace sf::forming {
 
@@ -60,7 +60,7 @@ class Model {
   // Adds a ply; returns its body index. The material is shared (several plies may use
   // one law); for the TI law its fibre direction should be ply.fibre_direction().
   // `constraints`: element-mean incompressibility / fibre inextensibility of this ply
-  // (forming/element.hpp ConstraintTerms: the flags and the penalties kappa, k_fibre;
+  // (forming/element/element.hpp ConstraintTerms: the flags and the penalties kappa, k_fibre;
   // its p and T are the starting multipliers of every element).
   int add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints = {});
 
@@ -219,7 +219,7 @@ struct StaticResult {
 
 // External force at load factor lambda and positions x, and (when asked for) its
 // derivative d f_ext / dx (empty when the load does not depend on x). See
-// forming/loads.hpp for the loads that build one.
+// forming/model/loads.hpp for the loads that build one.
 struct ExternalLoad {
   VecX force;                    // n_dofs, N
   linalg::SparseMatrix tangent;  // n_dofs x n_dofs or empty, N/mm

@@ -1,11 +1,11 @@
-#include "forming/arc_length.hpp"
+#include "forming/solve/arc_length.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "common/core/error.hpp"
-#include "forming/solver_messages.hpp"
+#include "forming/solve/messages.hpp"
 
 namespace sf::forming {
 namespace {

@@ -31,7 +31,7 @@
 
 #include "common/core/types.hpp"
 #include "common/linalg/sparse.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 
@@ -75,7 +75,7 @@ struct LoadSet {
   // tangent is then non-zero and in general unsymmetric.
   bool has_follower() const;
   // Assembles every load at positions x (n_dofs), each scaled by `factor` (ExternalLoad:
-  // forming/static_solver.hpp; its tangent is empty unless has_follower()).
+  // forming/solve/static_solver.hpp; its tangent is empty unless has_follower()).
   ExternalLoad assemble(const Model& model, const Eigen::Ref<const VecX>& x, double factor, bool want_tangent) const;
 };
 

@@ -1,4 +1,9 @@
-#include "forming/material.hpp"
+#include "forming/material/material.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "forming/material/law_support.hpp"
 
 namespace sf::forming {
 
@@ -19,5 +24,13 @@ Mat3 from_voigt_stress(const Vec6& v) {
   s << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
   return s;
 }
+
+Vec3 fibre_from_layup_angle(double theta_deg) {
+  detail::require_finite("ply", "layup angle", theta_deg);
+  const double t = theta_deg * kPi / 180.0;
+  return Vec3(std::cos(t), std::sin(t), 0.0);
+}
+
+Mat3 cauchy_stress(const Mat3& F, const Mat3& S) { return F * S * F.transpose() / F.determinant(); }
 
 }  // namespace sf::forming

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "forming/static_solver.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 

@@ -1,13 +1,7 @@
 #pragma once
-// Hyperelastic laws for the forming solver (implementations of forming/material.hpp):
-//
-//   NeoHookean             compressible neo-Hookean (diaphragms, verification);
-//   TransverselyIsotropic  the ply law: standard-reinforcing-type energy in I1, I4, I5
-//                          about the fibre direction a0, incompressible (the element adds
-//                          p) or compressible (volumetric term below).
-//
-// Units: MPa for moduli, stresses and energy density (N/mm^2 = N mm / mm^3), with
-// lengths in mm and forces in N. Any consistent set works; the laws hold no units.
+// Transversely isotropic ply law (an implementation of forming/material/material.hpp):
+// a standard-reinforcing-type energy in I1, I4, I5 about the fibre direction a0,
+// incompressible (the element adds p) or compressible (volumetric term below).
 //
 // Notation (C = F^T F symmetric positive definite, a0 unit fibre direction in the
 // reference configuration, A = a0 (x) a0, b = C a0, J = sqrt(det C), Ci = C^-1):
@@ -19,8 +13,11 @@
 //   (D5)_ijkl = (a_i a_k d_jl + a_i a_l d_jk + a_j a_k d_il + a_j a_l d_ik) / 2
 //                                                              (= d2 I5 / dC dC).
 //
-// Voigt conventions (those of material.hpp): order (11, 22, 33, 12, 23, 13);
-// tangent entries are the plain tensor components CC_IJ = CC_ijkl (no factors of 2),
+// Units: MPa for moduli, stresses and energy density (N/mm^2 = N mm / mm^3), with
+// lengths in mm and forces in N. Any consistent set works; the law holds no units.
+//
+// Voigt conventions (those of forming/material/material.hpp): order (11, 22, 33, 12, 23,
+// 13); tangent entries are the plain tensor components CC_IJ = CC_ijkl (no factors of 2),
 // so dS = CC dE with dE in voigt_strain form (shear entries 2 dE_12 etc.).
 //
 // Evaluation at det C <= 0 (an inverted point) is a numerical outcome the element
@@ -30,57 +27,10 @@
 #include <string>
 
 #include "common/core/types.hpp"
-#include "forming/material.hpp"
+#include "forming/material/material.hpp"
 
 namespace sf::forming {
 
-// Fibre direction of a ply from its layup angle theta (degrees, in the ply plane x-y,
-// measured from x towards y): a0 = (cos theta, sin theta, 0). Throws sf::InputError
-// naming "layup angle" when theta is not finite.
-Vec3 fibre_from_layup_angle(double theta_deg);
-
-// Cauchy stress sigma = F S F^T / det F from the deformation gradient F and a second
-// Piola-Kirchhoff stress S (MPa). Constraint stresses are added by the caller:
-// -p J C^-1 in S gives -p I in sigma; T a0 (x) a0 in S gives (T/J) a (x) a, a = F a0.
-Mat3 cauchy_stress(const Mat3& F, const Mat3& S);
-
-// ---------------------------------------------------------------------------------
-// Compressible neo-Hookean
-//   W  = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2
-//   S  = mu (I - Ci) + lambda ln J Ci
-//   CC = lambda Ci (x) Ci + 2 (mu - lambda ln J) (Ci (.) Ci)
-// Small strain: Lame constants mu, lambda; E = mu (3 lambda + 2 mu)/(lambda + mu),
-// nu = lambda / (2 (lambda + mu)), bulk modulus kappa = lambda + 2 mu / 3.
-// Stress free at C = I.
-
-struct NeoHookeanParams {
-  double mu = 0.0;      // shear modulus, MPa (> 0)
-  double lambda = 0.0;  // Lame's first parameter, MPa (bulk modulus lambda + 2 mu/3 > 0)
-
-  // From Young's modulus E (MPa, > 0) and Poisson's ratio nu (-1 < nu < 1/2):
-  // mu = E / (2 (1 + nu)), lambda = E nu / ((1 + nu)(1 - 2 nu)). Throws naming "E"/"nu".
-  static NeoHookeanParams from_young_poisson(double E, double nu);
-  // From shear modulus mu and bulk modulus kappa (MPa): lambda = kappa - 2 mu / 3.
-  // Throws naming "mu"/"kappa".
-  static NeoHookeanParams from_shear_bulk(double mu, double kappa);
-
-  double bulk_modulus() const { return lambda + 2.0 * mu / 3.0; }
-  // Throws sf::InputError naming the bad parameter ("neo-Hookean mu: ...").
-  void validate() const;
-};
-
-class NeoHookean final : public Material {
- public:
-  explicit NeoHookean(const NeoHookeanParams& params);  // validates
-  MaterialResponse evaluate(const Mat3& C, bool want_tangent) const override;
-  std::string name() const override { return "neo-Hookean"; }
-  const NeoHookeanParams& params() const { return params_; }
-
- private:
-  NeoHookeanParams params_;
-};
-
-// ---------------------------------------------------------------------------------
 // Transversely isotropic ply law (standard-reinforcing type, notes section 2.5), with
 // c = mu_L - mu_T:
 //   W = mu_T/2 (I1 - 3) + c/2 (I5 - 2 I4 + 1) + kappa_f/4 (I4 - 1)^2  [+ W_vol]

@@ -1,4 +1,4 @@
-#include "forming/static_solver.hpp"
+#include "forming/solve/static_solver.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,8 @@
 #include <utility>
 
 #include "common/core/error.hpp"
-#include "forming/line_search.hpp"
-#include "forming/solver_messages.hpp"
+#include "forming/solve/line_search.hpp"
+#include "forming/solve/messages.hpp"
 
 namespace sf::forming {
 namespace {

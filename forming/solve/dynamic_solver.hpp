@@ -7,7 +7,7 @@
 // force = t mm/s^2 = N, energy N mm, stiffness N/mm, mass matrix t, velocity mm/s,
 // acceleration mm/s^2. (Steel 7.85e-9 t/mm^3; a dry carbon ply ~1.5e-9 t/mm^3.)
 //
-// Unknowns and layout are those of Model (forming/static_solver.hpp): x = current
+// Unknowns and layout are those of Model (forming/solve/static_solver.hpp): x = current
 // POSITIONS (n_dofs, flattened like PlyMesh::flatten, derivative parameters included),
 // v = dx/dt, a = d2x/dt2 (the derivative parameters' rates are those of the arc-length
 // derivatives: 1/s and 1/s^2).
@@ -93,7 +93,7 @@
 #include "common/core/types.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 
@@ -112,8 +112,8 @@ double kinetic_energy(const linalg::SparseMatrix& mass, const Eigen::Ref<const V
 // External force at (time, x): force (n_dofs, N; empty = none) and, when asked for and
 // the load depends on x (follower loads), its derivative d force / dx (n_dofs x n_dofs,
 // N/mm; empty or without nonzeros = none).
-// The same load type as the static solver's (forming/static_solver.hpp ExternalLoad),
-// so the case's loads (forming/loads.hpp) plug into both.
+// The same load type as the static solver's (forming/solve/static_solver.hpp ExternalLoad),
+// so the case's loads (forming/model/loads.hpp) plug into both.
 using ExternalForce = ExternalLoad;
 // Called with the time, the positions at which the load acts (x_{n+1-af} during a step,
 // x0 at the start) and whether the tangent is wanted. An empty function = no load.

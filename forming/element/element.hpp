@@ -1,7 +1,7 @@
 #pragma once
 // Total Lagrangian hyperelastic element kernels (principle of virtual work) for the
-// ply elements, separate from the material law (forming/material.hpp) and from the
-// mesh (the caller maps element xi-parameters to global dofs, forming/ply_mesh.hpp).
+// ply elements, separate from the material law (forming/material/material.hpp) and from the
+// mesh (the caller maps element xi-parameters to global dofs, forming/model/ply_mesh.hpp).
 //
 //   Brick  BicubicHermiteLinear: 32 functions, 3-D; element parameters X_e, x_e are
 //          32 x 3 (row k = function k of common/basis/hermite.hpp, k = 4 n + d,
@@ -45,9 +45,9 @@
 //   g_T = (1/V_e) integral (I4 - 1)/2 dV,       I4 = a0 . C a0 = |F a0|^2,
 //   Pi_c = V_e [ -p g_J + kappa/2 g_J^2 ]        (if incompressible)
 //        + V_e [  T g_T + k_fibre/2 g_T^2 ]      (if inextensible)
-// is added to the element energy. SIGN CONVENTION (that of the notes, section 3.1,
-// and of materials.hpp cauchy_stress): p is the PRESSURE (positive in compression),
-// T the fibre TENSION (positive in tension); the element adds to S
+// is added to the element energy. SIGN CONVENTION (that of the notes, section 3.1, and
+// of forming/material/material.hpp cauchy_stress): p is the PRESSURE (positive in
+// compression), T the fibre TENSION (positive in tension); the element adds to S
 //   -p_eff J C^-1 + T_eff a0 (x) a0,  i.e. sigma = -p_eff I + ... + (T_eff/J) a (x) a,
 // with the effective (reported) multipliers
 //   p_eff = p - kappa g_J,    T_eff = T + k_fibre g_T.
@@ -74,7 +74,8 @@
 // still symmetric and the exact derivative of the force). The plane element uses the
 // same formulas with F_33 = 1 (a0 may have a z component; it enters I4 as a constant).
 // With the incompressible TransverselyIsotropic law the reference state is stress free
-// at p = mu_T (materials.hpp), so start the Uzawa loop from p = mu_T there.
+// at p = mu_T (forming/material/transversely_isotropic.hpp), so start the Uzawa loop
+// from p = mu_T there.
 // CAUTION (measured in tests/forming/constraint_test.cpp, ConstraintLocking): only the
 // element mean of J is constrained, so the zero-mean part of the dilatation is resisted
 // by the material alone. The incompressible law has no volumetric energy, and with
@@ -91,7 +92,7 @@
 
 #include "common/core/types.hpp"
 #include "common/quadrature/gauss.hpp"
-#include "forming/material.hpp"
+#include "forming/material/material.hpp"
 
 namespace sf::forming {
 

@@ -31,7 +31,8 @@
 #include <vector>
 
 #include "common/core/types.hpp"
-#include "forming/materials.hpp"
+#include "forming/material/neo_hookean.hpp"
+#include "forming/material/transversely_isotropic.hpp"
 
 namespace sf::forming {
 
@@ -126,7 +127,7 @@ struct CaseSolver {
   bool line_search = true;
   double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
   double constraint_tolerance = 1e-8;  // |mean J - 1|, |mean (I4 - 1)/2| after the multiplier updates
-  // analysis: dynamic (inertia; forming/dynamics.hpp). The load factor is then t/end_time
+  // analysis: dynamic (inertia; forming/solve/dynamic_solver.hpp). The load factor is then t/end_time
   // and the steps are output intervals of end_time/steps.
   bool dynamic = false;
   double end_time = 1.0;         // s
@@ -134,7 +135,7 @@ struct CaseSolver {
   std::string integrator = "generalized-alpha";  // | hht-alpha | newmark
   double rho_inf = 0.8;          // generalised-alpha high-frequency spectral radius
   // control: arc_length (static only): the load factor is an unknown and each step
-  // advances a fixed path length (mm) through limit points (forming/arc_length.hpp);
+  // advances a fixed path length (mm) through limit points (forming/solve/arc_length.hpp);
   // steps is then the maximum number of arc-length steps, the run ends past lambda 1.
   double arc_length = 0.0;       // mm; 0 = load control
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this

@@ -1,4 +1,4 @@
-#include "forming/dynamics.hpp"
+#include "forming/solve/dynamic_solver.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -11,8 +11,8 @@
 
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
-#include "forming/line_search.hpp"
-#include "forming/solver_messages.hpp"
+#include "forming/solve/line_search.hpp"
+#include "forming/solve/messages.hpp"
 
 namespace sf::forming {
 namespace {

@@ -50,4 +50,14 @@ Vec6 voigt_stress(const Mat3& s);          // plain components
 Vec6 voigt_strain(const Mat3& e);          // shear components doubled
 Mat3 from_voigt_stress(const Vec6& v);
 
+// Fibre direction of a ply from its layup angle theta (degrees, in the ply plane x-y,
+// measured from x towards y): a0 = (cos theta, sin theta, 0). Throws sf::InputError
+// naming "layup angle" when theta is not finite.
+Vec3 fibre_from_layup_angle(double theta_deg);
+
+// Cauchy stress sigma = F S F^T / det F from the deformation gradient F and a second
+// Piola-Kirchhoff stress S (MPa). Constraint stresses are added by the caller:
+// -p J C^-1 in S gives -p I in sigma; T a0 (x) a0 in S gives (T/J) a (x) a, a = F a0.
+Mat3 cauchy_stress(const Mat3& F, const Mat3& S);
+
 }  // namespace sf::forming

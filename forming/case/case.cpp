@@ -1,4 +1,4 @@
-#include "forming/case.hpp"
+#include "forming/case/case.hpp"
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,4 +1,4 @@
-#include "forming/element.hpp"
+#include "forming/element/element.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>

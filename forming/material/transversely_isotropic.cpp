@@ -1,57 +1,24 @@
-#include "forming/materials.hpp"
+#include "forming/material/transversely_isotropic.hpp"
 
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "common/core/error.hpp"
+#include "forming/material/law_support.hpp"
 
 namespace sf::forming {
 namespace {
 
-// Voigt index pairs (11, 22, 33, 12, 23, 13).
-constexpr int kVoigtPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
-
-[[noreturn]] void bad_parameter(const std::string& law, const std::string& parameter,
-                                const std::string& expected, double found) {
-  std::ostringstream os;
-  os.precision(10);
-  os << law << " " << parameter << ": expected " << expected << ", found " << found;
-  throw InputError(os.str());
-}
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
-void require_finite(const std::string& law, const std::string& parameter, double v) {
-  if (!std::isfinite(v)) bad_parameter(law, parameter, "a finite number", v);
-}
-
-void require_positive(const std::string& law, const std::string& parameter, double v) {
-  require_finite(law, parameter, v);
-  if (!(v > 0.0)) bad_parameter(law, parameter, "a positive value (MPa)", v);
-}
-
-// X (x) Y in Voigt form.
-Mat6 outer(const Mat3& X, const Mat3& Y) { return voigt_stress(X) * voigt_stress(Y).transpose(); }
-
-// (X (.) X)_ijkl = (X_ik X_jl + X_il X_jk) / 2 in Voigt form (X symmetric).
-Mat6 sym_product(const Mat3& X) {
-  Mat6 m;
-  for (int I = 0; I < 6; ++I) {
-    const int i = kVoigtPair[I][0], j = kVoigtPair[I][1];
-    for (int K = 0; K < 6; ++K) {
-      const int k = kVoigtPair[K][0], l = kVoigtPair[K][1];
-      m(I, K) = 0.5 * (X(i, k) * X(j, l) + X(i, l) * X(j, k));
-    }
-  }
-  return m;
-}
+using detail::add_volumetric;
+using detail::bad_parameter;
+using detail::fmt;
+using detail::inverted_response;
+using detail::kVoigtPair;
+using detail::outer;
+using detail::require_finite;
+using detail::require_positive;
+using detail::young_isotropic;
 
 // D5 = d2 I5 / dC dC: (a_i a_k d_jl + a_i a_l d_jk + a_j a_k d_il + a_j a_l d_ik) / 2.
 Mat6 d2_i5(const Vec3& a) {
@@ -68,95 +35,10 @@ Mat6 d2_i5(const Vec3& a) {
   return m;
 }
 
-// The response at an inverted point (det C <= 0) of a law with a ln J term.
-MaterialResponse inverted_response() {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  MaterialResponse r;
-  r.energy = std::numeric_limits<double>::infinity();
-  r.stress.setConstant(nan);
-  r.tangent.setConstant(nan);
-  return r;
-}
-
-[[maybe_unused]] bool is_symmetric(const Mat3& C) {
-  return (C - C.transpose()).cwiseAbs().maxCoeff() <= 1e-10 * (1.0 + C.cwiseAbs().maxCoeff());
-}
-
-// Coupled volumetric part shared by both laws:
-//   W = -mu ln J + lambda/2 (ln J)^2, S = (lambda ln J - mu) Ci,
-//   CC = lambda Ci (x) Ci + 2 (mu - lambda ln J) (Ci (.) Ci).
-void add_volumetric(const Mat3& Ci, double ln_j, double mu, double lambda, bool want_tangent,
-                    MaterialResponse& r) {
-  r.energy += -mu * ln_j + 0.5 * lambda * ln_j * ln_j;
-  r.stress += (lambda * ln_j - mu) * Ci;
-  if (want_tangent) r.tangent += lambda * outer(Ci, Ci) + 2.0 * (mu - lambda * ln_j) * sym_product(Ci);
-}
-
-const char* const kNeoHookean = "neo-Hookean";
 const char* const kTi = "transversely isotropic";
 const char* const kTiEng = "transversely isotropic engineering constant";
 
-// Isotropic small-strain Young's modulus from Lame constants.
-double young_isotropic(double mu, double lambda) { return mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu); }
-
 }  // namespace
-
-Vec3 fibre_from_layup_angle(double theta_deg) {
-  require_finite("ply", "layup angle", theta_deg);
-  const double t = theta_deg * kPi / 180.0;
-  return Vec3(std::cos(t), std::sin(t), 0.0);
-}
-
-Mat3 cauchy_stress(const Mat3& F, const Mat3& S) { return F * S * F.transpose() / F.determinant(); }
-
-// ---------------------------------------------------------------------------------
-// Neo-Hookean
-
-NeoHookeanParams NeoHookeanParams::from_young_poisson(double E, double nu) {
-  require_positive(kNeoHookean, "E", E);
-  require_finite(kNeoHookean, "nu", nu);
-  if (!(nu > -1.0 && nu < 0.5)) bad_parameter(kNeoHookean, "nu", "-1 < nu < 0.5", nu);
-  NeoHookeanParams p;
-  p.mu = E / (2.0 * (1.0 + nu));
-  p.lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-  return p;
-}
-
-NeoHookeanParams NeoHookeanParams::from_shear_bulk(double mu, double kappa) {
-  require_positive(kNeoHookean, "mu", mu);
-  require_positive(kNeoHookean, "kappa", kappa);
-  NeoHookeanParams p;
-  p.mu = mu;
-  p.lambda = kappa - 2.0 * mu / 3.0;
-  return p;
-}
-
-void NeoHookeanParams::validate() const {
-  require_positive(kNeoHookean, "mu", mu);
-  require_finite(kNeoHookean, "lambda", lambda);
-  if (!(bulk_modulus() > 0.0))
-    bad_parameter(kNeoHookean, "lambda", "lambda > -2 mu/3 (positive bulk modulus)", lambda);
-}
-
-NeoHookean::NeoHookean(const NeoHookeanParams& params) : params_(params) { params_.validate(); }
-
-MaterialResponse NeoHookean::evaluate(const Mat3& C, bool want_tangent) const {
-  SF_ASSERT(is_symmetric(C), "NeoHookean::evaluate: C must be symmetric");
-  const double det = C.determinant();
-  if (!(det > 0.0)) return inverted_response();
-  const Mat3 Ci = C.inverse();
-  const double ln_j = 0.5 * std::log(det);
-  const double mu = params_.mu;
-
-  MaterialResponse r;
-  r.energy = 0.5 * mu * (C.trace() - 3.0);
-  r.stress = mu * Mat3::Identity();
-  add_volumetric(Ci, ln_j, mu, params_.lambda, want_tangent, r);
-  return r;
-}
-
-// ---------------------------------------------------------------------------------
-// Transversely isotropic
 
 void TransverselyIsotropicParams::validate() const {
   require_positive(kTi, "mu_T", mu_T);
@@ -287,7 +169,7 @@ std::string TransverselyIsotropic::name() const {
 }
 
 MaterialResponse TransverselyIsotropic::evaluate(const Mat3& C, bool want_tangent) const {
-  SF_ASSERT(is_symmetric(C), "TransverselyIsotropic::evaluate: C must be symmetric");
+  SF_ASSERT(detail::is_symmetric(C), "TransverselyIsotropic::evaluate: C must be symmetric");
   const TransverselyIsotropicParams& p = params_;
   const Vec3& a = a0_;
   const Vec3 b = C * a;

@@ -1,7 +1,7 @@
 #pragma once
-// `simform run`: builds the model of a case (forming/case.hpp), steps the load factor
+// `simform run`: builds the model of a case (forming/case/case.hpp), steps the load factor
 // lambda = k / steps (k = 1..steps) with the quasi-static Newton solver
-// (forming/static_solver.hpp; each step may be cut back inside), and writes the results
+// (forming/solve/static_solver.hpp; each step may be cut back inside), and writes the results
 // atomically into one folder:
 //
 //   result.pvd              ParaView time series (time = load factor)
@@ -30,9 +30,9 @@
 #include <vector>
 
 #include "common/core/types.hpp"
-#include "forming/case.hpp"
-#include "forming/loads.hpp"
-#include "forming/static_solver.hpp"
+#include "forming/case/case.hpp"
+#include "forming/model/loads.hpp"
+#include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
 
@@ -69,7 +69,7 @@ struct RunReport {
 // Model of a case: its plies in order (body b = ply b), one material instance per ply
 // (fibre direction from the layup angle).
 Model build_model(const FormingCase& spec);
-// The case's loads (forming/loads.hpp), each with its ramp: f_ext(lambda, x) =
+// The case's loads (forming/model/loads.hpp), each with its ramp: f_ext(lambda, x) =
 // sum_i ramp_i(lambda) f_i(x).
 struct CaseLoads {
   std::vector<std::pair<Ramp, LoadSet>> sets;

@@ -1,4 +1,4 @@
-#include "forming/ply_mesh.hpp"
+#include "forming/model/ply_mesh.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>

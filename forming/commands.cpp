@@ -6,7 +6,7 @@
 
 #include "common/cli/app.hpp"
 #include "common/cli/progress.hpp"
-#include "forming/case/case.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
 
 namespace sf::forming {

@@ -2,7 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
+#include <utility>
 
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
@@ -173,6 +175,26 @@ ExternalLoad LoadSet::assemble(const Model& model, const Eigen::Ref<const VecX>&
     out.force(nf.dof) += factor * nf.value;
   }
   if (tangent) out.tangent = factor * k.compress();
+  return out;
+}
+
+void RampedLoads::add(Ramp ramp, LoadSet set) {
+  follower = follower || set.has_follower();
+  sets.emplace_back(ramp, std::move(set));
+}
+
+ExternalLoad RampedLoads::at(const Model& model, double lambda, const VecX& x, bool want_tangent) const {
+  ExternalLoad out;
+  out.force = VecX::Zero(model.n_dofs());
+  for (const auto& [ramp, set] : sets) {
+    const double factor = ramp_value(ramp, std::clamp(lambda, 0.0, 1.0));
+    if (factor == 0.0) continue;
+    ExternalLoad l = set.assemble(model, x, factor, want_tangent);
+    out.force += l.force;
+    if (l.tangent.size() == 0) continue;
+    if (out.tangent.size() == 0) out.tangent = std::move(l.tangent);
+    else out.tangent += l.tangent;
+  }
   return out;
 }
 

@@ -27,13 +27,26 @@
 // element maps (arc-length scale factors included), as the internal forces are.
 //
 // Units: mm, N, MPa.
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include "common/core/types.hpp"
 #include "common/linalg/sparse.hpp"
-#include "forming/solve/static_solver.hpp"
+#include "forming/model/model.hpp"
+#include "forming/model/ramp.hpp"
 
 namespace sf::forming {
+
+// External force at load factor (or time) lambda and positions x, and (when asked for)
+// its derivative d f_ext / dx (empty when the load does not depend on x).
+struct ExternalLoad {
+  VecX force;                    // n_dofs, N
+  linalg::SparseMatrix tangent;  // n_dofs x n_dofs or empty, N/mm
+};
+// The load as the solvers see it: the static solver passes the load factor, the dynamic
+// one the time.
+using LoadFunction = std::function<ExternalLoad(double lambda, const VecX& x, bool want_tangent)>;
 
 enum class BrickFace { kBottom, kTop, kXi1Min, kXi1Max, kXi2Min, kXi2Max };
 
@@ -74,9 +87,20 @@ struct LoadSet {
   // True when some load depends on the current positions (follower pressure): its
   // tangent is then non-zero and in general unsymmetric.
   bool has_follower() const;
-  // Assembles every load at positions x (n_dofs), each scaled by `factor` (ExternalLoad:
-  // forming/solve/static_solver.hpp; its tangent is empty unless has_follower()).
+  // Assembles every load at positions x (n_dofs), each scaled by `factor` (its tangent is
+  // empty unless has_follower()).
   ExternalLoad assemble(const Model& model, const Eigen::Ref<const VecX>& x, double factor, bool want_tangent) const;
+};
+
+// Load sets with their ramps: f_ext(lambda, x) = sum_i ramp_i(lambda) f_i(x), lambda
+// clamped to [0, 1] (a dynamic run passes t / end_time).
+struct RampedLoads {
+  std::vector<std::pair<Ramp, LoadSet>> sets;
+  bool follower = false;  // some load follows the deformation (unsymmetric tangent)
+
+  bool empty() const { return sets.empty(); }
+  void add(Ramp ramp, LoadSet set);
+  ExternalLoad at(const Model& model, double lambda, const VecX& x, bool want_tangent) const;
 };
 
 // Total area of the faces, reference (x = reference positions) or current (mm^2).

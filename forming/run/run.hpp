@@ -1,24 +1,20 @@
 #pragma once
-// `simform run`: builds the model of a case (forming/case/case.hpp), steps the load factor
-// lambda = k / steps (k = 1..steps) with the quasi-static Newton solver
-// (forming/solve/static_solver.hpp; each step may be cut back inside), and writes the results
-// atomically into one folder:
+// `simform run`: runs a case and writes its results atomically into one folder. The
+// driver (run.cpp) reads like its table of contents:
 //
-//   result.pvd              ParaView time series (time = load factor)
-//   steps/step_NNNN.vtu     hexahedra tessellating every brick (samples per element from
-//                           the case's output section); point data "displacement" (mm);
-//                           cell data "cauchy_stress" (6: xx, yy, zz, xy, yz, xz, MPa),
-//                           "fibre_direction" (unit, deformed, F a0/|F a0|),
-//                           "fibre_stretch" (|F a0|), "ply" (body index), evaluated at
-//                           each cell's centre
-//   history.csv             one row per converged step (row 0 = reference state):
-//                           step, load_factor, tool_ux, tool_uy, tool_uz (mean displacement
-//                           of the first displacement condition's edge, mm), tool_fx,
-//                           tool_fy, tool_fz (reaction on that edge, N: sum of the
-//                           reactions of its value dofs), strain_energy (N mm),
-//                           newton_iterations, cutbacks, residual (N)
-//   summary.json            inputs, parameters, status ("converged" | "not_converged"),
-//                           message, timings, final residual, outputs
+//   build the problem        forming/case/build.hpp: model, loads, prescribed dofs, once
+//   choose the stepper       forming/solve/stepper.hpp: load control, dynamics or arc
+//                            length, with the solver settings translated once
+//   step, with an observer   forming/run/recorder.hpp: every converged step goes to the
+//                            recorder, which writes the outputs (forming/output/)
+//   summarise                the last frame, result.pvd, history.csv, summary.json,
+//                            committed together; then the grid file
+//
+// Outputs (forming/output/*.hpp; docs/forming.md):
+//   result.pvd, steps/step_NNNN.vtu   ParaView series (time = load factor)
+//   history.csv                       one row per converged step (row 0 = reference)
+//   summary.json                      inputs, parameters, status, counts, timings
+//   restart.json                      the state at the last written frame (--restart)
 //
 // A step that cannot converge ends the run: the steps written so far plus the last
 // converged step are committed with status "not_converged" (the caller exits 1).
@@ -30,9 +26,7 @@
 #include <vector>
 
 #include "common/core/types.hpp"
-#include "forming/case/case.hpp"
-#include "forming/model/loads.hpp"
-#include "forming/solve/static_solver.hpp"
+#include "forming/case/schema.hpp"
 
 namespace sf::forming {
 
@@ -65,21 +59,6 @@ struct RunReport {
   bool ok() const { return status != Status::kNotConverged; }  // converged or stopped on request
   std::string brief() const;
 };
-
-// Model of a case: its plies in order (body b = ply b), one material instance per ply
-// (fibre direction from the layup angle).
-Model build_model(const FormingCase& spec);
-// The case's loads (forming/model/loads.hpp), each with its ramp: f_ext(lambda, x) =
-// sum_i ramp_i(lambda) f_i(x).
-struct CaseLoads {
-  std::vector<std::pair<Ramp, LoadSet>> sets;
-  bool follower = false;  // some load follows the deformation (unsymmetric tangent)
-  bool empty() const { return sets.empty(); }
-  ExternalLoad at(const Model& model, double lambda, const VecX& x, bool want_tangent) const;
-};
-CaseLoads build_loads(const FormingCase& spec, const Model& model);
-// Prescribed dofs at load factor lambda (global numbering of build_model()).
-std::vector<PrescribedDof> prescribed_at(const FormingCase& spec, const Model& model, double lambda);
 
 // Runs the case and writes the outputs (see header). Throws sf::InputError / sf::Error
 // for bad input or unwritable outputs; non-convergence is reported, not thrown.

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "common/core/error.hpp"
 #include "forming/solve/messages.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 namespace sf::forming {
 namespace {
@@ -76,7 +78,7 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
     return s;
   };
 
-  TangentSolver solver(options.linear_solver, unsymmetric);
+  TangentSolver solver(options.linear_solver, unsymmetric || !model.symmetric_tangent());
   ArcLengthResult result;
   VecX x = x_start;
   double lambda = 0.0;
@@ -93,6 +95,8 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
       result.message = "max_attempts reached at lambda " + detail::short_number(lambda);
       return result;
     }
+    StepRecord rec;
+    rec.increment = arc;
     // Predictor along the tangent.
     const State s = evaluate(x, lambda, true);
     std::string failure;
@@ -116,6 +120,7 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
           break;
         }
         rnorm = st.r.norm();
+        rec.residual_norms.push_back(rnorm);
         if (!std::isfinite(rnorm)) {
           failure = "non-finite residual";
           break;
@@ -150,8 +155,12 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
       if (!converged && failure.empty())
         failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " + detail::short_number(rnorm) + ")";
     }
+    rec.target = lambda + dlambda;
+    rec.converged = converged;
+    rec.iterations = std::min(iterations, options.max_iterations);
+    rec.failure = failure;
+    result.add(std::move(rec));
     if (!converged) {
-      ++result.cutbacks;
       arc *= 0.5;
       if (arc < options.min_arc) {
         result.message = "step from lambda " + detail::short_number(lambda) + " failed (" + failure + "); arc length below min_arc " +
@@ -166,17 +175,17 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
     result.path.push_back({lambda, x, iterations, rnorm});
     if (iterations <= options.easy_iterations) arc = std::min(options.max_arc, arc * 1.5);
     if (lambda > options.max_load_factor) {
-      result.completed = true;
+      result.status = SolveStatus::kConverged;
       result.message = "load factor " + detail::short_number(lambda) + " passed max_load_factor";
       return result;
     }
     if (stop && stop(result.path.back())) {
-      result.completed = true;
+      result.status = SolveStatus::kConverged;
       result.message = "stopped by the caller at lambda " + detail::short_number(lambda);
       return result;
     }
   }
-  result.completed = true;
+  result.status = SolveStatus::kConverged;
   result.message = "max_steps reached at lambda " + detail::short_number(lambda);
   return result;
 }

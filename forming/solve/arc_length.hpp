@@ -24,7 +24,12 @@
 #include <string>
 #include <vector>
 
-#include "forming/solve/static_solver.hpp"
+#include "common/core/types.hpp"
+#include "common/linalg/solver.hpp"
+#include "forming/model/loads.hpp"
+#include "forming/model/model.hpp"
+#include "forming/model/prescriptions.hpp"
+#include "forming/solve/step_history.hpp"
 
 namespace sf::forming {
 
@@ -51,15 +56,16 @@ struct ArcLengthPoint {
   double residual = 0.0;  // |r_f|, N
 };
 
-struct ArcLengthResult {
+// The steps of a continuation (forming/solve/step_history.hpp): one record per attempt
+// (target = the load factor it ended at, increment = its arc length Delta l, the
+// residual norm of every iteration), status kConverged when it stopped as asked
+// (max_load_factor, max_steps or the callback), with the message saying which.
+struct ArcLengthResult : StepHistory {
   std::vector<ArcLengthPoint> path;  // converged points, the start (lambda 0) first
-  bool completed = false;  // stopped by max_load_factor, max_steps or the callback
-  std::string message;     // why it stopped
-  int cutbacks = 0;
 };
 
 // `stop` is called after every converged point; returning true ends the solve
-// (completed). The start x_start must be in equilibrium at lambda = 0.
+// (converged). The start x_start must be in equilibrium at lambda = 0.
 ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX>& x_start,
                                  const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
                                  bool unsymmetric, const ArcLengthOptions& options,

@@ -9,10 +9,10 @@
 #include <sstream>
 #include <utility>
 
-#include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
 #include "forming/solve/line_search.hpp"
 #include "forming/solve/messages.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 namespace sf::forming {
 namespace {
@@ -37,77 +37,6 @@ bool has_nonzeros(const linalg::SparseMatrix& m) {
 }
 
 }  // namespace
-
-// ---------------------------------------------------------------------------------
-// Mass matrix
-
-linalg::SparseMatrix mass_matrix(const Model& model, const std::vector<double>& density) {
-  if (static_cast<int>(density.size()) != model.n_bodies())
-    throw InputError("mass matrix density: expected one value per body (" + std::to_string(model.n_bodies()) +
-                     "), found " + std::to_string(density.size()));
-  for (int b = 0; b < model.n_bodies(); ++b)
-    if (!(std::isfinite(density[b]) && density[b] >= 0.0)) {
-      std::ostringstream os;
-      os << "mass matrix density of body " << b << ": expected a finite value >= 0 (t/mm^3), found "
-         << density[b];
-      throw InputError(os.str());
-    }
-  const quadrature::TensorRule<3> rule = model.rule().brick();
-  std::vector<basis::BrickValues> values;
-  values.reserve(rule.size());
-  for (int q = 0; q < rule.size(); ++q)
-    values.push_back(basis::BicubicHermiteLinear::evaluate(rule.points[q], basis::kValues | basis::kFirst));
-
-  const Index n = model.n_dofs();
-  linalg::TripletAssembler triplets(n, n);
-  Index n_el = 0;
-  for (int b = 0; b < model.n_bodies(); ++b) n_el += model.ply(b).n_elements();
-  triplets.reserve(n_el * 3 * kBrickFunctions * kBrickFunctions);
-  std::vector<Index> dofs;
-  std::vector<double> coefs;
-  std::vector<int> local;
-  MatX block;
-  for (int b = 0; b < model.n_bodies(); ++b) {
-    const PlyMesh& ply = model.ply(b);
-    const double rho = density[b];
-    for (Index e = 0; e < ply.n_elements(); ++e) {
-      const BrickParams X_e = ply.element_parameters(e, ply.reference());
-      Eigen::Matrix<double, kBrickFunctions, kBrickFunctions> m_e =
-          Eigen::Matrix<double, kBrickFunctions, kBrickFunctions>::Zero();
-      for (int q = 0; q < rule.size(); ++q) {
-        const Mat3 G = X_e.transpose() * values[q].first;  // G(i, a) = dX_i / dxi_a
-        const double det_g = G.determinant();
-        if (!(det_g > 0.0))
-          throw InputError("mass matrix: body " + std::to_string(b) + " element " + std::to_string(e) +
-                           " has an inverted reference geometry (det G " + detail::short_number(det_g) + " at a Gauss point)");
-        m_e.noalias() += (rho * rule.weights[q] * det_g) * (values[q].value * values[q].value.transpose());
-      }
-      const BrickMap map = ply.element_map(e);
-      for (int i = 0; i < 3; ++i) {
-        dofs.clear();
-        coefs.clear();
-        local.clear();
-        for (int k = 0; k < kBrickFunctions; ++k)
-          for (int t = 0; t < map.n_terms[k]; ++t) {
-            dofs.push_back(model.offset(b) + 3 * map.terms[k][t].dof + i);
-            coefs.push_back(map.terms[k][t].coef);
-            local.push_back(k);
-          }
-        const int m = static_cast<int>(dofs.size());
-        block.resize(m, m);
-        for (int c = 0; c < m; ++c)
-          for (int a = 0; a < m; ++a) block(a, c) = coefs[a] * coefs[c] * m_e(local[a], local[c]);
-        triplets.add_block(dofs, dofs, block);
-      }
-    }
-  }
-  return triplets.compress();
-}
-
-double kinetic_energy(const linalg::SparseMatrix& mass, const Eigen::Ref<const VecX>& velocity) {
-  const VecX mv = mass * velocity;
-  return 0.5 * velocity.dot(mv);
-}
 
 // ---------------------------------------------------------------------------------
 // Options and report
@@ -192,28 +121,13 @@ IntegratorParameters DynamicOptions::parameters() const {
   return p;
 }
 
-std::string to_string(DynamicReport::Status status) {
-  switch (status) {
-    case DynamicReport::Status::kCompleted:
-      return "completed";
-    case DynamicReport::Status::kStepFailed:
-      return "step-failed";
-    case DynamicReport::Status::kInvalidStart:
-      return "invalid-start";
-  }
-  return "unknown";
-}
-
 std::string DynamicReport::brief() const {
   std::ostringstream os;
-  os << to_string(status) << ": t " << time << " in " << n_converged_steps << " steps (" << n_cutbacks
-     << " cut-backs), " << total_iterations << " Newton iterations";
-  if (n_converged_steps > 0) os << ", dt " << detail::short_number(min_dt_used) << ".." << detail::short_number(max_dt_used);
-  for (auto it = steps.rbegin(); it != steps.rend(); ++it)
-    if (it->converged && !it->residual_norms.empty()) {
-      os << ", |R| " << detail::short_number(it->residual_norms.back());
-      break;
-    }
+  os << to_string(status) << ": t " << time << " " << counts();
+  if (n_converged_steps > 0) {
+    os << ", dt " << detail::short_number(min_dt_used) << ".." << detail::short_number(max_dt_used);
+    os << ", |R| " << detail::short_number(last_residual());
+  }
   if (!message.empty()) os << "; " << message;
   return os.str();
 }
@@ -221,15 +135,410 @@ std::string DynamicReport::brief() const {
 // ---------------------------------------------------------------------------------
 // Time integration
 
+namespace {
+
+// Where the next step ends: steps land exactly on the hit times and on end_time; a
+// target between dt and 2 dt away is reached in two equal steps (no sliver step:
+// a_{n+1} ~ 1/dt^2 amplifies round-off). dt grows after easy steps and is cut back
+// after failed ones.
+class StepClock {
+ public:
+  explicit StepClock(const DynamicOptions& options) : options_(options), max_dt_(options.max_step()) {
+    for (double h : options.hit_times)
+      if (h > options.start_time && h < options.end_time) hits_.push_back(h);
+    std::sort(hits_.begin(), hits_.end());
+    dt_ = std::min(options.initial_dt, max_dt_);
+  }
+
+  double next_end(double t) {
+    while (next_hit_ < hits_.size() && hits_[next_hit_] <= t) ++next_hit_;
+    const double target = next_hit_ < hits_.size() ? hits_[next_hit_] : options_.end_time;
+    const double remaining = target - t;
+    return remaining <= dt_ * (1.0 + kLandingTol) ? target
+           : remaining < 2.0 * dt_               ? t + 0.5 * remaining
+                                                 : t + dt_;
+  }
+  void grow() { dt_ = std::min(max_dt_, dt_ * options_.growth); }
+  // After a failed step of length h; false when dt falls below min_dt.
+  bool cut_back(double h) {
+    dt_ = std::min(dt_, h) * options_.cutback_factor;
+    return dt_ >= options_.min_dt;
+  }
+
+ private:
+  const DynamicOptions& options_;
+  double max_dt_;
+  double dt_ = 0.0;
+  std::vector<double> hits_;
+  std::size_t next_hit_ = 0;
+};
+
+// One time step from t_n to t_new = t_n + h and its Newton iterate: the Newmark
+// relations are written in the step increment y = x_{n+1} - x_n (iterated instead of
+// x_{n+1} itself so that a_{n+1} = c0 (y - base) does not lose digits to |x|).
+struct TimeStep {
+  double h = 0.0;        // s
+  double t_new = 0.0;    // t_{n+1}, s
+  double t_alpha = 0.0;  // t_{n+1-af}, s
+  double c0 = 0.0;       // 1 / (beta h^2)
+  VecX base;             // h v_n + h^2 (1/2 - beta) a_n
+  VecX y;                // the iterate (predictor: a_{n+1} = a_n)
+};
+
+// Residual R (all dofs) at an iterate, the effective tangent S and the force scale.
+struct Balance {
+  VecX residual;
+  linalg::SparseMatrix tangent;
+  double scale = 0.0;
+};
+
+// The state (t, x, v, a) of a generalised-alpha integration and the pieces of a step:
+// start, the balance at an iterate, Newton on a step, and acceptance.
+class TimeIntegration {
+ public:
+  TimeIntegration(const Model& model, const linalg::SparseMatrix& mass, const std::vector<TimedDof>& prescribed,
+                  const ExternalForceFn& external, const DynamicOptions& options)
+      : model_(model), mass_(mass), prescribed_(prescribed), external_(external), options_(options) {
+    const IntegratorParameters ip = options.parameters();
+    am_ = ip.alpha_m;
+    af_ = ip.alpha_f;
+    beta_ = ip.beta;
+    gamma_ = ip.gamma;
+    for (int i = 0; i < model.n_interactions(); ++i)
+      velocity_dependent_ = velocity_dependent_ || model.interaction(i).needs_velocity();
+  }
+
+  // Checks the inputs, classifies the dofs and sets the start state: prescribed dofs at
+  // their positions at start_time, held dofs at rest, the initial acceleration
+  // M_ff a_f = f_ext_f - f_int_f. Returns why the start is invalid (empty when valid).
+  std::string start(const Eigen::Ref<const VecX>& x0, const Eigen::Ref<const VecX>& v0);
+  // Attempts the step to t_new from the current state; the record says whether it
+  // converged (then `step.y` is the increment and `end` the balance there) and why not.
+  StepRecord attempt(double t_new, TimeStep& step, Balance& end);
+  // Moves the state to the end of a converged step; reactions on the prescribed dofs.
+  void accept(const TimeStep& step, const Balance& end, VecX& reactions);
+
+  bool fatal() const { return fatal_; }  // a failure no smaller step can fix
+  double time() const { return t_; }
+  const VecX& x() const { return x_; }
+  const VecX& v() const { return v_; }
+  const VecX& a() const { return a_; }
+
+ private:
+  enum : char { kFree, kPrescribed, kHeld };
+  std::string classify_dofs();
+  std::string initial_acceleration();
+  bool set_prescribed(double t, VecX& y, std::string& why) const;
+  bool external_force(double t, const VecX& x, bool want_tangent, ExternalForce& out, std::string& why) const;
+  bool balance(const TimeStep& s, const VecX& y, bool want_tangent, Balance& out, std::string& why);
+  void newton(TimeStep& s, Balance& end, StepRecord& rec);
+  // Line-search factor along dy; < 0 (and rec.failure) when no trial could be evaluated.
+  double line_search(const TimeStep& s, const VecX& dy, double rnorm, StepRecord& rec);
+
+  const Model& model_;
+  const linalg::SparseMatrix& mass_;
+  const std::vector<TimedDof>& prescribed_;
+  const ExternalForceFn& external_;
+  const DynamicOptions& options_;
+  double am_ = 0.0, af_ = 0.0, beta_ = 0.25, gamma_ = 0.5;
+  bool velocity_dependent_ = false;  // some interaction's force depends on v
+
+  std::vector<char> kind_;
+  FreeDofs free_;
+  double length_scale_ = 1e-300;
+  std::unique_ptr<TangentSolver> solver_;
+  bool unsymmetric_ = false;
+  bool fatal_ = false;
+
+  double t_ = 0.0;
+  VecX x_, v_, a_;
+};
+
+std::string TimeIntegration::start(const Eigen::Ref<const VecX>& x0, const Eigen::Ref<const VecX>& v0) {
+  const Index n = model_.n_dofs();
+  if (x0.size() != n)
+    return "start positions have " + std::to_string(x0.size()) + " entries, expected " + std::to_string(n);
+  if (v0.size() != n)
+    return "start velocities have " + std::to_string(v0.size()) + " entries, expected " + std::to_string(n);
+  if (mass_.rows() != n || mass_.cols() != n)
+    return "mass matrix is " + std::to_string(mass_.rows()) + " x " + std::to_string(mass_.cols()) + ", expected " +
+           std::to_string(n) + " x " + std::to_string(n);
+  if (!x0.allFinite() || !v0.allFinite()) return "start positions or velocities are not finite";
+  if (std::string why = classify_dofs(); !why.empty()) return why;
+
+  t_ = options_.start_time;
+  x_ = x0;
+  v_ = v0;
+  a_ = VecX::Zero(n);
+  if (std::string why; !set_prescribed(t_, x_, why)) return why;
+  for (Index d = 0; d < n; ++d)
+    if (kind_[d] == kHeld) v_(d) = 0.0;
+  for (Index d = 0; d < n; ++d) length_scale_ = std::max(length_scale_, std::abs(x_(d)));
+  if (std::string why = initial_acceleration(); !why.empty()) return why;
+
+  // Effective-tangent solver: symmetric until an unsymmetric tangent shows up.
+  unsymmetric_ = !model_.symmetric_tangent();
+  solver_ = std::make_unique<TangentSolver>(options_.linear_solver, unsymmetric_);
+  return {};
+}
+
+// Free, prescribed, held (used by no element, not prescribed).
+std::string TimeIntegration::classify_dofs() {
+  const Index n = model_.n_dofs();
+  kind_.assign(static_cast<std::size_t>(n), kFree);
+  for (const TimedDof& p : prescribed_) {
+    if (p.dof < 0 || p.dof >= n)
+      return "prescribed dof " + std::to_string(p.dof) + " is outside 0.." + std::to_string(n - 1);
+    if (!p.position) return "prescribed dof " + std::to_string(p.dof) + " has no position function";
+    if (kind_[p.dof] == kPrescribed) return "dof " + std::to_string(p.dof) + " is prescribed twice";
+    kind_[p.dof] = kPrescribed;
+  }
+  const std::vector<bool> used = model_.used_dofs();
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
+  for (Index d = 0; d < n; ++d) {
+    if (!used[d] && kind_[d] == kFree) kind_[d] = kHeld;
+    is_free[static_cast<std::size_t>(d)] = kind_[d] == kFree;
+  }
+  free_ = FreeDofs(is_free);
+  return {};
+}
+
+// M_ff a_f = f_ext_f - f_int_f (a = 0 on prescribed and held dofs).
+std::string TimeIntegration::initial_acceleration() {
+  const InteractionContext context{t_, velocity_dependent_ ? &v_ : nullptr};
+  const Assembly a0 = model_.assemble(x_, context, false);
+  if (!a0.ok) return "start state: " + a0.message;
+  ExternalForce ext;
+  std::string why;
+  if (!external_force(t_, x_, false, ext, why)) return "start state: " + why;
+  if (free_.size() == 0) return {};
+  linalg::LinearSolver msolver(options_.linear_solver, linalg::MatrixProperty::kSymmetricPositiveDefinite);
+  const linalg::SparseMatrix mff = free_.select.transpose() * mass_ * free_.select;
+  const linalg::SolveReport& sr = msolver.factorize(mff);
+  if (!sr.ok()) return "mass matrix on the free dofs cannot be factorised (a body without density?): " + sr.brief();
+  const VecX rhs = free_.restrict(ext.force - a0.force);
+  const VecX af0 = msolver.solve(rhs);
+  if (!af0.allFinite()) return "initial acceleration is not finite";
+  a_ = free_.select * af0;
+  return {};
+}
+
+// Sets the prescribed dofs of y to their positions at time t; false (and why) when a
+// position is not finite.
+bool TimeIntegration::set_prescribed(double t, VecX& y, std::string& why) const {
+  for (const TimedDof& p : prescribed_) {
+    const double value = p.position(t);
+    if (!std::isfinite(value)) {
+      why = "prescribed dof " + std::to_string(p.dof) + " has a non-finite position at t = " + detail::short_number(t);
+      return false;
+    }
+    y(p.dof) = value;
+  }
+  return true;
+}
+
+// External force at (t, x); false (and why) on a wrong size or non-finite values.
+bool TimeIntegration::external_force(double t, const VecX& x, bool want_tangent, ExternalForce& out,
+                                     std::string& why) const {
+  const Index n = model_.n_dofs();
+  out = external_ ? external_(t, x, want_tangent) : ExternalForce{};
+  if (out.force.size() == 0) out.force = VecX::Zero(n);
+  if (out.force.size() != n) {
+    why = "external force has " + std::to_string(out.force.size()) + " entries, expected " + std::to_string(n);
+    return false;
+  }
+  if (!out.force.allFinite()) {
+    why = "external force is not finite at t = " + detail::short_number(t);
+    return false;
+  }
+  if (out.tangent.nonZeros() > 0 && (out.tangent.rows() != n || out.tangent.cols() != n)) {
+    why = "external tangent is " + std::to_string(out.tangent.rows()) + " x " + std::to_string(out.tangent.cols()) +
+          ", expected " + std::to_string(n) + " x " + std::to_string(n);
+    return false;
+  }
+  return true;
+}
+
+// R = M a_{n+1-am} + f(x_{n+1-af}, v_{n+1-af}) - f_ext(t_{n+1-af}, x_{n+1-af}) at the
+// iterate y, and (want_tangent) S = dR/dy. False (and why) on an inverted element or a
+// bad external force (the latter is fatal).
+bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangent, Balance& out, std::string& why) {
+  const VecX a1 = s.c0 * (y - s.base);
+  const VecX xa = x_ + (1.0 - af_) * y;
+  const VecX aa = (1.0 - am_) * a1 + am_ * a_;
+  InteractionContext context{s.t_alpha, nullptr};
+  VecX va;
+  if (velocity_dependent_) {
+    va = v_ + ((1.0 - af_) * s.h) * ((1.0 - gamma_) * a_ + gamma_ * a1);
+    context.velocity = &va;
+  }
+  const Assembly internal = model_.assemble(xa, context, want_tangent);
+  if (!internal.ok) {
+    why = internal.message;
+    return false;
+  }
+  ExternalForce ext;
+  if (!external_force(s.t_alpha, xa, want_tangent, ext, why)) {
+    fatal_ = true;
+    return false;
+  }
+  const VecX inertia = mass_ * aa;
+  out.residual = inertia + internal.force - ext.force;
+  out.scale = std::max({internal.force.norm(), ext.force.norm(), inertia.norm()});
+  if (!out.residual.allFinite()) {
+    why = "non-finite residual";
+    return false;
+  }
+  if (!want_tangent) return true;
+  out.tangent = (s.c0 * (1.0 - am_)) * mass_ + (1.0 - af_) * internal.tangent;
+  if (internal.damping.size() > 0) out.tangent += ((1.0 - af_) * gamma_ * s.h * s.c0) * internal.damping;
+  if (has_nonzeros(ext.tangent)) {
+    out.tangent -= (1.0 - af_) * ext.tangent;
+    if (!unsymmetric_) {
+      try {
+        solver_ = std::make_unique<TangentSolver>(options_.linear_solver, true);
+      } catch (const InputError& e) {
+        why = std::string("the external load has an unsymmetric tangent: ") + e.what();
+        fatal_ = true;
+        return false;
+      }
+      unsymmetric_ = true;
+    }
+  }
+  return true;
+}
+
+StepRecord TimeIntegration::attempt(double t_new, TimeStep& s, Balance& end) {
+  s.t_new = t_new;
+  s.h = t_new - t_;
+  s.c0 = 1.0 / (beta_ * s.h * s.h);
+  s.t_alpha = (1.0 - af_) * t_new + af_ * t_;
+  s.base = s.h * v_ + (s.h * s.h * (0.5 - beta_)) * a_;
+  s.y = s.h * v_ + (0.5 * s.h * s.h) * a_;  // predictor a_{n+1} = a_n
+  StepRecord rec;
+  rec.target = t_new;
+  rec.increment = s.h;
+  VecX x_new = x_;
+  const bool moved = set_prescribed(t_new, x_new, rec.failure);
+  for (const TimedDof& p : prescribed_) s.y(p.dof) = x_new(p.dof) - x_(p.dof);
+  if (!moved) {
+    fatal_ = true;
+    return rec;
+  }
+  newton(s, end, rec);
+  // The end state must be admissible too (with af > 0 only x_{n+1-af} was assembled).
+  if (rec.converged && af_ > 0.0) {
+    const VecX x_end = x_ + s.y;
+    const Assembly a_end = model_.assemble(x_end, false);
+    if (!a_end.ok) {
+      rec.converged = false;
+      rec.failure = "end state: " + a_end.message;
+    }
+  }
+  return rec;
+}
+
+// Newton on the step increment until |R_f| meets the tolerance or a correction reaches
+// the round-off floor; the record gets every residual norm and line-search factor.
+void TimeIntegration::newton(TimeStep& s, Balance& end, StepRecord& rec) {
+  double first_norm = -1.0;
+  const linalg::SparseMatrix& select = free_.select;
+  for (;;) {
+    std::string why;
+    if (!balance(s, s.y, true, end, why)) {
+      rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + why;
+      return;
+    }
+    const VecX rf = free_.restrict(end.residual);
+    const double rnorm = rf.norm();
+    rec.residual_norms.push_back(rnorm);
+    if (first_norm < 0.0) first_norm = rnorm;
+    const double tol = std::max(options_.residual_tol_abs, options_.residual_tol_rel * end.scale);
+    if (rnorm <= tol) {
+      rec.converged = true;
+      return;
+    }
+    if (rnorm > options_.divergence_factor * std::max(first_norm, 1e-300)) {
+      rec.failure = "diverged: |R| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) +
+                    " iterations";
+      return;
+    }
+    if (rec.iterations >= options_.max_iterations) {
+      rec.failure = "no convergence in " + std::to_string(options_.max_iterations) + " iterations (|R| " +
+                    detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
+      return;
+    }
+    const linalg::SolveReport& sr = solver_->factorize(select.transpose() * end.tangent * select);
+    if (!sr.ok()) {
+      rec.failure = "linear solve " + sr.brief();
+      return;
+    }
+    const VecX dyf = solver_->solve(-rf);
+    ++rec.iterations;
+    if (!dyf.allFinite()) {
+      rec.failure = "linear solve returned non-finite values";
+      return;
+    }
+    const VecX dy = select * dyf;
+    if (dyf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale_) {
+      s.y += dy;
+      rec.step_lengths.push_back(1.0);
+      // Final state: residual (for the reactions) without the tangent.
+      if (!balance(s, s.y, false, end, why)) {
+        rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + why;
+        return;
+      }
+      rec.residual_norms.push_back(free_.restrict(end.residual).norm());
+      rec.converged = true;
+      return;
+    }
+    const double step = options_.line_search ? line_search(s, dy, rnorm, rec) : 1.0;
+    if (step < 0.0) return;
+    s.y += step * dy;
+    rec.step_lengths.push_back(step);
+  }
+}
+
+double TimeIntegration::line_search(const TimeStep& s, const VecX& dy, double rnorm, StepRecord& rec) {
+  const detail::LineSearch ls =
+      detail::backtrack(rnorm, options_.max_line_search, [&](double trial_step, bool& stop) -> std::optional<double> {
+        Balance trial;
+        std::string trial_why;
+        if (!balance(s, s.y + trial_step * dy, false, trial, trial_why)) {
+          stop = fatal_;
+          return std::nullopt;
+        }
+        return free_.restrict(trial.residual).norm();
+      });
+  if (ls.stopped) {
+    rec.failure = "iteration " + std::to_string(rec.iterations) + ": external force failed";
+    return -1.0;
+  }
+  if (ls.step < 0.0) {
+    rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+    return -1.0;
+  }
+  return ls.step;
+}
+
+void TimeIntegration::accept(const TimeStep& s, const Balance& end, VecX& reactions) {
+  const VecX a_new = s.c0 * (s.y - s.base);
+  v_ += s.h * ((1.0 - gamma_) * a_ + gamma_ * a_new);
+  a_ = a_new;
+  x_ += s.y;
+  std::string unused;
+  set_prescribed(s.t_new, x_, unused);  // exact prescribed values (no round-off drift; finite: checked in attempt)
+  t_ = s.t_new;
+  for (Index d = 0; d < model_.n_dofs(); ++d) reactions(d) = kind_[d] == kPrescribed ? end.residual(d) : 0.0;
+}
+
+}  // namespace
+
 DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass,
                             const Eigen::Ref<const VecX>& x0, const Eigen::Ref<const VecX>& v0,
                             const std::vector<TimedDof>& prescribed, const ExternalForceFn& external,
                             const DynamicOptions& options, const StepCallback& on_step) {
   options.validate();
-  const IntegratorParameters ip = options.parameters();
-  const double am = ip.alpha_m, af = ip.alpha_f, beta = ip.beta, gamma = ip.gamma;
-  const Index n = model.n_dofs();
-
   DynamicResult result;
   DynamicReport& report = result.report;
   result.positions = x0;
@@ -237,345 +546,60 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
   result.accelerations = VecX::Zero(x0.size());
   result.reactions = VecX::Zero(x0.size());
   report.time = options.start_time;
-  auto invalid = [&](const std::string& msg) {
-    report.status = DynamicReport::Status::kInvalidStart;
-    report.message = msg;
+
+  TimeIntegration run(model, mass, prescribed, external, options);
+  if (const std::string why = run.start(x0, v0); !why.empty()) {
+    report.status = SolveStatus::kInvalidStart;
+    report.message = why;
     return result;
-  };
-  if (x0.size() != n)
-    return invalid("start positions have " + std::to_string(x0.size()) + " entries, expected " + std::to_string(n));
-  if (v0.size() != n)
-    return invalid("start velocities have " + std::to_string(v0.size()) + " entries, expected " + std::to_string(n));
-  if (mass.rows() != n || mass.cols() != n)
-    return invalid("mass matrix is " + std::to_string(mass.rows()) + " x " + std::to_string(mass.cols()) +
-                   ", expected " + std::to_string(n) + " x " + std::to_string(n));
-  if (!x0.allFinite() || !v0.allFinite()) return invalid("start positions or velocities are not finite");
-
-  // Dof classes: free, prescribed, held (used by no element, not prescribed).
-  enum : char { kFree, kPrescribed, kHeld };
-  std::vector<char> kind(n, kFree);
-  for (const TimedDof& p : prescribed) {
-    if (p.dof < 0 || p.dof >= n)
-      return invalid("prescribed dof " + std::to_string(p.dof) + " is outside 0.." + std::to_string(n - 1));
-    if (!p.position) return invalid("prescribed dof " + std::to_string(p.dof) + " has no position function");
-    if (kind[p.dof] == kPrescribed) return invalid("dof " + std::to_string(p.dof) + " is prescribed twice");
-    kind[p.dof] = kPrescribed;
   }
-  const std::vector<bool> used = model.used_dofs();
-  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
-  for (Index d = 0; d < n; ++d) {
-    if (!used[d] && kind[d] == kFree) kind[d] = kHeld;
-    is_free[static_cast<std::size_t>(d)] = kind[d] == kFree;
-  }
-  const FreeDofs free_dofs(is_free);
-  const Index nf = free_dofs.size();
-  const linalg::SparseMatrix& select = free_dofs.select;
-  auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
-  // Sets the prescribed dofs of y to their positions at time t; false (and a message)
-  // when a position is not finite.
-  auto set_prescribed = [&](double t, VecX& y, std::string& why) {
-    for (const TimedDof& p : prescribed) {
-      const double value = p.position(t);
-      if (!std::isfinite(value)) {
-        why = "prescribed dof " + std::to_string(p.dof) + " has a non-finite position at t = " + detail::short_number(t);
-        return false;
-      }
-      y(p.dof) = value;
-    }
-    return true;
-  };
-  // External force at (t, x); false (and a message) on a wrong size.
-  auto eval_external = [&](double t, const VecX& x, bool want_tangent, ExternalForce& out, std::string& why) {
-    if (external) {
-      out = external(t, x, want_tangent);
-    } else {
-      out = ExternalForce{};
-    }
-    if (out.force.size() == 0) out.force = VecX::Zero(n);
-    if (out.force.size() != n) {
-      why = "external force has " + std::to_string(out.force.size()) + " entries, expected " + std::to_string(n);
-      return false;
-    }
-    if (!out.force.allFinite()) {
-      why = "external force is not finite at t = " + detail::short_number(t);
-      return false;
-    }
-    if (out.tangent.nonZeros() > 0 && (out.tangent.rows() != n || out.tangent.cols() != n)) {
-      why = "external tangent is " + std::to_string(out.tangent.rows()) + " x " + std::to_string(out.tangent.cols()) +
-            ", expected " + std::to_string(n) + " x " + std::to_string(n);
-      return false;
-    }
-    return true;
-  };
+  if (on_step) on_step(run.time(), run.x(), run.v());
 
-  double t = options.start_time;
-  VecX x = x0;
-  VecX v = v0;
-  VecX a = VecX::Zero(n);
-  {
-    std::string why;
-    if (!set_prescribed(t, x, why)) return invalid(why);
-  }
-  for (Index d = 0; d < n; ++d)
-    if (kind[d] == kHeld) v(d) = 0.0;
-  double length_scale = 1e-300;
-  for (Index d = 0; d < n; ++d) length_scale = std::max(length_scale, std::abs(x(d)));
-
-  // Initial acceleration: M_ff a_f = f_ext_f - f_int_f (a = 0 on prescribed and held dofs).
-  {
-    const Assembly a0 = model.assemble(x, false);
-    if (!a0.ok) return invalid("start state: " + a0.message);
-    ExternalForce ext;
-    std::string why;
-    if (!eval_external(t, x, false, ext, why)) return invalid("start state: " + why);
-    if (nf > 0) {
-      linalg::LinearSolver msolver(options.linear_solver, linalg::MatrixProperty::kSymmetricPositiveDefinite);
-      const linalg::SparseMatrix mff = select.transpose() * mass * select;
-      const linalg::SolveReport& sr = msolver.factorize(mff);
-      if (!sr.ok())
-        return invalid("mass matrix on the free dofs cannot be factorised (a body without density?): " + sr.brief());
-      const VecX rhs = free_part(ext.force - a0.force);
-      const VecX af0 = msolver.solve(rhs);
-      if (!af0.allFinite()) return invalid("initial acceleration is not finite");
-      a = select * af0;
-    }
-  }
-  result.positions = x;
-  result.velocities = v;
-  result.accelerations = a;
-  if (on_step) on_step(t, x, v);
-
-  // Effective-tangent solver: symmetric until an external tangent has nonzeros.
-  std::unique_ptr<TangentSolver> solver = std::make_unique<TangentSolver>(options.linear_solver, false);
-  bool unsymmetric = false;
-
-  std::vector<double> hits;
-  for (double h : options.hit_times)
-    if (h > options.start_time && h < options.end_time) hits.push_back(h);
-  std::sort(hits.begin(), hits.end());
-  std::size_t next_hit = 0;
-
-  const double max_dt = options.max_step();
-  double dt = std::min(options.initial_dt, max_dt);
+  StepClock clock(options);
   int attempts = 0;
-  bool fatal = false;
-  while (t < options.end_time) {
+  while (run.time() < options.end_time) {
     if (attempts >= options.max_steps) {
-      report.status = DynamicReport::Status::kStepFailed;
-      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted time steps reached at t = " + detail::short_number(t);
+      report.status = SolveStatus::kStepFailed;
+      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted time steps reached at t = " +
+                       detail::short_number(run.time());
       break;
     }
     ++attempts;
-    while (next_hit < hits.size() && hits[next_hit] <= t) ++next_hit;
-    const double target = next_hit < hits.size() ? hits[next_hit] : options.end_time;
-    // Land on the target when it is within dt; between dt and 2 dt away take half the
-    // remaining interval (no sliver step: a_{n+1} ~ 1/dt^2 amplifies round-off).
-    const double remaining = target - t;
-    const double t_new = remaining <= dt * (1.0 + kLandingTol) ? target
-                         : remaining < 2.0 * dt               ? t + 0.5 * remaining
-                                                              : t + dt;
-    const double h = t_new - t;
-    DynamicStepRecord rec;
-    rec.time = t_new;
-    rec.dt = h;
-
-    // Newmark relations in the step increment y = x_{n+1} - x_n (iterated instead of
-    // x_{n+1} itself so that a_{n+1} = c0 (y - base) does not lose digits to |x|):
-    //   base = dt v_n + dt^2 (1/2 - beta) a_n.
-    const double c0 = 1.0 / (beta * h * h);
-    const double t_alpha = (1.0 - af) * t_new + af * t;
-    const VecX base = h * v + (h * h * (0.5 - beta)) * a;
-    VecX y = h * v + (0.5 * h * h) * a;  // predictor a_{n+1} = a_n
-    bool failed = false;
-    {
-      VecX x_new = x;
-      if (!set_prescribed(t_new, x_new, rec.failure)) {
-        failed = true;
-        fatal = true;
-      }
-      for (const TimedDof& p : prescribed) y(p.dof) = x_new(p.dof) - x(p.dof);
-    }
-    // Residual R (all dofs) at y; false on an inverted element or a bad external force.
-    struct Eval {
-      VecX residual;
-      linalg::SparseMatrix tangent;
-      double scale = 0.0;
-    };
-    auto evaluate = [&](const VecX& yy, bool want_tangent, Eval& ev, std::string& why) {
-      const VecX a1 = c0 * (yy - base);
-      const VecX xa = x + (1.0 - af) * yy;
-      const VecX aa = (1.0 - am) * a1 + am * a;
-      const Assembly asm_ = model.assemble(xa, want_tangent);
-      if (!asm_.ok) {
-        why = asm_.message;
-        return false;
-      }
-      ExternalForce ext;
-      if (!eval_external(t_alpha, xa, want_tangent, ext, why)) {
-        fatal = true;
-        return false;
-      }
-      const VecX inertia = mass * aa;
-      ev.residual = inertia + asm_.force - ext.force;
-      ev.scale = std::max({asm_.force.norm(), ext.force.norm(), inertia.norm()});
-      if (!ev.residual.allFinite()) {
-        why = "non-finite residual";
-        return false;
-      }
-      if (want_tangent) {
-        ev.tangent = (c0 * (1.0 - am)) * mass + (1.0 - af) * asm_.tangent;
-        if (has_nonzeros(ext.tangent)) {
-          ev.tangent -= (1.0 - af) * ext.tangent;
-          if (!unsymmetric) {
-            try {
-              solver = std::make_unique<TangentSolver>(options.linear_solver, true);
-            } catch (const InputError& e) {
-              why = std::string("the external load has an unsymmetric tangent: ") + e.what();
-              fatal = true;
-              return false;
-            }
-            unsymmetric = true;
-          }
-        }
-      }
-      return true;
-    };
-
-    Eval ev;
-    double first_norm = -1.0;
-    while (!failed) {
-      std::string why;
-      if (!evaluate(y, true, ev, why)) {
-        rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + why;
-        failed = true;
-        break;
-      }
-      const VecX rf = free_part(ev.residual);
-      const double rnorm = rf.norm();
-      rec.residual_norms.push_back(rnorm);
-      if (first_norm < 0.0) first_norm = rnorm;
-      const double tol = std::max(options.residual_tol_abs, options.residual_tol_rel * ev.scale);
-      if (rnorm <= tol) {
-        rec.converged = true;
-        break;
-      }
-      if (rnorm > options.divergence_factor * std::max(first_norm, 1e-300)) {
-        rec.failure = "diverged: |R| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
-        failed = true;
-        break;
-      }
-      if (rec.iterations >= options.max_iterations) {
-        rec.failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|R| " +
-                      detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
-        failed = true;
-        break;
-      }
-      const linalg::SolveReport& sr = solver->factorize(select.transpose() * ev.tangent * select);
-      if (!sr.ok()) {
-        rec.failure = "linear solve " + sr.brief();
-        failed = true;
-        break;
-      }
-      const VecX dyf = solver->solve(-rf);
-      ++rec.iterations;
-      if (!dyf.allFinite()) {
-        rec.failure = "linear solve returned non-finite values";
-        failed = true;
-        break;
-      }
-      const VecX dy = select * dyf;
-      if (dyf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale) {
-        y += dy;
-        rec.step_lengths.push_back(1.0);
-        // Final state: residual (for the reactions) without the tangent.
-        if (!evaluate(y, false, ev, why)) {
-          rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + why;
-          failed = true;
-          break;
-        }
-        rec.residual_norms.push_back(free_part(ev.residual).norm());
-        rec.converged = true;
-        break;
-      }
-      double step = 1.0;
-      if (options.line_search) {
-        const detail::LineSearch ls =
-            detail::backtrack(rnorm, options.max_line_search, [&](double trial_step, bool& stop) -> std::optional<double> {
-              Eval trial;
-              std::string trial_why;
-              if (!evaluate(y + trial_step * dy, false, trial, trial_why)) {
-                stop = fatal;
-                return std::nullopt;
-              }
-              return free_part(trial.residual).norm();
-            });
-        if (ls.stopped) {
-          rec.failure = "iteration " + std::to_string(rec.iterations) + ": external force failed";
-          failed = true;
-          break;
-        }
-        if (ls.step < 0.0) {
-          rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
-          failed = true;
-          break;
-        }
-        step = ls.step;
-      }
-      y += step * dy;
-      rec.step_lengths.push_back(step);
-    }
-
-    // The end state must be admissible too (with af > 0 only x_{n+1-af} was assembled).
-    if (rec.converged && af > 0.0) {
-      const VecX x_end = x + y;
-      const Assembly end = model.assemble(x_end, false);
-      if (!end.ok) {
-        rec.converged = false;
-        rec.failure = "end state: " + end.message;
-      }
-    }
-    report.total_iterations += rec.iterations;
+    TimeStep step;
+    Balance end;
+    StepRecord rec = run.attempt(clock.next_end(run.time()), step, end);
     if (rec.converged) {
-      const VecX a_new = c0 * (y - base);
-      v += h * ((1.0 - gamma) * a + gamma * a_new);
-      a = a_new;
-      x += y;
-      set_prescribed(t_new, x, rec.failure);  // exact prescribed values (no round-off drift)
-      t = t_new;
-      ++report.n_converged_steps;
-      report.last_dt = h;
-      report.min_dt_used = report.n_converged_steps == 1 ? h : std::min(report.min_dt_used, h);
-      report.max_dt_used = std::max(report.max_dt_used, h);
-      for (Index d = 0; d < n; ++d) result.reactions(d) = kind[d] == kPrescribed ? ev.residual(d) : 0.0;
-      if (rec.iterations <= options.easy_iterations) dt = std::min(max_dt, dt * options.growth);
-      if (options.keep_step_records) report.steps.push_back(std::move(rec));
-      if (on_step) on_step(t, x, v);
+      run.accept(step, end, result.reactions);
+      report.last_dt = step.h;
+      report.min_dt_used = report.n_converged_steps == 0 ? step.h : std::min(report.min_dt_used, step.h);
+      report.max_dt_used = std::max(report.max_dt_used, step.h);
+      if (rec.iterations <= options.easy_iterations) clock.grow();
+      report.add(std::move(rec), options.keep_step_records);
+      if (on_step) on_step(run.time(), run.x(), run.v());
       continue;
     }
-    ++report.n_cutbacks;
     const std::string why = rec.failure;
-    if (options.keep_step_records) report.steps.push_back(std::move(rec));
-    if (fatal) {
-      report.status = DynamicReport::Status::kStepFailed;
-      report.message = "time step from t = " + detail::short_number(t) + " failed: " + why;
+    report.add(std::move(rec), options.keep_step_records);
+    const std::string from = "time step from t = " + detail::short_number(run.time());
+    if (run.fatal()) {
+      report.status = SolveStatus::kStepFailed;
+      report.message = from + " failed: " + why;
       break;
     }
-    dt = std::min(dt, h) * options.cutback_factor;
-    if (dt < options.min_dt) {
-      report.status = DynamicReport::Status::kStepFailed;
-      report.message = "time step from t = " + detail::short_number(t) + " failed (" + why + "); dt cut back below min_dt " +
-                       detail::short_number(options.min_dt);
+    if (!clock.cut_back(step.h)) {
+      report.status = SolveStatus::kStepFailed;
+      report.message = from + " failed (" + why + "); dt cut back below min_dt " + detail::short_number(options.min_dt);
       break;
     }
   }
-  if (t >= options.end_time) {
-    report.status = DynamicReport::Status::kCompleted;
+  if (run.time() >= options.end_time) {
+    report.status = SolveStatus::kConverged;
     report.message.clear();
   }
-  report.time = t;
-  result.positions = x;
-  result.velocities = v;
-  result.accelerations = a;
+  report.time = run.time();
+  result.positions = run.x();
+  result.velocities = run.v();
+  result.accelerations = run.a();
   return result;
 }
 

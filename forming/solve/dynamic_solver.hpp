@@ -1,26 +1,17 @@
 #pragma once
-// Implicit dynamics with inertia for the forming solver: consistent mass matrix and a
-// generalised-alpha time integrator (HHT-alpha and Newmark as special cases) with a
-// Newton solve per step, automatic time-step cut-back and regrowth.
+// Implicit dynamics with inertia for the forming solver: a generalised-alpha time
+// integrator (HHT-alpha and Newmark as special cases) with a Newton solve per step,
+// automatic time-step cut-back and regrowth. The consistent mass matrix comes from
+// forming/solve/mass.hpp.
 //
 // Units (consistent set): lengths mm, time s, mass t (tonne), density t/mm^3, so that
 // force = t mm/s^2 = N, energy N mm, stiffness N/mm, mass matrix t, velocity mm/s,
 // acceleration mm/s^2. (Steel 7.85e-9 t/mm^3; a dry carbon ply ~1.5e-9 t/mm^3.)
 //
-// Unknowns and layout are those of Model (forming/solve/static_solver.hpp): x = current
+// Unknowns and layout are those of Model (forming/model/model.hpp): x = current
 // POSITIONS (n_dofs, flattened like PlyMesh::flatten, derivative parameters included),
 // v = dx/dt, a = d2x/dt2 (the derivative parameters' rates are those of the arc-length
 // derivatives: 1/s and 1/s^2).
-//
-// Mass matrix (mass_matrix):
-//   M_ij = sum over bricks of  int_{V0} rho_b N_k N_l dV0  mapped to global dofs,
-// the brick's 32 x 32 scalar mass m_kl = sum_q w_q det G_q rho_b N_k(xi_q) N_l(xi_q)
-// (the stiffness' Gauss rule model.rule().brick(), reference volume dV0 = w det G) is
-// scattered through PlyMesh::element_map with the scale-factor coefficients:
-//   M[3 p + i, 3 p' + i] += coef_k(p) coef_l(p') m_kl  for every coordinate i,
-// and M[3 p + i, 3 p' + j] = 0 for i != j (not stored: block diagonal per coordinate).
-// Kinetic energy T = 1/2 v^T M v; for a rigid translation u (value parameters = unit
-// vector e, derivative parameters 0), u^T M u = total mass.
 //
 // Time integration (Chung & Hulbert 1993; notes/forming-verification.md section 3.3):
 //   Newmark:   x_{n+1} = x_n + dt v_n + dt^2 [(1/2 - beta) a_n + beta a_{n+1}]
@@ -44,10 +35,14 @@
 //   FEBio's alpha_f, alpha_m are 1 - af, 1 - am.
 //   Newton on x_{n+1} (free dofs), with a_{n+1} = (x_{n+1} - x_n - dt v_n)/(beta dt^2)
 //   - (1/(2 beta) - 1) a_n and the consistent effective tangent
-//     S = dR/dx_{n+1} = (1 - am)/(beta dt^2) M + (1 - af) (K(x_{n+1-af}) - K_ext),
-//   K = d f_int/dx (Model::assemble), K_ext = d f_ext/dx (external force callback).
-//   Linear solves: LinearSolver with kSymmetricIndefinite (S symmetric) unless some
-//   external tangent has nonzeros, then (from that step on) kUnsymmetric.
+//     S = dR/dx_{n+1} = (1 - am)/(beta dt^2) M
+//                       + (1 - af) (K(x_{n+1-af}) - K_ext + gamma/(beta dt) D),
+//   K = d f_int/dx (Model::assemble), K_ext = d f_ext/dx (external force callback),
+//   D = d f_int/dv (velocity-dependent interactions, forming/model/interaction.hpp; they
+//   see t_{n+1-af} and v_{n+1-af} = (1 - af) v_{n+1} + af v_n).
+//   Linear solves: TangentSolver (forming/solve/tangent_solver.hpp) for a symmetric S
+//   unless the model's interactions or some external tangent are unsymmetric, then
+//   (from that step on) an unsymmetric factorisation.
 //   Predictor: a_{n+1} = a_n on free dofs (x_{n+1} = x_n + dt v_n + dt^2/2 a_n),
 //   prescribed dofs at their positions at t_{n+1}.
 //   Convergence: |R_f| <= max(residual_tol_abs, residual_tol_rel * force_scale),
@@ -93,18 +88,13 @@
 #include "common/core/types.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
-#include "forming/solve/static_solver.hpp"
+#include "forming/model/loads.hpp"
+#include "forming/model/model.hpp"
+#include "forming/model/prescriptions.hpp"
+#include "forming/solve/mass.hpp"
+#include "forming/solve/step_history.hpp"
 
 namespace sf::forming {
-
-// Consistent mass matrix (n_dofs x n_dofs, t; symmetric positive semi-definite, block
-// diagonal per coordinate). density: one value per body (t/mm^3, finite, >= 0). Throws
-// sf::InputError naming "mass matrix density" for a wrong count or value, and for a
-// brick whose reference geometry is inverted (det G <= 0 at a Gauss point).
-linalg::SparseMatrix mass_matrix(const Model& model, const std::vector<double>& density);
-
-// 1/2 v^T M v (N mm).
-double kinetic_energy(const linalg::SparseMatrix& mass, const Eigen::Ref<const VecX>& velocity);
 
 // ---------------------------------------------------------------------------------
 // Loads and prescribed motion
@@ -112,19 +102,13 @@ double kinetic_energy(const linalg::SparseMatrix& mass, const Eigen::Ref<const V
 // External force at (time, x): force (n_dofs, N; empty = none) and, when asked for and
 // the load depends on x (follower loads), its derivative d force / dx (n_dofs x n_dofs,
 // N/mm; empty or without nonzeros = none).
-// The same load type as the static solver's (forming/solve/static_solver.hpp ExternalLoad),
-// so the case's loads (forming/model/loads.hpp) plug into both.
+// The same load type as the static solver's (forming/model/loads.hpp ExternalLoad), so
+// the case's loads plug into both.
 using ExternalForce = ExternalLoad;
 // Called with the time, the positions at which the load acts (x_{n+1-af} during a step,
 // x0 at the start) and whether the tangent is wanted. An empty function = no load.
 // (The static solver's LoadFunction, with the time in place of the load factor.)
 using ExternalForceFn = LoadFunction;
-
-// A prescribed dof: position(t) (mm; dimensionless for a derivative parameter).
-struct TimedDof {
-  Index dof = -1;
-  std::function<double(double)> position;
-};
 
 // Called once with the initial state and then after every converged step:
 // time (s), positions x (mm) and velocities v (mm/s), all n_dofs.
@@ -191,38 +175,17 @@ struct DynamicOptions {
 // ---------------------------------------------------------------------------------
 // Report and result
 
-struct DynamicStepRecord {
-  double time = 0.0;  // end of the step (target), s
-  double dt = 0.0;    // s
-  bool converged = false;
-  int iterations = 0;                  // Newton solves
-  std::vector<double> residual_norms;  // |R_f| at the predictor and after each correction
-  std::vector<double> step_lengths;    // line-search factor of each correction (1 = full)
-  std::string failure;                 // why it failed (empty when converged)
-};
-
-struct DynamicReport {
-  enum class Status {
-    kCompleted,     // end_time reached
-    kStepFailed,    // dt cut back below min_dt, max_steps reached, or a fatal step error
-    kInvalidStart,  // bad sizes, prescribed dofs, an inverted start state, singular M_ff
-  };
-  Status status = Status::kStepFailed;
-  std::string message;
-  double time = 0.0;  // of the returned (last converged) state, s
-  int n_converged_steps = 0;
-  int n_cutbacks = 0;
-  int total_iterations = 0;
-  double last_dt = 0.0;           // of the last converged step, s
-  double min_dt_used = 0.0;       // smallest converged step, s (0 before the first)
-  double max_dt_used = 0.0;       // largest converged step, s
-  std::vector<DynamicStepRecord> steps;  // attempted steps (if keep_step_records)
-  bool ok() const { return status == Status::kCompleted; }
-  // One line, e.g. "completed: t 0.001 in 100 steps (0 cut-backs), 250 Newton iterations, dt 1e-05..1e-05".
+// The time steps of a solve (forming/solve/step_history.hpp: status, message, counters,
+// every attempted step with target = its end time and increment = dt, last_residual()).
+struct DynamicReport : StepHistory {
+  double time = 0.0;         // of the returned (last converged) state, s
+  double last_dt = 0.0;      // of the last converged step, s
+  double min_dt_used = 0.0;  // smallest converged step, s (0 before the first)
+  double max_dt_used = 0.0;  // largest converged step, s
+  // One line, e.g. "converged: t 0.001 in 100 steps (0 cut-backs), 250 Newton
+  // iterations, dt 1e-05..1e-05, |R| 2e-12".
   std::string brief() const;
 };
-
-std::string to_string(DynamicReport::Status status);
 
 struct DynamicResult {
   VecX positions;      // last converged state x (n_dofs, mm)

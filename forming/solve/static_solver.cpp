@@ -10,6 +10,7 @@
 #include "common/core/error.hpp"
 #include "forming/solve/line_search.hpp"
 #include "forming/solve/messages.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 namespace sf::forming {
 namespace {
@@ -23,148 +24,6 @@ namespace {
 constexpr double kIncrementTolRel = 1e-14;
 
 }  // namespace
-
-// ---------------------------------------------------------------------------------
-// Model
-
-Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()) {}
-
-int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
-  if (!material) throw InputError("model: ply added without a material");
-  constraints.validate();
-  if (constraints.inextensible && material->fibre_direction().isZero(0.0))
-    throw InputError("model: fibre inextensibility asked for a material without fibres (" + material->name() + ")");
-  const Index n = ply.n_dofs();
-  const Index ne = ply.n_elements();
-  Body b{std::move(ply), std::move(material), n_dofs_, constraints, {}, {}};
-  if (constraints.active()) {
-    b.p.assign(static_cast<std::size_t>(ne), constraints.p);
-    b.T.assign(static_cast<std::size_t>(ne), constraints.T);
-  }
-  bodies_.push_back(std::move(b));
-  n_dofs_ += n;
-  return n_bodies() - 1;
-}
-
-void Model::set_multipliers(int body, std::vector<double> p, std::vector<double> T) {
-  Body& b = bodies_.at(static_cast<std::size_t>(body));
-  SF_ASSERT(static_cast<Index>(p.size()) == b.ply.n_elements() && static_cast<Index>(T.size()) == b.ply.n_elements(),
-            "one multiplier per element");
-  b.p = std::move(p);
-  b.T = std::move(T);
-}
-
-ConstraintTerms Model::element_constraints(const Body& b, Index e) const {
-  ConstraintTerms c = b.constraints;
-  if (c.active()) {
-    c.p = b.p[static_cast<std::size_t>(e)];
-    c.T = b.T[static_cast<std::size_t>(e)];
-  }
-  return c;
-}
-
-std::vector<Model::ConstraintState> Model::constraint_state(int body, const Eigen::Ref<const VecX>& x) const {
-  const Body& b = bodies_.at(static_cast<std::size_t>(body));
-  std::vector<ConstraintState> out;
-  if (!b.constraints.active()) return out;
-  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
-  for (Index e = 0; e < b.ply.n_elements(); ++e) {
-    const ElementResult r = brick_element(b.ply.element_parameters(e, b.ply.reference()), b.ply.element_parameters(e, xb),
-                                          *b.material, brick_rule_, false, element_constraints(b, e));
-    out.push_back({r.g_J, r.g_T, r.p_eff, r.T_eff, r.volume});
-  }
-  return out;
-}
-
-VecX Model::reference_positions() const {
-  VecX x(n_dofs_);
-  for (const Body& b : bodies_) x.segment(b.offset, b.ply.n_dofs()) = b.ply.reference_dofs();
-  return x;
-}
-
-std::vector<bool> Model::used_dofs() const {
-  std::vector<bool> used(n_dofs_, false);
-  for (const Body& b : bodies_)
-    for (Index e = 0; e < b.ply.n_elements(); ++e) {
-      const BrickMap map = b.ply.element_map(e);
-      for (int k = 0; k < kBrickFunctions; ++k)
-        for (int t = 0; t < map.n_terms[k]; ++t)
-          if (map.terms[k][t].coef != 0.0)
-            for (int i = 0; i < 3; ++i) used[b.offset + 3 * map.terms[k][t].dof + i] = true;
-    }
-  return used;
-}
-
-Model::ElementDofs Model::element_dofs(int body, Index e) const {
-  const Body& b = bodies_[body];
-  const BrickMap map = b.ply.element_map(e);
-  ElementDofs out;
-  for (int k = 0; k < kBrickFunctions; ++k)
-    for (int t = 0; t < map.n_terms[k]; ++t)
-      for (int i = 0; i < 3; ++i) {
-        out.dofs.push_back(b.offset + 3 * map.terms[k][t].dof + i);
-        out.coefs.push_back(map.terms[k][t].coef);
-        out.local.push_back(3 * k + i);
-      }
-  return out;
-}
-
-Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) const {
-  SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
-  Assembly out;
-  out.force = VecX::Zero(n_dofs_);
-  linalg::TripletAssembler triplets(n_dofs_, n_dofs_);
-  if (want_tangent) {
-    Index n_el = 0;
-    for (const Body& b : bodies_) n_el += b.ply.n_elements();
-    triplets.reserve(n_el * kBrickDofs * kBrickDofs);
-  }
-  MatX block;
-  for (int body = 0; body < n_bodies(); ++body) {
-    const Body& b = bodies_[body];
-    const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
-    for (Index e = 0; e < b.ply.n_elements(); ++e) {
-      const BrickParams X_e = b.ply.element_parameters(e, b.ply.reference());
-      const BrickParams x_e = b.ply.element_parameters(e, xb);
-      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent, element_constraints(b, e));
-      if (!r.ok()) {
-        out.ok = false;
-        out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
-                      to_string(r.status) + " (min det F " + detail::short_number(r.min_det_f) + ")";
-        out.energy = std::numeric_limits<double>::infinity();
-        return out;
-      }
-      out.energy += r.energy;
-      // Expanded local -> global list: one entry per (function, map term, coordinate);
-      // duplicates (collapsed elements) are summed by the assembler.
-      const ElementDofs ed = element_dofs(body, e);
-      const std::vector<Index>& dofs = ed.dofs;
-      const std::vector<double>& coefs = ed.coefs;
-      const std::vector<int>& local = ed.local;
-      const int m = static_cast<int>(dofs.size());
-      for (int a = 0; a < m; ++a) out.force(dofs[a]) += coefs[a] * r.force(local[a]);
-      if (!want_tangent) continue;
-      block.resize(m, m);
-      for (int c = 0; c < m; ++c)
-        for (int a = 0; a < m; ++a) block(a, c) = coefs[a] * coefs[c] * r.tangent(local[a], local[c]);
-      triplets.add_block(dofs, dofs, block);
-    }
-  }
-  if (want_tangent) out.tangent = triplets.compress();
-  return out;
-}
-
-std::vector<Mat3> Model::deformation_gradients(int body, const Eigen::Ref<const VecX>& x) const {
-  const Body& b = bodies_[body];
-  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
-  std::vector<Mat3> out;
-  for (Index e = 0; e < b.ply.n_elements(); ++e) {
-    const std::vector<Mat3> f = brick_deformation_gradients(b.ply.element_parameters(e, b.ply.reference()),
-                                                            b.ply.element_parameters(e, xb), brick_rule_);
-    out.insert(out.end(), f.begin(), f.end());
-  }
-  return out;
-}
 
 // ---------------------------------------------------------------------------------
 // Options and report
@@ -189,77 +48,12 @@ void StaticOptions::validate() const {
                      "' is not compiled in");
 }
 
-std::string to_string(StaticReport::Status status) {
-  switch (status) {
-    case StaticReport::Status::kConverged:
-      return "converged";
-    case StaticReport::Status::kStepFailed:
-      return "step-failed";
-    case StaticReport::Status::kInvalidStart:
-      return "invalid-start";
-  }
-  return "unknown";
-}
-
 std::string StaticReport::brief() const {
   std::ostringstream os;
-  os << to_string(status) << ": lambda " << load_factor << " in " << n_converged_steps << " steps ("
-     << n_cutbacks << " cut-backs), " << total_iterations << " Newton iterations";
-  for (auto it = steps.rbegin(); it != steps.rend(); ++it)
-    if (it->converged && !it->residual_norms.empty()) {
-      os << ", |r| " << detail::short_number(it->residual_norms.back());
-      break;
-    }
+  os << to_string(status) << ": lambda " << load_factor << " " << counts();
+  if (n_converged_steps > 0) os << ", |r| " << detail::short_number(last_residual());
   if (!message.empty()) os << "; " << message;
   return os.str();
-}
-
-TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric) {
-  const bool try_cholesky = kind == linalg::SolverKind::kAuto && !unsymmetric &&
-                            linalg::solver_available(linalg::SolverKind::kCholmod);
-  if (try_cholesky)
-    spd_ = std::make_unique<linalg::LinearSolver>(linalg::SolverKind::kCholmod,
-                                                  linalg::MatrixProperty::kSymmetricPositiveDefinite);
-  general_ = std::make_unique<linalg::LinearSolver>(
-      kind, unsymmetric ? linalg::MatrixProperty::kUnsymmetric : linalg::MatrixProperty::kSymmetricIndefinite);
-}
-
-const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& k) {
-  if (spd_ && skip_cholesky_ > 0) {
-    --skip_cholesky_;
-  } else if (spd_) {
-    const linalg::SolveReport& r = spd_->factorize(k);
-    if (r.ok()) {
-      active_ = spd_.get();
-      return r;
-    }
-    skip_cholesky_ = 4;
-  }
-  const linalg::SolveReport& r = general_->factorize(k);
-  active_ = r.ok() ? general_.get() : nullptr;
-  return r;
-}
-
-Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
-  SF_ASSERT(active_ != nullptr, "TangentSolver::solve() needs a successful factorize()");
-  return active_->solve(b);
-}
-
-FreeDofs::FreeDofs(const std::vector<bool>& is_free) {
-  const Index n = static_cast<Index>(is_free.size());
-  for (Index d = 0; d < n; ++d)
-    if (is_free[static_cast<std::size_t>(d)]) index.push_back(d);
-  select.resize(n, size());
-  std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(index.size());
-  for (Index j = 0; j < size(); ++j) t.emplace_back(static_cast<int>(index[j]), static_cast<int>(j), 1.0);
-  select.setFromTriplets(t.begin(), t.end());
-}
-
-VecX FreeDofs::restrict(const VecX& v) const {
-  VecX out(size());
-  for (Index j = 0; j < size(); ++j) out(j) = v(index[j]);
-  return out;
 }
 
 // ---------------------------------------------------------------------------------
@@ -272,7 +66,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     StaticResult result;
     result.positions = x_start;
     result.reactions = VecX::Zero(model.n_dofs());
-    result.report.status = StaticReport::Status::kInvalidStart;
+    result.report.status = SolveStatus::kInvalidStart;
     result.report.message = "external force has " + std::to_string(f_ext.size()) + " entries, expected " +
                             std::to_string(model.n_dofs());
     return result;
@@ -292,7 +86,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   result.positions = x_start;
   result.reactions = VecX::Zero(n);
   auto invalid = [&](const std::string& msg) {
-    report.status = StaticReport::Status::kInvalidStart;
+    report.status = SolveStatus::kInvalidStart;
     report.message = msg;
     return result;
   };
@@ -346,7 +140,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (!a0.ok) return invalid("start state: " + a0.message);
   }
 
-  TangentSolver solver(options.linear_solver, unsymmetric);
+  TangentSolver solver(options.linear_solver, unsymmetric || !model.symmetric_tangent());
   VecX x = x_start;
   double lambda = 0.0;
   double increment = std::min(options.initial_increment, options.max_increment);
@@ -361,7 +155,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   int attempts = 0;
   while (lambda < 1.0) {
     if (attempts >= options.max_steps) {
-      report.status = StaticReport::Status::kStepFailed;
+      report.status = SolveStatus::kStepFailed;
       report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted load steps reached at lambda " +
                        detail::short_number(lambda);
       break;
@@ -369,7 +163,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     ++attempts;
     const double lam_new = (1.0 - lambda <= increment * (1.0 + 1e-12)) ? 1.0 : lambda + increment;
     StepRecord rec;
-    rec.load_factor = lam_new;
+    rec.target = lam_new;
     rec.increment = lam_new - lambda;
 
     // Predictor: tangent at the converged state, prescribed dofs moved.
@@ -467,29 +261,26 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       xt += alpha * dx;
       rec.step_lengths.push_back(alpha);
     }
-    report.total_iterations += rec.iterations;
     if (rec.converged) {
       x = xt;
       lambda = lam_new;
-      ++report.n_converged_steps;
       if (rec.iterations <= options.easy_iterations)
         increment = std::min(options.max_increment, increment * options.growth);
-      report.steps.push_back(std::move(rec));
+      report.add(std::move(rec));
       continue;
     }
-    ++report.n_cutbacks;
     const std::string why = rec.failure;
-    report.steps.push_back(std::move(rec));
+    report.add(std::move(rec));
     increment *= 0.5;
     if (increment < options.min_increment) {
-      report.status = StaticReport::Status::kStepFailed;
+      report.status = SolveStatus::kStepFailed;
       report.message = "load step from lambda " + detail::short_number(lambda) + " failed (" + why +
                        "); increment cut back below min_increment " + detail::short_number(options.min_increment);
       break;
     }
   }
   if (lambda >= 1.0) {
-    report.status = StaticReport::Status::kConverged;
+    report.status = SolveStatus::kConverged;
     report.message.clear();
   }
   report.load_factor = lambda;
@@ -504,8 +295,7 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
                                       UzawaReport* report) {
   UzawaReport rep;
   StaticResult r = solve_static(model, x_start, prescribed, load, unsymmetric, options);
-  bool any = false;
-  for (int b = 0; b < model.n_bodies(); ++b) any = any || model.constrained(b);
+  const bool any = model.any_constrained();
   auto measure = [&](const VecX& x) {
     rep.max_g_J = rep.max_g_T = 0.0;
     for (int b = 0; b < model.n_bodies(); ++b)
@@ -521,7 +311,7 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
     while (measure(r.positions) > uzawa.tolerance) {
       if (rep.updates >= uzawa.max_updates) {
         rep.converged = false;
-        r.report.status = StaticReport::Status::kStepFailed;
+        r.report.status = SolveStatus::kStepFailed;
         r.report.message = "constraints not met after " + std::to_string(uzawa.max_updates) +
                            " multiplier updates (max |mean J - 1| " + detail::short_number(rep.max_g_J) + ", max |mean (I4 - 1)/2| " +
                            detail::short_number(rep.max_g_T) + ", tolerance " + detail::short_number(uzawa.tolerance) + ")";

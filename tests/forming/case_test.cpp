@@ -1,4 +1,4 @@
-// Case files and `simform run` (forming/case/case.hpp, forming/run/run.hpp):
+// Case files and `simform run` (forming/case/reader.hpp, forming/run/run.hpp):
 //  - check lists EVERY problem with its line and column (not just the first);
 //  - the sample cases in data/forming/ check clean;
 //  - a uniaxial stretch of a TI ply (fibres along or across the load) gives the reaction
@@ -18,7 +18,7 @@
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
 #include "common/io/json.hpp"
-#include "forming/case/case.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/run/run.hpp"

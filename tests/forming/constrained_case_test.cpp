@@ -13,8 +13,8 @@
 #include <cstdio>
 #include <string>
 
-#include "forming/case/case.hpp"
-#include "forming/run/run.hpp"
+#include "forming/case/build.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/solve/static_solver.hpp"
 
 namespace sf::forming {
@@ -40,9 +40,10 @@ TEST(ConstrainedCase, TensionAcrossInextensibleFibresIsExact) {
   const CaseCheck check = check_case_text(kCaseB, "case_b.yaml");
   ASSERT_TRUE(check.ok()) << check.located(0);
   const FormingCase& spec = check.spec;
-  Model model = build_model(spec);
+  Problem problem = build_problem(spec);
+  Model& model = problem.model;
   ASSERT_TRUE(model.constrained(0));
-  const CaseLoads loads = build_loads(spec, model);
+  const RampedLoads& loads = problem.loads;
   VecX x = model.reference_positions();
   StaticOptions so;
   so.residual_tol_rel = 1e-11;
@@ -52,7 +53,7 @@ TEST(ConstrainedCase, TensionAcrossInextensibleFibresIsExact) {
   for (int k = 1; k <= 4; ++k) {
     const LoadFunction none = [&](double, const VecX& xs, bool t) { return loads.at(model, 0.0, xs, t); };
     UzawaReport ur;
-    const StaticResult r = solve_static_constrained(model, x, prescribed_at(spec, model, k / 4.0), none, false, so, uo, &ur);
+    const StaticResult r = solve_static_constrained(model, x, problem.prescriptions.at(k / 4.0), none, false, so, uo, &ur);
     ASSERT_TRUE(r.report.ok()) << r.report.brief();
     updates += ur.updates;
     x = r.positions;

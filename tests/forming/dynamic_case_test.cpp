@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "forming/case/case.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
 
 namespace sf::forming {

@@ -536,7 +536,7 @@ TEST(DynamicsStepping, HitTimesRegrowthAndCallback) {
     EXPECT_NE(std::find(times.begin(), times.end(), h), times.end()) << "hit time " << h;
   EXPECT_TRUE(std::is_sorted(times.begin(), times.end()));
   EXPECT_DOUBLE_EQ(r.report.max_dt_used, opt.max_dt);
-  EXPECT_DOUBLE_EQ(r.report.steps.front().dt, opt.initial_dt);
+  EXPECT_DOUBLE_EQ(r.report.steps.front().increment, opt.initial_dt);
   EXPECT_EQ(r.report.n_cutbacks, 0);
 }
 

@@ -16,6 +16,7 @@
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
 #include "forming/solve/static_solver.hpp"
 

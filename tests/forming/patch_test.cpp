@@ -161,7 +161,7 @@ void run_patch(const std::shared_ptr<const Material>& material, const PlyMesh& p
   std::printf("%s: %s\n", label, res.report.brief().c_str());
   ASSERT_TRUE(res.report.ok()) << res.report.brief();
   for (const StepRecord& s : res.report.steps) {
-    std::printf("  step to lambda %.3f (%s), |r|/scale:", s.load_factor, s.converged ? "converged" : "failed");
+    std::printf("  step to lambda %.3f (%s), |r|/scale:", s.target, s.converged ? "converged" : "failed");
     for (double r : s.residual_norms) std::printf(" %.2e", r / res.report.force_scale);
     std::printf("; line-search factors:");
     for (double a : s.step_lengths) std::printf(" %.3g", a);
@@ -188,8 +188,8 @@ void run_patch(const std::shared_ptr<const Material>& material, const PlyMesh& p
     for (std::size_t k = 0; k + 1 < e.size(); ++k) {
       if (e[k] > kAsymptotic || e[k + 1] <= kRoundoffFloor) continue;
       const double ratio = e[k + 1] / (e[k] * e[k]);
-      std::printf("  lambda %.2f: e_%zu / e_%zu^2 = %.3g\n", s.load_factor, k + 1, k, ratio);
-      EXPECT_LT(ratio, kQuadraticBound) << "step to lambda " << s.load_factor << ", iteration " << k + 1;
+      std::printf("  lambda %.2f: e_%zu / e_%zu^2 = %.3g\n", s.target, k + 1, k, ratio);
+      EXPECT_LT(ratio, kQuadraticBound) << "step to lambda " << s.target << ", iteration " << k + 1;
       ++checked;
     }
   }

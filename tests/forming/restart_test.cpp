@@ -9,7 +9,7 @@
 #include <string>
 
 #include "common/core/error.hpp"
-#include "forming/case/case.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
 
 namespace sf::forming {

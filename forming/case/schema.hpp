@@ -1,29 +1,34 @@
 #pragma once
-// Case files of `simform` (YAML, read with yaml-cpp; format documented in docs/forming.md).
+// What a case file of `simform` holds (YAML; the format is documented in
+// docs/forming.md): the data as read and checked by forming/case/reader.hpp, with the
+// place in the file of everything a problem may be reported at.
 //
 //   units: "mm, N, MPa"            # informational; any consistent set works
 //   materials:
 //     gfpp:
 //       transversely_isotropic: {E_f: 25000, E_T: 1, G_L: 0.5, G_T: 0.4}
+//       density: 1.5e-9                           # t/mm^3: gravity and dynamics
+//       inextensible: true                        # exact element-mean constraints
 //   plies:
 //     - {name: ply, size: [100, 20], thickness: 2, elements: [10, 2], angle: 0, material: gfpp}
 //   boundary_conditions:
 //     - clamp: {ply: ply, edge: x0}
 //     - displacement: {ply: ply, edge: x1, value: [5, ~, ~], ramp: linear}
 //     - symmetry: {ply: ply, plane: bottom}
-//   solver: {steps: 10, max_iterations: 25, tolerance: 1e-8, line_search: true}
 //   loads:
 //     - pressure: {ply: ply, face: top, value: 0.01, follower: true, ramp: linear}
-//     - gravity: {acceleration: [0, 0, -9810]}     # materials need density: t/mm^3
+//     - gravity: {acceleration: [0, 0, -9810]}
+//   solver: {steps: 10, analysis: static, control: load, tolerance: 1e-8}
 //   output: {every: 1, samples: [4, 2]}
 //
-// Quasi-static only for now: no contact, no dynamics, no exact constraints (the TI law
-// is used in its compressible form).
+// A case can ask for: plies of neo-Hookean or transversely isotropic material (the
+// compressible forms, optionally with exact element-mean incompressibility and fibre
+// inextensibility), clamps, prescribed edge displacements and symmetry planes;
+// follower or dead pressure, gravity, edge and point forces, each with its ramp;
+// quasi-static load control, arc-length control (through limit points) or implicit
+// dynamics with inertia. Not yet: contact, tools, inter-ply slip.
 //
-// check_case_*() returns EVERY problem found (unknown keys, wrong types, values out of
-// range, unknown names, conflicting boundary conditions), each with its place in the
-// file (1-based line and column of yaml-cpp's Mark); load_case() throws sf::InputError
-// when there is any.
+// Units: those of the file (the samples use mm, N, MPa, s, t/mm^3).
 
 #include <array>
 #include <optional>
@@ -33,6 +38,9 @@
 #include "common/core/types.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
+#include "forming/model/ply_grid.hpp"
+#include "forming/model/prescriptions.hpp"
+#include "forming/model/ramp.hpp"
 
 namespace sf::forming {
 
@@ -41,17 +49,6 @@ struct SourcePlace {
   int line = 0;
   int column = 0;
 };
-
-// Sides of a rectangular ply (reference frame of the ply: x along size[0], y along size[1]);
-// kBottom is the face z = origin z (symmetry planes only).
-enum class PlySide { kX0, kX1, kY0, kY1, kBottom };
-std::string to_string(PlySide side);
-
-// Load-factor ramp r(t), t in [0, 1], r(0) = 0, r(1) = 1.
-//   kLinear r = t;  kSmooth r = 3 t^2 - 2 t^3 (zero rate at both ends).
-enum class Ramp { kLinear, kSmooth };
-std::string to_string(Ramp ramp);
-double ramp_value(Ramp ramp, double t);
 
 struct CaseMaterial {
   enum class Kind { kNeoHookean, kTransverselyIsotropic };
@@ -80,11 +77,10 @@ struct CasePly {
 };
 
 struct CaseBoundary {
-  enum class Kind {
-    kClamp,         // every dof (values and derivatives, both layers) of the edge nodes fixed
-    kDisplacement,  // edge translated by value * ramp(load factor); null components free
-    kSymmetry,      // mirror plane through the side (see docs/forming.md for the dofs)
-  };
+  // kClamp: every dof (values and derivatives, both layers) of the edge nodes fixed;
+  // kDisplacement: edge translated by value * ramp(load factor), null components free;
+  // kSymmetry: mirror plane through the side (forming/model/prescriptions.hpp).
+  using Kind = EdgeCondition::Kind;
   Kind kind = Kind::kClamp;
   std::string ply;
   int ply_index = -1;
@@ -93,7 +89,6 @@ struct CaseBoundary {
   Ramp ramp = Ramp::kLinear;
   SourcePlace place;
 };
-std::string to_string(CaseBoundary::Kind kind);
 
 // A load, scaled by ramp(load factor):
 //   pressure     {ply, face: top|bottom, value: MPa (positive pushes into the ply),
@@ -127,18 +122,21 @@ struct CaseSolver {
   bool line_search = true;
   double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
   double constraint_tolerance = 1e-8;  // |mean J - 1|, |mean (I4 - 1)/2| after the multiplier updates
-  // analysis: dynamic (inertia; forming/solve/dynamic_solver.hpp). The load factor is then t/end_time
-  // and the steps are output intervals of end_time/steps.
+  // analysis: dynamic (inertia; forming/solve/dynamic_solver.hpp). The load factor is
+  // then t / end_time and the steps are output intervals of end_time / steps.
   bool dynamic = false;
   double end_time = 1.0;         // s
   double time_step = 0.0;        // s, first (and largest) time step; 0 = end_time / (10 steps)
   std::string integrator = "generalized-alpha";  // | hht-alpha | newmark
   double rho_inf = 0.8;          // generalised-alpha high-frequency spectral radius
   // control: arc_length (static only): the load factor is an unknown and each step
-  // advances a fixed path length (mm) through limit points (forming/solve/arc_length.hpp);
-  // steps is then the maximum number of arc-length steps, the run ends past lambda 1.
+  // advances a fixed path length (mm) through limit points
+  // (forming/solve/arc_length.hpp); steps is then the maximum number of arc-length
+  // steps, the run ends past lambda 1.
   double arc_length = 0.0;       // mm; 0 = load control
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
+  SourcePlace analysis_place;      // of the value of "analysis" (cross-field problems); 0: not given
+  SourcePlace control_place;       // of the value of "control"; 0: not given
 };
 
 struct CaseOutput {
@@ -159,52 +157,5 @@ struct FormingCase {
 
   int find_ply(const std::string& name) const;  // -1 when absent
 };
-
-struct CaseProblem {
-  SourcePlace place;
-  std::string message;
-};
-
-struct CaseCheck {
-  FormingCase spec;                   // complete only when ok()
-  std::vector<CaseProblem> problems;  // in file order
-  bool ok() const { return problems.empty(); }
-  // "FILE:LINE:COLUMN: message" for problem i.
-  std::string located(std::size_t i) const;
-};
-
-// Reads and validates a case file (a missing file is a problem too).
-CaseCheck check_case_file(const std::string& path);
-// Same from text; `name` stands for the file name in messages.
-CaseCheck check_case_text(const std::string& text, const std::string& name);
-// check_case_file(); throws sf::InputError with the first problem and the number of
-// others ("run simform check") when there is any.
-FormingCase load_case(const std::string& path);
-
-}  // namespace sf::forming
-
-namespace sf::forming {
-
-// One prescribed parameter of a ply: ply node (PlyMesh::node numbering, structured
-// rectangle: surface node j (n1 + 1) + i, layer 0 bottom / 1 top), parameter d
-// (0 value, 1 d/ds1, 2 d/ds2, 3 cross), coordinate; its target is
-// reference + displacement * ramp(load factor).
-struct PlyPrescription {
-  Index node = 0;
-  int d = 0;
-  int coord = 0;
-  double displacement = 0.0;  // mm for d = 0, 0 for derivative parameters
-  Ramp ramp = Ramp::kLinear;
-  int boundary = -1;  // index into FormingCase::boundaries
-};
-
-// Every prescribed parameter of ply `ply` (sorted by node, d, coord; no duplicates).
-// Two conditions prescribing one parameter differently are a problem appended to
-// `conflicts` (at the later condition's place).
-std::vector<PlyPrescription> ply_prescriptions(const FormingCase& spec, int ply,
-                                               std::vector<CaseProblem>& conflicts);
-
-// Surface nodes of a side of a structured n1 x n2 rectangle (kBottom: all of them).
-std::vector<Index> side_surface_nodes(int n1, int n2, PlySide side);
 
 }  // namespace sf::forming

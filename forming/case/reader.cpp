@@ -1,4 +1,4 @@
-#include "forming/case/case.hpp"
+#include "forming/case/reader.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -7,52 +7,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
 
 #include "common/core/error.hpp"
+#include "forming/case/checks.hpp"
 
 namespace sf::forming {
-
-std::string to_string(PlySide side) {
-  switch (side) {
-    case PlySide::kX0: return "x0";
-    case PlySide::kX1: return "x1";
-    case PlySide::kY0: return "y0";
-    case PlySide::kY1: return "y1";
-    case PlySide::kBottom: return "bottom";
-  }
-  return "?";
-}
-
-std::string to_string(Ramp ramp) { return ramp == Ramp::kLinear ? "linear" : "smooth"; }
-
-double ramp_value(Ramp ramp, double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return ramp == Ramp::kLinear ? t : t * t * (3.0 - 2.0 * t);
-}
-
-std::string to_string(CaseBoundary::Kind kind) {
-  switch (kind) {
-    case CaseBoundary::Kind::kClamp: return "clamp";
-    case CaseBoundary::Kind::kDisplacement: return "displacement";
-    case CaseBoundary::Kind::kSymmetry: return "symmetry";
-  }
-  return "?";
-}
-
-int FormingCase::find_ply(const std::string& name) const {
-  for (std::size_t i = 0; i < plies.size(); ++i)
-    if (plies[i].name == name) return static_cast<int>(i);
-  return -1;
-}
-
-std::string CaseCheck::located(std::size_t i) const {
-  const CaseProblem& p = problems.at(i);
-  return located_message(spec.file, p.place.line, p.place.column, p.message);
-}
 
 namespace {
 
@@ -80,13 +42,17 @@ class Reader {
  public:
   explicit Reader(std::vector<CaseProblem>& problems) : problems_(problems) {}
 
-  void problem(const YAML::Node& at, const std::string& message) { problems_.push_back({place_of(at), message}); }
-  void problem(SourcePlace at, const std::string& message) { problems_.push_back({at, message}); }
+  void problem(ProblemKind kind, const YAML::Node& at, const std::string& message, const std::string& name = {}) {
+    problems_.push_back({kind, place_of(at), message, name});
+  }
+  void problem(ProblemKind kind, SourcePlace at, const std::string& message) {
+    problems_.push_back({kind, at, message, {}});
+  }
 
   // `n` must be a mapping whose keys are all in `allowed` (no duplicates).
   bool mapping(const YAML::Node& n, const std::string& what, const std::vector<std::string>& allowed) {
     if (!n.IsMap()) {
-      problem(n, what + ": expected a mapping (key: value), found " + describe(n));
+      problem(ProblemKind::kWrongType, n, what + ": expected a mapping (key: value), found " + describe(n));
       return false;
     }
     std::set<std::string> seen;
@@ -95,9 +61,9 @@ class Reader {
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         std::string list;
         for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        problem(it->first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
+        problem(ProblemKind::kUnknownKey, it->first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
       } else if (!seen.insert(key).second) {
-        problem(it->first, what + ": key '" + key + "' given twice");
+        problem(ProblemKind::kDuplicate, it->first, what + ": key '" + key + "' given twice");
       }
     }
     return true;
@@ -105,7 +71,7 @@ class Reader {
 
   std::optional<double> number(const YAML::Node& n, const std::string& what) {
     if (!n.IsScalar()) {
-      problem(n, what + ": expected a number, found " + describe(n));
+      problem(ProblemKind::kWrongType, n, what + ": expected a number, found " + describe(n));
       return std::nullopt;
     }
     const std::string& s = n.Scalar();
@@ -113,7 +79,7 @@ class Reader {
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
     if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) {
-      problem(n, what + ": expected a finite number, found '" + s + "'");
+      problem(ProblemKind::kWrongType, n, what + ": expected a finite number, found '" + s + "'");
       return std::nullopt;
     }
     return v;
@@ -122,7 +88,7 @@ class Reader {
   std::optional<double> positive(const YAML::Node& n, const std::string& what, const std::string& unit) {
     const std::optional<double> v = number(n, what);
     if (v && !(*v > 0.0)) {
-      problem(n, what + ": expected a positive value (" + unit + "), found " + n.Scalar());
+      problem(ProblemKind::kOutOfRange, n, what + ": expected a positive value (" + unit + "), found " + n.Scalar());
       return std::nullopt;
     }
     return v;
@@ -130,7 +96,7 @@ class Reader {
 
   std::optional<int> integer(const YAML::Node& n, const std::string& what, int lo, int hi) {
     if (!n.IsScalar()) {
-      problem(n, what + ": expected an integer, found " + describe(n));
+      problem(ProblemKind::kWrongType, n, what + ": expected an integer, found " + describe(n));
       return std::nullopt;
     }
     const std::string& s = n.Scalar();
@@ -138,11 +104,11 @@ class Reader {
     errno = 0;
     const long v = std::strtol(s.c_str(), &end, 10);
     if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) {
-      problem(n, what + ": expected an integer, found '" + s + "'");
+      problem(ProblemKind::kWrongType, n, what + ": expected an integer, found '" + s + "'");
       return std::nullopt;
     }
     if (v < lo || v > hi) {
-      problem(n, what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+      problem(ProblemKind::kOutOfRange, n, what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                      "], found " + s);
       return std::nullopt;
     }
@@ -155,13 +121,13 @@ class Reader {
       if (s == "true" || s == "yes" || s == "on") return true;
       if (s == "false" || s == "no" || s == "off") return false;
     }
-    problem(n, what + ": expected true or false, found " + describe(n));
+    problem(ProblemKind::kWrongType, n, what + ": expected true or false, found " + describe(n));
     return std::nullopt;
   }
 
   std::optional<std::string> text(const YAML::Node& n, const std::string& what) {
     if (!n.IsScalar() || n.Scalar().empty()) {
-      problem(n, what + ": expected a name, found " + describe(n));
+      problem(ProblemKind::kWrongType, n, what + ": expected a name, found " + describe(n));
       return std::nullopt;
     }
     return n.Scalar();
@@ -170,7 +136,7 @@ class Reader {
   // A required key of mapping `parent`; records "missing" at the parent.
   YAML::Node required(const YAML::Node& parent, const std::string& key, const std::string& what) {
     const YAML::Node n = parent[key];
-    if (!n.IsDefined()) problem(parent, what + ": missing required key '" + key + "'");
+    if (!n.IsDefined()) problem(ProblemKind::kMissing, parent, what + ": missing required key '" + key + "'");
     return n;
   }
 
@@ -201,7 +167,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
       (std::string(flag) == "incompressible" ? m.incompressible : m.inextensible) = *v;
   }
   if (body.size() != extras + 1) {
-    r.problem(key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
+    r.problem(ProblemKind::kWrongType, key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
     return;
   }
   auto law = body.begin();
@@ -209,7 +175,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
     ++law;
   if (law == body.end()) return;
   if (m.inextensible && law->first.Scalar() == "neo_hookean")
-    r.problem(body["inextensible"], what + ": inextensible needs fibres (a transversely_isotropic law)");
+    r.problem(ProblemKind::kUnsupported, body["inextensible"], what + ": inextensible needs fibres (a transversely_isotropic law)");
   const std::string law_name = law->first.Scalar();
   const YAML::Node p = law->second;
   if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
@@ -220,7 +186,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
     const bool young = p["E"].IsDefined() || p["nu"].IsDefined();
     const bool lame = p["mu"].IsDefined() || p["lambda"].IsDefined();
     if (young == lame) {
-      r.problem(law->first, lw + ": give either {E, nu} or {mu, lambda}");
+      r.problem(ProblemKind::kWrongType, law->first, lw + ": give either {E, nu} or {mu, lambda}");
       return;
     }
     try {
@@ -239,7 +205,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
         m.given_as = "mu, lambda";
       }
     } catch (const InputError& e) {
-      r.problem(law->first, what + ": " + e.what());
+      r.problem(ProblemKind::kOutOfRange, law->first, what + ": " + e.what());
       return;
     }
   } else {  // transversely_isotropic (the mapping check rejected anything else)
@@ -250,7 +216,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
     const bool direct = p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() ||
                         p["lambda"].IsDefined();
     if (engineering == direct) {
-      r.problem(law->first, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
+      r.problem(ProblemKind::kWrongType, law->first, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
       return;
     }
     try {
@@ -283,7 +249,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
         m.given_as = "mu_T, mu_L, kappa_f, lambda";
       }
     } catch (const InputError& e) {
-      r.problem(law->first, what + ": " + e.what());
+      r.problem(ProblemKind::kOutOfRange, law->first, what + ": " + e.what());
       return;
     }
   }
@@ -293,7 +259,7 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
 // [a, b] of positive numbers, or [n1, n2] of integers.
 bool pair_of(Reader& r, const YAML::Node& n, const std::string& what) {
   if (!n.IsSequence() || n.size() != 2) {
-    r.problem(n, what + ": expected a list of two values [x, y], found " + describe(n));
+    r.problem(ProblemKind::kWrongType, n, what + ": expected a list of two values [x, y], found " + describe(n));
     return false;
   }
   return true;
@@ -309,7 +275,7 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
     ply.name = *name;
     what = "ply '" + ply.name + "'";
     if (spec.find_ply(ply.name) >= 0) {
-      r.problem(n["name"], what + ": name used by an earlier ply");
+      r.problem(ProblemKind::kDuplicate, n["name"], what + ": name used by an earlier ply");
       ok = false;
     }
   } else {
@@ -317,7 +283,7 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   }
   if (const YAML::Node o = n["origin"]; o.IsDefined()) {
     if (!o.IsSequence() || o.size() != 3) {
-      r.problem(o, what + " origin: expected [x, y, z] (mm), found " + describe(o));
+      r.problem(ProblemKind::kWrongType, o, what + " origin: expected [x, y, z] (mm), found " + describe(o));
       ok = false;
     } else {
       for (int i = 0; i < 3; ++i) {
@@ -352,7 +318,8 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
       for (std::size_t i = 0; i < spec.materials.size(); ++i)
         if (spec.materials[i].name == *name) ply.material_index = static_cast<int>(i);
       if (ply.material_index < 0) {
-        r.problem(m, what + ": unknown material '" + *name + "' (not defined under materials)");
+        r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + *name + "' (not defined under materials)",
+                  *name);
         ok = false;
       }
     } else ok = false;
@@ -369,7 +336,7 @@ std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string
     if (s == "y1") return PlySide::kY1;
     if (allow_bottom && s == "bottom") return PlySide::kBottom;
   }
-  r.problem(n, what + ": expected " + std::string(allow_bottom ? "x0, x1, y0, y1 or bottom" : "x0, x1, y0 or y1") +
+  r.problem(ProblemKind::kWrongType, n, what + ": expected " + std::string(allow_bottom ? "x0, x1, y0, y1 or bottom" : "x0, x1, y0 or y1") +
                    ", found " + describe(n));
   return std::nullopt;
 }
@@ -385,7 +352,7 @@ bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, const Formi
   name = *text;
   index = spec.find_ply(*text);
   if (index < 0) {
-    r.problem(p, what + ": unknown ply '" + *text + "'");
+    r.problem(ProblemKind::kUnknownPly, p, what + ": unknown ply '" + *text + "'", *text);
     return false;
   }
   return true;
@@ -400,7 +367,7 @@ bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ramp& ramp
   } else if (rp.IsScalar() && rp.Scalar() == "smooth") {
     ramp = Ramp::kSmooth;
   } else {
-    r.problem(rp, what + " ramp: expected linear or smooth, found " + describe(rp));
+    r.problem(ProblemKind::kWrongType, rp, what + " ramp: expected linear or smooth, found " + describe(rp));
     return false;
   }
   return true;
@@ -410,7 +377,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   const std::string what = "boundary condition " + std::to_string(index + 1);
   if (!r.mapping(n, what, {"clamp", "displacement", "symmetry"})) return;
   if (n.size() != 1) {
-    r.problem(n, what + ": expected exactly one of clamp, displacement, symmetry");
+    r.problem(ProblemKind::kWrongType, n, what + ": expected exactly one of clamp, displacement, symmetry");
     return;
   }
   const auto kv = n.begin();
@@ -442,7 +409,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     const YAML::Node v = r.required(b, "value", bw);
     if (v.IsDefined()) {
       if (!v.IsSequence() || v.size() != 3) {
-        r.problem(v, bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
+        r.problem(ProblemKind::kWrongType, v, bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
         ok = false;
       } else {
         int given = 0;
@@ -452,7 +419,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
           if (u) { bc.value[i] = *u; ++given; } else ok = false;
         }
         if (ok && given == 0) {
-          r.problem(v, bw + " value: every component is free; give at least one");
+          r.problem(ProblemKind::kMissing, v, bw + " value: every component is free; give at least one");
           ok = false;
         }
       }
@@ -464,7 +431,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
 
 std::optional<Vec3> vector3(Reader& r, const YAML::Node& n, const std::string& what, const std::string& unit) {
   if (!n.IsSequence() || n.size() != 3) {
-    r.problem(n, what + ": expected [x, y, z] (" + unit + "), found " + describe(n));
+    r.problem(ProblemKind::kWrongType, n, what + ": expected [x, y, z] (" + unit + "), found " + describe(n));
     return std::nullopt;
   }
   Vec3 v;
@@ -481,7 +448,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   const std::vector<std::string> kinds = {"pressure", "gravity", "edge_force", "point_force"};
   if (!r.mapping(n, what, kinds)) return;
   if (n.size() != 1) {
-    r.problem(n, what + ": expected exactly one of pressure, gravity, edge_force, point_force");
+    r.problem(ProblemKind::kWrongType, n, what + ": expected exactly one of pressure, gravity, edge_force, point_force");
     return;
   }
   const auto kv = n.begin();
@@ -513,7 +480,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
         if (f.IsScalar() && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
           load.top = f.Scalar() == "top";
         } else {
-          r.problem(f, lw + " face: expected top or bottom, found " + describe(f));
+          r.problem(ProblemKind::kWrongType, f, lw + " face: expected top or bottom, found " + describe(f));
           ok = false;
         }
       } else ok = false;
@@ -534,7 +501,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
       }
       for (const CaseMaterial& m : spec.materials)
         if (!(m.density > 0.0)) {
-          r.problem(kv->first, lw + ": material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
+          r.problem(ProblemKind::kMissing, kv->first, lw + ": material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
           ok = false;
         }
       break;
@@ -566,7 +533,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
         else if (l.IsScalar() && l.Scalar() == "top") load.layer = 1;
         else if (l.IsScalar() && l.Scalar() == "both") load.layer = -1;
         else {
-          r.problem(l, lw + " layer: expected bottom, top or both, found " + describe(l));
+          r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
           ok = false;
         }
       }
@@ -586,28 +553,30 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                                "control", "arc_length", "stop_displacement"}))
     return;
   bool arc = false;
+  s.control_place = place_of(n["control"]);
+  s.analysis_place = place_of(n["analysis"]);
   if (const YAML::Node c = n["control"]; c.IsDefined()) {
     if (c.IsScalar() && (c.Scalar() == "load" || c.Scalar() == "arc_length"))
       arc = c.Scalar() == "arc_length";
     else
-      r.problem(c, "solver control: expected load or arc_length, found " + describe(c));
+      r.problem(ProblemKind::kWrongType, c, "solver control: expected load or arc_length, found " + describe(c));
   }
   if (arc) {
     const YAML::Node a = n["arc_length"];
     if (!a.IsDefined())
-      r.problem(n["control"], "solver control arc_length: give arc_length (the path length per step, mm)");
+      r.problem(ProblemKind::kMissing, n["control"], "solver control arc_length: give arc_length (the path length per step, mm)");
     else if (const auto v = r.positive(a, "solver arc_length", "mm")) s.arc_length = *v;
     if (n["stop_displacement"].IsDefined())
       if (const auto v = r.positive(n["stop_displacement"], "solver stop_displacement", "mm")) s.stop_displacement = *v;
   } else {
     for (const char* key : {"arc_length", "stop_displacement"})
-      if (n[key].IsDefined()) r.problem(n[key], std::string("solver ") + key + ": only used with control: arc_length");
+      if (n[key].IsDefined()) r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with control: arc_length");
   }
   if (const YAML::Node a = n["analysis"]; a.IsDefined()) {
     if (a.IsScalar() && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
       s.dynamic = a.Scalar() == "dynamic";
     else
-      r.problem(a, "solver analysis: expected static or dynamic, found " + describe(a));
+      r.problem(ProblemKind::kWrongType, a, "solver analysis: expected static or dynamic, found " + describe(a));
   }
   if (n["end_time"].IsDefined())
     if (const auto v = r.positive(n["end_time"], "solver end_time", "s")) s.end_time = *v;
@@ -617,21 +586,21 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (i.IsScalar() && (i.Scalar() == "generalized-alpha" || i.Scalar() == "hht-alpha" || i.Scalar() == "newmark"))
       s.integrator = i.Scalar();
     else
-      r.problem(i, "solver integrator: expected generalized-alpha, hht-alpha or newmark, found " + describe(i));
+      r.problem(ProblemKind::kWrongType, i, "solver integrator: expected generalized-alpha, hht-alpha or newmark, found " + describe(i));
   }
   if (n["rho_inf"].IsDefined()) {
     const auto v = r.number(n["rho_inf"], "solver rho_inf");
     if (v && !(*v >= 0.0 && *v <= 1.0))
-      r.problem(n["rho_inf"], "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
+      r.problem(ProblemKind::kOutOfRange, n["rho_inf"], "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
     else if (v) s.rho_inf = *v;
   }
   for (const char* key : {"end_time", "time_step", "integrator", "rho_inf"})
     if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !n["analysis"].IsScalar()))
-      r.problem(n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
+      r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
   if (n["constraint_tolerance"].IsDefined()) {
     const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
     if (v && !(*v > 0.0 && *v < 0.1))
-      r.problem(n["constraint_tolerance"], "solver constraint_tolerance: expected a value in (0, 0.1), found " +
+      r.problem(ProblemKind::kOutOfRange, n["constraint_tolerance"], "solver constraint_tolerance: expected a value in (0, 0.1), found " +
                                                n["constraint_tolerance"].Scalar());
     else if (v) s.constraint_tolerance = *v;
   }
@@ -642,7 +611,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (n["tolerance"].IsDefined()) {
     const auto v = r.number(n["tolerance"], "solver tolerance");
     if (v && (*v <= 0.0 || *v >= 1.0))
-      r.problem(n["tolerance"], "solver tolerance: expected a relative residual in (0, 1), found " +
+      r.problem(ProblemKind::kOutOfRange, n["tolerance"], "solver tolerance: expected a relative residual in (0, 1), found " +
                                     n["tolerance"].Scalar());
     else if (v) s.tolerance = *v;
   }
@@ -651,7 +620,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (n["min_increment"].IsDefined()) {
     const auto v = r.number(n["min_increment"], "solver min_increment");
     if (v && !(*v > 0.0 && *v <= 1.0))
-      r.problem(n["min_increment"], "solver min_increment: expected a fraction of a step in (0, 1], found " +
+      r.problem(ProblemKind::kOutOfRange, n["min_increment"], "solver min_increment: expected a fraction of a step in (0, 1], found " +
                                         n["min_increment"].Scalar());
     else if (v) s.min_increment = *v;
   }
@@ -671,31 +640,39 @@ void read_output(Reader& r, const YAML::Node& n, CaseOutput& o) {
   }
 }
 
+// Drops the problems from index `from` on of `kind` whose name is in `defined`: a
+// reference to something defined but itself bad (reported where it is defined).
+void drop_unknown_names(std::vector<CaseProblem>& problems, std::size_t from, ProblemKind kind,
+                        const std::set<std::string>& defined) {
+  const auto follow_on = [&](const CaseProblem& p) { return p.kind == kind && defined.count(p.name) > 0; };
+  problems.erase(std::remove_if(problems.begin() + static_cast<long>(from), problems.end(), follow_on), problems.end());
+}
+
 void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::vector<CaseProblem>& problems) {
   if (!root.IsDefined() || root.IsNull()) {
-    r.problem(SourcePlace{1, 1}, "empty case file: expected materials, plies, boundary_conditions");
+    r.problem(ProblemKind::kMissing, SourcePlace{1, 1}, "empty case file: expected materials, plies, boundary_conditions");
     return;
   }
   if (!r.mapping(root, "case", kTopKeys)) return;
   if (const YAML::Node u = root["units"]; u.IsDefined()) {
     if (u.IsScalar()) spec.units = u.Scalar();
-    else r.problem(u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
+    else r.problem(ProblemKind::kWrongType, u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
   }
   if (const YAML::Node ms = r.required(root, "materials", "case"); ms.IsDefined()) {
     if (!ms.IsMap()) {
-      r.problem(ms, "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
+      r.problem(ProblemKind::kWrongType, ms, "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
                         describe(ms));
     } else {
       std::set<std::string> seen;
       for (auto it = ms.begin(); it != ms.end(); ++it) {
         const std::string name = it->first.Scalar();
         if (!seen.insert(name).second) {
-          r.problem(it->first, "material '" + name + "' defined twice");
+          r.problem(ProblemKind::kDuplicate, it->first, "material '" + name + "' defined twice");
           continue;
         }
         read_material(r, name, it->first, it->second, spec);
       }
-      if (ms.size() == 0) r.problem(ms, "materials: expected at least one material");
+      if (ms.size() == 0) r.problem(ProblemKind::kMissing, ms, "materials: expected at least one material");
     }
   }
   // Names of materials that failed to read must not also be reported as "unknown".
@@ -704,20 +681,13 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
     for (auto it = ms.begin(); it != ms.end(); ++it) material_names.insert(it->first.Scalar());
   if (const YAML::Node ps = r.required(root, "plies", "case"); ps.IsDefined()) {
     if (!ps.IsSequence() || ps.size() == 0) {
-      r.problem(ps, "plies: expected a list of plies (- name: ...), found " + describe(ps));
+      r.problem(ProblemKind::kWrongType, ps, "plies: expected a list of plies (- name: ...), found " + describe(ps));
     } else {
       for (std::size_t i = 0; i < ps.size(); ++i) {
         const std::size_t before = problems.size();
         read_ply(r, ps[i], static_cast<int>(i), spec);
         // A ply naming a material that exists but was bad: one problem is enough.
-        for (std::size_t k = before; k < problems.size(); ++k) {
-          const std::string& msg = problems[k].message;
-          const auto pos = msg.find("unknown material '");
-          if (pos == std::string::npos) continue;
-          const auto start = pos + 18;
-          const std::string name = msg.substr(start, msg.find('\'', start) - start);
-          if (material_names.count(name)) problems.erase(problems.begin() + static_cast<long>(k--));
-        }
+        drop_unknown_names(problems, before, ProblemKind::kUnknownMaterial, material_names);
       }
     }
   }
@@ -727,18 +697,11 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
       if (p.IsMap() && p["name"].IsScalar()) ply_names.insert(p["name"].Scalar());
   // A condition or load naming a ply that exists but was bad: the ply's own problem is enough.
   auto drop_unknown_ply_problems = [&](std::size_t from) {
-    for (std::size_t k = from; k < problems.size(); ++k) {
-      const std::string& msg = problems[k].message;
-      const auto pos = msg.find("unknown ply '");
-      if (pos == std::string::npos) continue;
-      const auto start = pos + 13;
-      if (ply_names.count(msg.substr(start, msg.find('\'', start) - start)))
-        problems.erase(problems.begin() + static_cast<long>(k--));
-    }
+    drop_unknown_names(problems, from, ProblemKind::kUnknownPly, ply_names);
   };
   if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
     if (!bs.IsSequence() || bs.size() == 0) {
-      r.problem(bs, "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
+      r.problem(ProblemKind::kWrongType, bs, "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
     } else {
       for (std::size_t i = 0; i < bs.size(); ++i) {
         const std::size_t before = problems.size();
@@ -749,7 +712,7 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
   }
   if (const YAML::Node ls = root["loads"]; ls.IsDefined()) {
     if (!ls.IsSequence()) {
-      r.problem(ls, "loads: expected a list (- pressure: ...), found " + describe(ls));
+      r.problem(ProblemKind::kWrongType, ls, "loads: expected a list (- pressure: ...), found " + describe(ls));
     } else {
       for (std::size_t i = 0; i < ls.size(); ++i) {
         const std::size_t before = problems.size();
@@ -759,119 +722,10 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
     }
   }
   if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
-  if (spec.solver.arc_length > 0.0) {
-    const YAML::Node at = root["solver"]["control"];
-    if (spec.solver.dynamic) r.problem(at, "solver control arc_length: static analysis only");
-    for (const CaseBoundary& bc : spec.boundaries)
-      if (bc.kind == CaseBoundary::Kind::kDisplacement)
-        r.problem(bc.place, "solver control arc_length: prescribed displacements cannot follow the arc length "
-                            "(hold edges with clamp or symmetry; drive the case by loads)");
-    for (const CaseLoad& l : spec.loads)
-      if (l.ramp != Ramp::kLinear)
-        r.problem(l.place, "solver control arc_length: loads must be proportional to the load factor (ramp: linear)");
-    for (const CaseMaterial& m : spec.materials)
-      if (m.incompressible || m.inextensible)
-        r.problem(at, "solver control arc_length: material '" + m.name +
-                          "' is incompressible/inextensible; exact constraints need load control for now");
-    if (spec.loads.empty()) r.problem(at, "solver control arc_length: there is no load to scale");
-  }
-  if (spec.solver.dynamic) {
-    const YAML::Node at = root["solver"]["analysis"];
-    for (const CaseMaterial& m : spec.materials) {
-      if (!(m.density > 0.0))
-        r.problem(at, "solver analysis dynamic: material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
-      if (m.incompressible || m.inextensible)
-        r.problem(at, "solver analysis dynamic: material '" + m.name +
-                          "' is incompressible/inextensible; exact constraints are quasi-static only for now");
-    }
-  }
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
 }
 
 }  // namespace
-
-std::vector<Index> side_surface_nodes(int n1, int n2, PlySide side) {
-  std::vector<Index> out;
-  auto id = [&](int i, int j) { return static_cast<Index>(j) * (n1 + 1) + i; };
-  switch (side) {
-    case PlySide::kX0: for (int j = 0; j <= n2; ++j) out.push_back(id(0, j)); break;
-    case PlySide::kX1: for (int j = 0; j <= n2; ++j) out.push_back(id(n1, j)); break;
-    case PlySide::kY0: for (int i = 0; i <= n1; ++i) out.push_back(id(i, 0)); break;
-    case PlySide::kY1: for (int i = 0; i <= n1; ++i) out.push_back(id(i, n2)); break;
-    case PlySide::kBottom:
-      for (Index s = 0; s < static_cast<Index>(n1 + 1) * (n2 + 1); ++s) out.push_back(s);
-      break;
-  }
-  return out;
-}
-
-std::vector<PlyPrescription> ply_prescriptions(const FormingCase& spec, int ply,
-                                               std::vector<CaseProblem>& conflicts) {
-  const CasePly& p = spec.plies.at(static_cast<std::size_t>(ply));
-  const Index n_s = static_cast<Index>(p.n1 + 1) * (p.n2 + 1);
-  std::map<std::tuple<Index, int, int>, PlyPrescription> dofs;
-  std::set<std::pair<int, int>> reported;  // (earlier, later) condition pairs
-  for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
-    const CaseBoundary& bc = spec.boundaries[b];
-    if (bc.ply_index != ply) continue;
-    auto add = [&](Index node, int d, int coord, double u) {
-      PlyPrescription pr{node, d, coord, u, bc.ramp, static_cast<int>(b)};
-      const auto key = std::make_tuple(node, d, coord);
-      const auto [it, inserted] = dofs.emplace(key, pr);
-      if (inserted) return;
-      const PlyPrescription& old = it->second;
-      const bool same = old.displacement == u && (u == 0.0 || old.ramp == bc.ramp);
-      if (!same && reported.insert({old.boundary, static_cast<int>(b)}).second) {
-        const CaseBoundary& ob = spec.boundaries[static_cast<std::size_t>(old.boundary)];
-        conflicts.push_back({bc.place, to_string(bc.kind) + " on " + to_string(bc.side) + " of ply '" + p.name +
-                                           "' prescribes some of the same dofs as the " + to_string(ob.kind) +
-                                           " on " + to_string(ob.side) + " (line " +
-                                           std::to_string(ob.place.line) + ") differently"});
-      }
-    };
-    const bool x_side = bc.side == PlySide::kX0 || bc.side == PlySide::kX1;
-    const int along = x_side ? 2 : 1;   // derivative along the edge
-    const int across = x_side ? 1 : 2;  // derivative across the edge
-    const std::vector<Index> nodes = side_surface_nodes(p.n1, p.n2, bc.side);
-    for (const Index s : nodes) {
-      for (int layer = 0; layer < 2; ++layer) {
-        const Index node = s + layer * n_s;
-        switch (bc.kind) {
-          case CaseBoundary::Kind::kClamp:
-            for (int d = 0; d < 4; ++d)
-              for (int c = 0; c < 3; ++c) add(node, d, c, 0.0);
-            break;
-          case CaseBoundary::Kind::kDisplacement:
-            for (int c = 0; c < 3; ++c) {
-              if (!bc.value[static_cast<std::size_t>(c)]) continue;
-              add(node, 0, c, *bc.value[static_cast<std::size_t>(c)]);
-              add(node, along, c, 0.0);
-            }
-            break;
-          case CaseBoundary::Kind::kSymmetry:
-            if (bc.side == PlySide::kBottom) {
-              if (layer == 0)
-                for (int d = 0; d < 4; ++d) add(node, d, 2, 0.0);
-            } else {
-              const int k = x_side ? 0 : 1;  // normal of the plane
-              add(node, 0, k, 0.0);
-              add(node, along, k, 0.0);
-              for (int c = 0; c < 3; ++c)
-                if (c != k) {
-                  add(node, across, c, 0.0);
-                  add(node, 3, c, 0.0);
-                }
-            }
-            break;
-        }
-      }
-    }
-  }
-  std::vector<PlyPrescription> out;
-  out.reserve(dofs.size());
-  for (const auto& kv : dofs) out.push_back(kv.second);
-  return out;
-}
 
 CaseCheck check_case_text(const std::string& text, const std::string& name) {
   CaseCheck result;
@@ -881,23 +735,19 @@ CaseCheck check_case_text(const std::string& text, const std::string& name) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    result.problems.push_back({{e.mark.line + 1, e.mark.column + 1}, "invalid YAML: " + e.msg});
+    result.problems.push_back(
+        {ProblemKind::kUnreadable, {e.mark.line + 1, e.mark.column + 1}, "invalid YAML: " + e.msg, {}});
     return result;
   }
   try {
     read_document(r, root, result.spec, result.problems);
   } catch (const YAML::Exception& e) {
-    result.problems.push_back({{e.mark.line + 1, e.mark.column + 1}, std::string("cannot read: ") + e.msg});
+    result.problems.push_back(
+        {ProblemKind::kUnreadable, {e.mark.line + 1, e.mark.column + 1}, std::string("cannot read: ") + e.msg, {}});
   }
-  if (result.ok()) {
-    bool any = false;
-    for (std::size_t p = 0; p < result.spec.plies.size(); ++p) {
-      const std::vector<PlyPrescription> pr = ply_prescriptions(result.spec, static_cast<int>(p), result.problems);
-      any = any || !pr.empty();
-    }
-    if (!any)
-      result.problems.push_back({{1, 1}, "boundary_conditions: nothing is held (the plies could move as rigid bodies)"});
-  }
+  check_solver_rules(result.spec, result.problems);
+  // Conditions are discretised only for a case that read cleanly (valid plies).
+  if (result.ok()) check_boundary_conditions(result.spec, result.problems);
   std::stable_sort(result.problems.begin(), result.problems.end(), [](const CaseProblem& a, const CaseProblem& b) {
     return std::tie(a.place.line, a.place.column) < std::tie(b.place.line, b.place.column);
   });
@@ -909,7 +759,7 @@ CaseCheck check_case_file(const std::string& path) {
   if (!in) {
     CaseCheck c;
     c.spec.file = path;
-    c.problems.push_back({{}, "cannot open case file"});
+    c.problems.push_back({ProblemKind::kUnreadable, {}, "cannot open case file", {}});
     return c;
   }
   std::ostringstream ss;

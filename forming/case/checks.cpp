@@ -1,0 +1,82 @@
+#include "forming/case/checks.hpp"
+
+#include <string>
+
+namespace sf::forming {
+
+void check_solver_rules(const FormingCase& spec, std::vector<CaseProblem>& problems) {
+  const auto add = [&](ProblemKind kind, SourcePlace at, const std::string& message) {
+    problems.push_back({kind, at, message, {}});
+  };
+  if (spec.solver.arc_length > 0.0) {
+    const SourcePlace at = spec.solver.control_place;
+    if (spec.solver.dynamic) add(ProblemKind::kUnsupported, at, "solver control arc_length: static analysis only");
+    for (const CaseBoundary& bc : spec.boundaries)
+      if (bc.kind == CaseBoundary::Kind::kDisplacement)
+        add(ProblemKind::kUnsupported, bc.place,
+            "solver control arc_length: prescribed displacements cannot follow the arc length "
+            "(hold edges with clamp or symmetry; drive the case by loads)");
+    for (const CaseLoad& l : spec.loads)
+      if (l.ramp != Ramp::kLinear)
+        add(ProblemKind::kUnsupported, l.place,
+            "solver control arc_length: loads must be proportional to the load factor (ramp: linear)");
+    for (const CaseMaterial& m : spec.materials)
+      if (m.incompressible || m.inextensible)
+        add(ProblemKind::kUnsupported, at,
+            "solver control arc_length: material '" + m.name +
+                "' is incompressible/inextensible; exact constraints need load control for now");
+    if (spec.loads.empty()) add(ProblemKind::kMissing, at, "solver control arc_length: there is no load to scale");
+  }
+  if (spec.solver.dynamic) {
+    const SourcePlace at = spec.solver.analysis_place;
+    for (const CaseMaterial& m : spec.materials) {
+      if (!(m.density > 0.0))
+        add(ProblemKind::kMissing, at,
+            "solver analysis dynamic: material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
+      if (m.incompressible || m.inextensible)
+        add(ProblemKind::kUnsupported, at,
+            "solver analysis dynamic: material '" + m.name +
+                "' is incompressible/inextensible; exact constraints are quasi-static only for now");
+    }
+  }
+}
+
+std::vector<EdgeCondition> edge_conditions(const FormingCase& spec, int ply) {
+  std::vector<EdgeCondition> out;
+  for (const CaseBoundary& bc : spec.boundaries)
+    if (bc.ply_index == ply) out.push_back({bc.kind, bc.side, bc.value, bc.ramp});
+  return out;
+}
+
+std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec,
+                                                          std::vector<CaseProblem>& problems) {
+  std::vector<PlyConditions> out;
+  for (std::size_t p = 0; p < spec.plies.size(); ++p) {
+    const CasePly& ply = spec.plies[p];
+    std::vector<const CaseBoundary*> of_ply;  // case condition of each edge condition
+    for (const CaseBoundary& bc : spec.boundaries)
+      if (bc.ply_index == static_cast<int>(p)) of_ply.push_back(&bc);
+    out.push_back(discretise_conditions(PlyGrid{ply.n1, ply.n2}, edge_conditions(spec, static_cast<int>(p))));
+    for (const ConditionConflict& c : out.back().conflicts) {
+      const CaseBoundary& later = *of_ply[static_cast<std::size_t>(c.later)];
+      const CaseBoundary& earlier = *of_ply[static_cast<std::size_t>(c.earlier)];
+      problems.push_back({ProblemKind::kConflict, later.place,
+                          to_string(later.kind) + " on " + to_string(later.side) + " of ply '" + ply.name +
+                              "' prescribes some of the same dofs as the " + to_string(earlier.kind) + " on " +
+                              to_string(earlier.side) + " (line " + std::to_string(earlier.place.line) +
+                              ") differently",
+                          {}});
+    }
+  }
+  return out;
+}
+
+void check_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>& problems) {
+  bool any = false;
+  for (const PlyConditions& c : discretise_boundary_conditions(spec, problems)) any = any || !c.parameters.empty();
+  if (!any)
+    problems.push_back({ProblemKind::kNothingHeld, {1, 1},
+                        "boundary_conditions: nothing is held (the plies could move as rigid bodies)", {}});
+}
+
+}  // namespace sf::forming

@@ -1,0 +1,223 @@
+#include "forming/model/model.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include "common/core/error.hpp"
+
+namespace sf::forming {
+namespace {
+
+// A number with 4 significant digits, for messages.
+std::string short_number(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()) {}
+
+int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
+  if (!material) throw InputError("model: ply added without a material");
+  constraints.validate();
+  if (constraints.inextensible && material->fibre_direction().isZero(0.0))
+    throw InputError("model: fibre inextensibility asked for a material without fibres (" + material->name() + ")");
+  const Index n = ply.n_dofs();
+  const Index ne = ply.n_elements();
+  Body b{std::move(ply), std::move(material), n_dofs_, constraints, {}, {}};
+  if (constraints.active()) {
+    b.p.assign(static_cast<std::size_t>(ne), constraints.p);
+    b.T.assign(static_cast<std::size_t>(ne), constraints.T);
+  }
+  bodies_.push_back(std::move(b));
+  n_dofs_ += n;
+  return n_bodies() - 1;
+}
+
+int Model::add_interaction(std::shared_ptr<const Interaction> interaction) {
+  if (!interaction) throw InputError("model: interaction added as a null pointer");
+  interactions_.push_back(std::move(interaction));
+  return n_interactions() - 1;
+}
+
+bool Model::symmetric_tangent() const {
+  for (const std::shared_ptr<const Interaction>& i : interactions_)
+    if (!i->symmetric()) return false;
+  return true;
+}
+
+bool Model::any_constrained() const {
+  for (const Body& b : bodies_)
+    if (b.constraints.active()) return true;
+  return false;
+}
+
+void Model::set_multipliers(int body, std::vector<double> p, std::vector<double> T) {
+  Body& b = bodies_.at(static_cast<std::size_t>(body));
+  SF_ASSERT(static_cast<Index>(p.size()) == b.ply.n_elements() && static_cast<Index>(T.size()) == b.ply.n_elements(),
+            "one multiplier per element");
+  b.p = std::move(p);
+  b.T = std::move(T);
+}
+
+ConstraintTerms Model::element_constraints(const Body& b, Index e) const {
+  ConstraintTerms c = b.constraints;
+  if (c.active()) {
+    c.p = b.p[static_cast<std::size_t>(e)];
+    c.T = b.T[static_cast<std::size_t>(e)];
+  }
+  return c;
+}
+
+std::vector<Model::ConstraintState> Model::constraint_state(int body, const Eigen::Ref<const VecX>& x) const {
+  const Body& b = bodies_.at(static_cast<std::size_t>(body));
+  std::vector<ConstraintState> out;
+  if (!b.constraints.active()) return out;
+  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+  for (Index e = 0; e < b.ply.n_elements(); ++e) {
+    const ElementResult r = brick_element(b.ply.element_parameters(e, b.ply.reference()), b.ply.element_parameters(e, xb),
+                                          *b.material, brick_rule_, false, element_constraints(b, e));
+    out.push_back({r.g_J, r.g_T, r.p_eff, r.T_eff, r.volume});
+  }
+  return out;
+}
+
+VecX Model::reference_positions() const {
+  VecX x(n_dofs_);
+  for (const Body& b : bodies_) x.segment(b.offset, b.ply.n_dofs()) = b.ply.reference_dofs();
+  return x;
+}
+
+std::vector<bool> Model::used_dofs() const {
+  std::vector<bool> used(n_dofs_, false);
+  for (const Body& b : bodies_)
+    for (Index e = 0; e < b.ply.n_elements(); ++e) {
+      const BrickMap map = b.ply.element_map(e);
+      for (int k = 0; k < kBrickFunctions; ++k)
+        for (int t = 0; t < map.n_terms[k]; ++t)
+          if (map.terms[k][t].coef != 0.0)
+            for (int i = 0; i < 3; ++i) used[b.offset + 3 * map.terms[k][t].dof + i] = true;
+    }
+  return used;
+}
+
+Model::ElementDofs Model::element_dofs(int body, Index e) const {
+  const Body& b = bodies_[body];
+  const BrickMap map = b.ply.element_map(e);
+  ElementDofs out;
+  for (int k = 0; k < kBrickFunctions; ++k)
+    for (int t = 0; t < map.n_terms[k]; ++t)
+      for (int i = 0; i < 3; ++i) {
+        out.dofs.push_back(b.offset + 3 * map.terms[k][t].dof + i);
+        out.coefs.push_back(map.terms[k][t].coef);
+        out.local.push_back(3 * k + i);
+      }
+  return out;
+}
+
+Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) const {
+  return assemble(x, InteractionContext{}, want_tangent);
+}
+
+Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent) const {
+  SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
+  Assembly out;
+  out.force = VecX::Zero(n_dofs_);
+  linalg::TripletAssembler triplets(n_dofs_, n_dofs_);
+  if (want_tangent) {
+    Index n_el = 0;
+    for (const Body& b : bodies_) n_el += b.ply.n_elements();
+    triplets.reserve(n_el * kBrickDofs * kBrickDofs);
+  }
+  MatX block;
+  for (int body = 0; body < n_bodies(); ++body) {
+    const Body& b = bodies_[body];
+    const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+    for (Index e = 0; e < b.ply.n_elements(); ++e) {
+      const BrickParams X_e = b.ply.element_parameters(e, b.ply.reference());
+      const BrickParams x_e = b.ply.element_parameters(e, xb);
+      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent, element_constraints(b, e));
+      if (!r.ok()) {
+        out.ok = false;
+        out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
+                      to_string(r.status) + " (min det F " + short_number(r.min_det_f) + ")";
+        out.energy = std::numeric_limits<double>::infinity();
+        return out;
+      }
+      out.energy += r.energy;
+      // Expanded local -> global list: one entry per (function, map term, coordinate);
+      // duplicates (collapsed elements) are summed by the assembler.
+      const ElementDofs ed = element_dofs(body, e);
+      const std::vector<Index>& dofs = ed.dofs;
+      const std::vector<double>& coefs = ed.coefs;
+      const std::vector<int>& local = ed.local;
+      const int m = static_cast<int>(dofs.size());
+      for (int a = 0; a < m; ++a) out.force(dofs[a]) += coefs[a] * r.force(local[a]);
+      if (!want_tangent) continue;
+      block.resize(m, m);
+      for (int c = 0; c < m; ++c)
+        for (int a = 0; a < m; ++a) block(a, c) = coefs[a] * coefs[c] * r.tangent(local[a], local[c]);
+      triplets.add_block(dofs, dofs, block);
+    }
+  }
+  out.strain_energy = out.energy;
+  if (!interactions_.empty() && !add_interactions(x, context, want_tangent, triplets, out)) return out;
+  if (want_tangent) out.tangent = triplets.compress();
+  return out;
+}
+
+bool Model::add_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent,
+                             linalg::TripletAssembler& stiffness, Assembly& out) const {
+  SF_ASSERT(!context.velocity || context.velocity->size() == n_dofs_, "velocities must have n_dofs entries");
+  linalg::TripletAssembler damping(n_dofs_, n_dofs_);
+  InteractionSums sums;
+  sums.force = std::move(out.force);
+  sums.stiffness = want_tangent ? &stiffness : nullptr;
+  sums.damping = want_tangent && context.velocity ? &damping : nullptr;
+  bool velocity_dependent = false;
+  for (const std::shared_ptr<const Interaction>& interaction : interactions_) {
+    interaction->add_to(x, context, sums);
+    if (!sums.ok) {
+      out.ok = false;
+      out.message = interaction->name() + ": " + sums.message;
+      out.energy = std::numeric_limits<double>::infinity();
+      out.force = std::move(sums.force);
+      return false;
+    }
+    velocity_dependent = velocity_dependent || interaction->needs_velocity();
+  }
+  out.energy += sums.energy;
+  out.force = std::move(sums.force);
+  if (sums.damping && velocity_dependent) out.damping = damping.compress();
+  return true;
+}
+
+std::vector<Mat3> Model::deformation_gradients(int body, const Eigen::Ref<const VecX>& x) const {
+  const Body& b = bodies_[body];
+  const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
+  std::vector<Mat3> out;
+  for (Index e = 0; e < b.ply.n_elements(); ++e) {
+    const std::vector<Mat3> f = brick_deformation_gradients(b.ply.element_parameters(e, b.ply.reference()),
+                                                            b.ply.element_parameters(e, xb), brick_rule_);
+    out.insert(out.end(), f.begin(), f.end());
+  }
+  return out;
+}
+
+Vec3 largest_displacement(const Model& model, const Eigen::Ref<const VecX>& x, const Eigen::Ref<const VecX>& X) {
+  Vec3 largest = Vec3::Zero();
+  for (int b = 0; b < model.n_bodies(); ++b)
+    for (Index nd = 0; nd < model.ply(b).n_nodes(); ++nd) {
+      Vec3 u;
+      for (int c = 0; c < 3; ++c) u[c] = x[model.dof(b, nd, 0, c)] - X[model.dof(b, nd, 0, c)];
+      if (u.norm() > largest.norm()) largest = u;
+    }
+  return largest;
+}
+
+}  // namespace sf::forming

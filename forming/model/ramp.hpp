@@ -1,0 +1,17 @@
+#pragma once
+// Ramps: how a prescribed displacement or a load grows with the load factor (or with the
+// time t / end_time of a dynamic run).
+//   kLinear  r(t) = t
+//   kSmooth  r(t) = 3 t^2 - 2 t^3   (zero rate at both ends)
+// t is clamped to [0, 1]; r(0) = 0, r(1) = 1.
+#include <string>
+
+namespace sf::forming {
+
+enum class Ramp { kLinear, kSmooth };
+
+// "linear", "smooth" (the case-file names).
+std::string to_string(Ramp ramp);
+double ramp_value(Ramp ramp, double t);
+
+}  // namespace sf::forming

@@ -1,0 +1,50 @@
+#pragma once
+// The ParaView time series of a run (CONTRACT.md, docs/forming.md "Outputs"):
+//
+//   result.pvd             the collection: one DataSet per written step, time = load factor
+//   steps/step_NNNN.vtu    one per written step (NNNN = step, 4 digits)
+//
+// Each brick is tessellated into samples_inplane^2 x samples_thickness hexahedra;
+// point data "displacement" (mm); cell data at each cell's centre: "cauchy_stress"
+// (6 components xx, yy, zz, xy, yz, xz, MPa), "fibre_direction" (unit, deformed:
+// F a0 / |F a0|), "fibre_stretch" (|F a0|), "ply" (body index); with a constrained body
+// also "pressure" (MPa, positive in compression) and "fibre_tension" (MPa), and the
+// stress includes -p I + (T/J) a (x) a.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/io/atomic_file.hpp"
+#include "common/io/vtk_xml.hpp"
+#include "forming/model/model.hpp"
+
+namespace sf::forming {
+
+io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane, int samples_thickness);
+
+// "steps/step_NNNN.vtu" of step k.
+std::string step_file_name(int k);
+
+class FrameSeries {
+ public:
+  FrameSeries(const Model& model, int samples_inplane, int samples_thickness)
+      : model_(model), samples_inplane_(samples_inplane), samples_thickness_(samples_thickness) {}
+
+  // Writes step k (load factor lambda, positions x) into `out`; a frame of the same
+  // name (a restarted run with other step counts) is replaced in the collection.
+  void write(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x);
+  // A frame already in the output folder (kept by a restart).
+  void keep(double lambda, const std::string& name) { frames_.emplace_back(lambda, name); }
+  // (load factor, file name) of every frame, in the order written.
+  const std::vector<std::pair<double, std::string>>& frames() const { return frames_; }
+  // result.pvd listing them.
+  void write_collection(const std::string& path) const;
+
+ private:
+  const Model& model_;
+  int samples_inplane_, samples_thickness_;
+  std::vector<std::pair<double, std::string>> frames_;
+};
+
+}  // namespace sf::forming

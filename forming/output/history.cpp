@@ -1,0 +1,59 @@
+#include "forming/output/history.hpp"
+
+#include <utility>
+
+#include "forming/model/ply_grid.hpp"
+
+namespace sf::forming {
+
+ToolEdge tool_edge(const FormingCase& spec, const Model& model) {
+  ToolEdge t;
+  const CaseBoundary* chosen = nullptr;
+  for (const CaseBoundary& bc : spec.boundaries)
+    if (bc.kind == CaseBoundary::Kind::kDisplacement) {
+      chosen = &bc;
+      break;
+    }
+  if (!chosen && !spec.boundaries.empty()) chosen = &spec.boundaries.front();
+  if (!chosen) return t;
+  const CasePly& p = spec.plies[static_cast<std::size_t>(chosen->ply_index)];
+  const PlyGrid grid{p.n1, p.n2};
+  t.label = to_string(chosen->kind) + " on " + to_string(chosen->side) + " of ply '" + p.name + "'";
+  for (const Index s : grid.side_surface_nodes(chosen->side))
+    for (int layer = 0; layer < 2; ++layer)
+      t.value_dofs_x.push_back(model.dof(chosen->ply_index, s + layer * grid.n_surface_nodes(), 0, 0));
+  return t;
+}
+
+ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX& reactions) {
+  ToolState s;
+  if (tool.value_dofs_x.empty()) return s;
+  for (const Index d : tool.value_dofs_x)
+    for (int c = 0; c < 3; ++c) {
+      s.displacement[c] += x[d + c] - X[d + c];
+      if (reactions.size() > 0) s.force[c] += reactions[d + c];
+    }
+  s.displacement /= static_cast<double>(tool.value_dofs_x.size());
+  return s;
+}
+
+HistoryTable::HistoryTable(const Model& model, ToolEdge tool)
+    : model_(model),
+      tool_(std::move(tool)),
+      X_(model.reference_positions()),
+      writer_(out_, {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy", "tool_fz",
+                     "strain_energy", "newton_iterations", "cutbacks", "residual"}),
+      header_size_(out_.str().size()) {}
+
+ToolState HistoryTable::add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations,
+                                int cutbacks, double residual) {
+  const ToolState ts = measure(tool_, x, X_, reactions);
+  const Assembly a = model_.assemble(x, false);
+  writer_.begin_row().add(k).add(load_factor);
+  for (int c = 0; c < 3; ++c) writer_.add(ts.displacement[c]);
+  for (int c = 0; c < 3; ++c) writer_.add(ts.force[c]);
+  writer_.add(a.strain_energy).add(iterations).add(cutbacks).add(residual).end_row();
+  return ts;
+}
+
+}  // namespace sf::forming

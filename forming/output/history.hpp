@@ -1,0 +1,60 @@
+#pragma once
+// history.csv of a run (CONTRACT.md; docs/forming.md "Outputs"): one row per converged
+// step, row 0 the reference state, columns
+//
+//   step, load_factor, tool_ux, tool_uy, tool_uz, tool_fx, tool_fy, tool_fz,
+//   strain_energy, newton_iterations, cutbacks, residual
+//
+// tool_u*: mean displacement of the tool edge's value parameters, both layers (mm);
+// tool_f*: the sum of the reactions on them (N); strain_energy: the elements' stored
+// energy (N mm); residual: |r_f| at the end of the step (N).
+//
+// The tool edge is the edge of the first `displacement` condition of the case (or of the
+// first condition when there is none). Rigid tools will add their reaction columns here
+// (forming/model/interaction.hpp ToolReaction).
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/io/csv.hpp"
+#include "forming/case/schema.hpp"
+#include "forming/model/model.hpp"
+
+namespace sf::forming {
+
+struct ToolEdge {
+  std::string label;                // e.g. "displacement on x1 of ply 'ply'"; empty: none
+  std::vector<Index> value_dofs_x;  // global dof of coordinate 0 of each value parameter
+};
+ToolEdge tool_edge(const FormingCase& spec, const Model& model);
+
+struct ToolState {
+  Vec3 displacement = Vec3::Zero();  // mm
+  Vec3 force = Vec3::Zero();         // N
+};
+// reactions: n_dofs, or empty (zero force).
+ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX& reactions);
+
+class HistoryTable {
+ public:
+  HistoryTable(const Model& model, ToolEdge tool);
+  // The rows of an earlier run (restart.json), appended after the header.
+  void append_rows(const std::string& rows) { out_ << rows; }
+  // A row for step k; returns the tool's state in it.
+  ToolState add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
+                    double residual);
+  const ToolEdge& tool() const { return tool_; }
+  std::string text() const { return out_.str(); }
+  std::string rows() const { return out_.str().substr(header_size_); }
+
+ private:
+  const Model& model_;
+  ToolEdge tool_;
+  VecX X_;
+  std::ostringstream out_;
+  io::CsvWriter writer_;
+  std::size_t header_size_ = 0;
+};
+
+}  // namespace sf::forming

@@ -1,0 +1,40 @@
+#pragma once
+// restart.json: the state of a run at its last written frame, written with every frame
+// straight into the output folder (so it survives a run that is killed before its
+// outputs are committed); `simform run --restart` continues from it.
+//
+//   format         "simform-restart-1"
+//   case           the case file
+//   fingerprint    what must not change for a restart: dofs, and every ply's name,
+//                  origin, size, thickness, elements, angle and material
+//   step, load_factor  of the state
+//   positions      n_dofs (mm); velocities n_dofs (mm/s, dynamic runs) or empty
+//   multipliers    per body {p, T}: element pressures and fibre tensions (MPa)
+//   history_rows   the rows of history.csv so far (without the header)
+//   frames         [load factor, file name] of every frame written so far
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "forming/case/schema.hpp"
+#include "forming/model/model.hpp"
+
+namespace sf::forming {
+
+struct RestartState {
+  int step = 0;
+  double load_factor = 0.0;
+  VecX positions;
+  VecX velocities;  // dynamic runs (mm/s); empty for static ones
+  std::string history_rows;
+  std::vector<std::pair<double, std::string>> frames;
+};
+
+// The multipliers come from `model`.
+void write_restart(const std::string& path, const FormingCase& spec, const Model& model, const RestartState& s);
+// Reads `path` and sets `model`'s multipliers from it. Throws sf::InputError when the
+// file is missing or unreadable, was written for another model, or has the wrong size.
+RestartState read_restart(const std::string& path, const FormingCase& spec, Model& model);
+
+}  // namespace sf::forming

@@ -1,0 +1,68 @@
+#pragma once
+// The StepObserver of `simform run` (forming/solve/stepper.hpp): it writes the outputs of
+// a run as the steps converge and fills its RunReport.
+//
+//   start()    the state stepping starts from: the reference state (history row 0 and
+//              frame 0 written), or the state of OUT/restart.json (its history rows and
+//              the frames still in the folder kept);
+//   on_step()  per converged step: a history row, the report fields, a progress line;
+//              every `output.every` steps (and at the last step, and where --stop-after
+//              stops the run) a frame and restart.json;
+//   finish()   the last converged step's frame if it was not written, result.pvd,
+//              history.csv and summary.json, committed together; then the grid file of
+//              a converged run.
+//
+// Everything is written into an io::AtomicOutputDir, except restart.json, which goes
+// straight into the final folder with every frame so that it survives a killed run.
+#include <chrono>
+#include <string>
+
+#include "common/core/types.hpp"
+#include "common/io/atomic_file.hpp"
+#include "forming/case/schema.hpp"
+#include "forming/model/problem.hpp"
+#include "forming/output/frames.hpp"
+#include "forming/output/history.hpp"
+#include "forming/output/restart.hpp"
+#include "forming/run/run.hpp"
+#include "forming/solve/stepper.hpp"
+
+namespace sf::forming {
+
+class RunRecorder final : public StepObserver {
+ public:
+  // `problem` must outlive the recorder. Creates the temporary output folder.
+  RunRecorder(const FormingCase& spec, Problem& problem, const RunOptions& options);
+
+  SteppingState start();
+  StepAction on_step(const StepInfo& step, const SteppingState& state, const VecX& reactions) override;
+  // seconds_build: time spent building the problem before the recorder was made
+  // (summary.json timings).
+  RunReport finish(const SteppingReport& stepping, double seconds_build);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  void write_step(int k, double load_factor);  // frame k of the last converged state + restart.json
+  std::string progress_line(const StepInfo& step) const;
+
+  const FormingCase& spec_;
+  Problem& problem_;
+  const RunOptions& options_;
+  const VecX X_;
+  io::AtomicOutputDir out_;
+  FrameSeries frames_;
+  HistoryTable history_;
+  std::string restart_path_;
+  RestartState restart_;
+  RunReport report_;
+
+  SteppingState last_;        // the last converged state (the start until a step converges)
+  double start_load_factor_ = 0.0;
+  int steps_this_run_ = 0;
+  int last_written_ = 0;
+  Clock::time_point created_;
+  Clock::time_point stepping_started_;
+  double seconds_write_ = 0.0;
+};
+
+}  // namespace sf::forming

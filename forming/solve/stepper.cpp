@@ -1,0 +1,179 @@
+#include "forming/solve/stepper.hpp"
+
+#include <sstream>
+#include <utility>
+
+#include "forming/solve/mass.hpp"
+
+namespace sf::forming {
+namespace {
+
+// The end of a run at a load or time step that did not converge.
+SteppingReport failed(SteppingReport out, int k, int n, double lambda, const std::string& why) {
+  std::ostringstream os;
+  os << "step " << k << " of " << n << " (load factor " << lambda << ") did not converge: " << why
+     << "; results up to step " << (k - 1) << " are written. Try more steps, a larger max_iterations or a smaller "
+     << "min_increment";
+  out.status = SteppingReport::Status::kFailed;
+  out.message = os.str();
+  out.step_failure = "step " + std::to_string(k) + " failed: " + why;
+  return out;
+}
+
+// The first output step beyond load factor `lambda` (n + 1 when none is left).
+int first_step_after(double lambda, int n) {
+  int first = 1;
+  while (first <= n && double(first) / n <= lambda * (1.0 + 1e-12)) ++first;
+  return first;
+}
+
+class LoadStepper final : public Stepper {
+ public:
+  LoadStepper(Problem& problem, const StepperSettings& settings) : problem_(problem), settings_(settings) {}
+
+  SteppingReport run(SteppingState& state, StepObserver& observer) override {
+    SteppingReport out;
+    const int n = settings_.steps;
+    const int first = first_step_after(state.load_factor, n);
+    out.nothing_left = first > n;
+    const double lambda_start = state.load_factor;
+    for (int k = first; k <= n; ++k) {
+      const double lambda = double(k) / n;
+      // Within the step the solver's factor s in [0, 1] runs from the previous load
+      // factor to this one.
+      const double lambda_prev = k == first ? lambda_start : double(k - 1) / n;
+      const LoadFunction step_load = [&](double s, const VecX& xs, bool want_tangent) {
+        return problem_.loads.at(problem_.model, lambda_prev + s * (lambda - lambda_prev), xs, want_tangent);
+      };
+      UzawaReport uzawa;
+      const StaticResult r =
+          solve_static_constrained(problem_.model, state.x, problem_.prescriptions.at(lambda), step_load,
+                                   problem_.loads.follower, settings_.statics, settings_.uzawa, &uzawa);
+      out.multiplier_updates += uzawa.updates;
+      out.total_iterations += r.report.total_iterations;
+      if (!r.report.ok()) return failed(std::move(out), k, n, lambda, r.report.message);
+      state.x = r.positions;
+      state.load_factor = lambda;
+      const StepInfo info{Control::kLoad, k, n, lambda, 0.0, r.report.total_iterations, r.report.n_cutbacks,
+                          r.report.last_residual()};
+      if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
+        out.status = SteppingReport::Status::kStopped;
+        return out;
+      }
+    }
+    return out;
+  }
+
+ private:
+  Problem& problem_;
+  StepperSettings settings_;
+};
+
+class DynamicStepper final : public Stepper {
+ public:
+  DynamicStepper(Problem& problem, const StepperSettings& settings)
+      : problem_(problem), settings_(settings), mass_(mass_matrix(problem.model, problem.density)) {}
+
+  SteppingReport run(SteppingState& state, StepObserver& observer) override {
+    SteppingReport out;
+    const int n = settings_.steps;
+    const double end_time = settings_.end_time;
+    const int first = first_step_after(state.load_factor, n);
+    out.nothing_left = first > n;
+    const double lambda_start = state.load_factor;
+    const std::vector<TimedDof> moving = problem_.prescriptions.in_time(end_time);
+    const ExternalForceFn external = [&](double t, const VecX& xs, bool want_tangent) {
+      return problem_.loads.at(problem_.model, t / end_time, xs, want_tangent);
+    };
+    for (int k = first; k <= n; ++k) {
+      const double lambda = double(k) / n;
+      const double lambda_prev = k == first ? lambda_start : double(k - 1) / n;
+      // Inertia: integrate over the output interval [t_prev, t], load factor t / end_time.
+      DynamicOptions options = settings_.dynamics;
+      options.start_time = lambda_prev * end_time;
+      options.end_time = lambda * end_time;
+      const DynamicResult r = solve_dynamic(problem_.model, mass_, state.x, state.v, moving, external, options);
+      out.total_iterations += r.report.total_iterations;
+      if (!r.report.ok()) return failed(std::move(out), k, n, lambda, r.report.message);
+      state.x = r.positions;
+      state.v = r.velocities;
+      state.load_factor = lambda;
+      const StepInfo info{Control::kDynamic, k, n, lambda, lambda * end_time, r.report.total_iterations,
+                          r.report.n_cutbacks, r.report.last_residual()};
+      if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
+        out.status = SteppingReport::Status::kStopped;
+        return out;
+      }
+    }
+    return out;
+  }
+
+ private:
+  Problem& problem_;
+  StepperSettings settings_;
+  linalg::SparseMatrix mass_;
+};
+
+class ArcLengthStepper final : public Stepper {
+ public:
+  ArcLengthStepper(Problem& problem, const StepperSettings& settings) : problem_(problem), settings_(settings) {}
+
+  SteppingReport run(SteppingState& state, StepObserver& observer) override {
+    SteppingReport out;
+    const Model& model = problem_.model;
+    const VecX X = model.reference_positions();
+    const auto at_stop_displacement = [&](const VecX& x) {
+      return settings_.stop_displacement > 0.0 &&
+             largest_displacement(model, x, X).norm() >= settings_.stop_displacement;
+    };
+    const LoadFunction proportional = [&](double lambda, const VecX& xs, bool want_tangent) {
+      return problem_.loads.at(model, lambda, xs, want_tangent);
+    };
+    int k = 0;
+    bool stopped = false;
+    const auto on_point = [&](const ArcLengthPoint& pt) {
+      ++k;
+      state.x = pt.x;
+      state.load_factor = pt.lambda;
+      const VecX reactions = model.assemble(state.x, false).force - proportional(pt.lambda, state.x, false).force;
+      out.total_iterations += pt.iterations;
+      const StepInfo info{Control::kArcLength, k, settings_.steps, pt.lambda, 0.0, pt.iterations, 0, pt.residual};
+      stopped = observer.on_step(info, state, reactions) == StepAction::kStop;
+      return stopped || at_stop_displacement(state.x);
+    };
+    const ArcLengthResult r = solve_arc_length(model, state.x, problem_.prescriptions.at(0.0), proportional,
+                                               problem_.loads.follower, settings_.arc, on_point);
+    if (stopped) {
+      out.status = SteppingReport::Status::kStopped;
+      return out;
+    }
+    const bool reached = state.load_factor >= 1.0 || at_stop_displacement(state.x);
+    if (!(r.ok() && reached)) {
+      out.status = SteppingReport::Status::kFailed;
+      out.message = "arc-length continuation ended at load factor " + std::to_string(state.load_factor) + ": " +
+                    r.message + "; results up to arc-length step " + std::to_string(k) +
+                    " are written. Try a smaller arc_length or more steps";
+    }
+    return out;
+  }
+
+ private:
+  Problem& problem_;
+  StepperSettings settings_;
+};
+
+}  // namespace
+
+std::unique_ptr<Stepper> make_stepper(Problem& problem, const StepperSettings& settings) {
+  switch (settings.control) {
+    case Control::kDynamic:
+      return std::make_unique<DynamicStepper>(problem, settings);
+    case Control::kArcLength:
+      return std::make_unique<ArcLengthStepper>(problem, settings);
+    case Control::kLoad:
+      break;
+  }
+  return std::make_unique<LoadStepper>(problem, settings);
+}
+
+}  // namespace sf::forming

@@ -1,0 +1,101 @@
+#pragma once
+// Steppers: how a run walks a Problem (forming/model/problem.hpp) from its start to its
+// end, one output step at a time, behind one interface, so the run driver
+// (forming/run/run.hpp) reads the same whichever is chosen:
+//
+//   LoadStepper       quasi-static load control: step k of n solves for the load
+//                     factor k / n with solve_static_constrained (cut back inside the
+//                     step; Uzawa updates of constrained bodies' multipliers); within
+//                     the step the loads move from the previous factor to the new one;
+//   DynamicStepper    implicit dynamics: step k integrates the output interval
+//                     [(k - 1) T / n, k T / n] with solve_dynamic (time steps cut back
+//                     and regrown inside); load factor t / T, starting at rest;
+//   ArcLengthStepper  Crisfield's arc length: one continuation from the reference
+//                     state, every converged point a step; it ends past load factor 1
+//                     (or at stop_displacement), with at most n steps.
+//
+//   state (x, v, lambda) --> [stepper] --step k converged--> StepObserver::on_step
+//                                |                               (outputs, progress,
+//                                v                                may stop the run)
+//                         SteppingReport (finished | stopped | failed: which step, why)
+//
+// Load and time steppers start at the first step beyond the state's load factor (a
+// restart); the arc-length stepper always starts from the reference state.
+#include <memory>
+#include <string>
+
+#include "common/core/types.hpp"
+#include "forming/model/problem.hpp"
+#include "forming/solve/arc_length.hpp"
+#include "forming/solve/dynamic_solver.hpp"
+#include "forming/solve/static_solver.hpp"
+
+namespace sf::forming {
+
+enum class Control { kLoad, kDynamic, kArcLength };
+
+// Solver settings of a run, translated once from the case (forming/case/build.hpp).
+struct StepperSettings {
+  Control control = Control::kLoad;
+  int steps = 10;                  // output steps (arc length: the most steps)
+  StaticOptions statics;           // kLoad
+  UzawaOptions uzawa;              // kLoad with constrained bodies
+  DynamicOptions dynamics;         // kDynamic: per output interval (its times are set per step)
+  double end_time = 1.0;           // kDynamic, s
+  ArcLengthOptions arc;            // kArcLength
+  double stop_displacement = 0.0;  // kArcLength: also end when max |u| reaches this, mm (0: off)
+};
+
+// The state stepping starts from and, as it goes, the last converged state.
+struct SteppingState {
+  VecX x;                    // positions (n_dofs, mm)
+  VecX v;                    // velocities (n_dofs, mm/s); used by dynamic runs
+  double load_factor = 0.0;  // of x
+};
+
+// A converged step as the observer sees it.
+struct StepInfo {
+  Control control = Control::kLoad;
+  int index = 0;             // k, 1-based
+  int n_steps = 0;           // requested steps (arc length: the most)
+  double load_factor = 0.0;
+  double time = 0.0;         // s, dynamic runs (load factor x end_time); 0 otherwise
+  int iterations = 0;        // Newton iterations of the step
+  int cutbacks = 0;          // cut-backs inside the step
+  double residual = 0.0;     // |r_f| at its end, N
+};
+
+enum class StepAction { kContinue, kStop };
+
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  // After converged step `step`: the state reached and the support reactions there
+  // (n_dofs, N: f - f_ext, non-zero on prescribed dofs). kStop ends the run after it.
+  virtual StepAction on_step(const StepInfo& step, const SteppingState& state, const VecX& reactions) = 0;
+};
+
+struct SteppingReport {
+  enum class Status { kFinished, kStopped, kFailed };
+  Status status = Status::kFinished;
+  std::string message;       // kFailed: names the step and what to try
+  std::string step_failure;  // kFailed in a load or time step: "step k failed: <solver message>"
+  bool nothing_left = false;  // the start state was already at the last step (a finished run restarted)
+  int total_iterations = 0;   // Newton iterations (load and time steps: failed attempts included)
+  int multiplier_updates = 0;  // Uzawa updates of the constraint multipliers
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  // Steps from `state` (updated to the last converged state) until the end, a failure
+  // or the observer's kStop.
+  virtual SteppingReport run(SteppingState& state, StepObserver& observer) = 0;
+};
+
+// The stepper of settings.control for `problem` (which must outlive it; its model's
+// multipliers change during load control). Throws sf::InputError for a dynamic problem
+// whose mass matrix cannot be built.
+std::unique_ptr<Stepper> make_stepper(Problem& problem, const StepperSettings& settings);
+
+}  // namespace sf::forming

@@ -22,6 +22,7 @@
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/run/run.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -92,25 +93,9 @@ double uniaxial_nominal_stress(const Material& m, double l1) {
   return l1 * m.evaluate(Mat3(d.asDiagonal()), false).stress(0, 0);
 }
 
-struct RunOutput {
-  RunReport report;
-  io::CsvTable history;
-  nlohmann::json summary;
-};
-
+using fixtures::RunOutput;
 RunOutput run_in(const FormingCase& spec, const std::string& name, const std::string& grid = "") {
-  const std::filesystem::path dir = kWork / name;
-  std::filesystem::remove_all(dir);
-  RunOptions o;
-  o.out_dir = dir.string();
-  o.quiet = true;
-  o.grid_out = grid;
-  o.grid_marks = 5;
-  RunOutput out;
-  out.report = run_case(spec, o);
-  out.history = io::read_csv((dir / "history.csv").string());
-  out.summary = io::read_json((dir / "summary.json").string());
-  return out;
+  return fixtures::run_into(spec, kWork / name, grid);
 }
 
 double last(const io::CsvTable& t, const std::string& column) {

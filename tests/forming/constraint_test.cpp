@@ -34,9 +34,12 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "tests/common/tolerances.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
+
+using fixtures::max_abs;
 
 // ---- Named tolerances ------------------------------------------------------------
 // Central-difference step in positions (element size O(1) mm): truncation
@@ -54,49 +57,9 @@ constexpr double kZeroForceRel = 1e-12;
 constexpr double kUzawaResidual = 1e-8;
 constexpr double kUzawaMultiplierRel = 1e-8;
 
-template <class Derived>
-double max_abs(const Eigen::MatrixBase<Derived>& m) {
-  return m.cwiseAbs().maxCoeff();
-}
-
 // Incompressible ply law (notes section 2.5 constants): mu_T = 1, mu_L = 3, kappa_f = 50 MPa.
 std::shared_ptr<const Material> trans_iso_incompressible(const Vec3& a0) {
-  TransverselyIsotropicParams p;
-  p.mu_T = 1.0;
-  p.mu_L = 3.0;
-  p.kappa_f = 50.0;
-  p.incompressible = true;
-  return std::make_shared<TransverselyIsotropic>(p, a0);
-}
-
-// Single brick of a 2 x 1.5 x 0.4 mm ply, parameters perturbed by `distortion`.
-BrickParams reference_brick(std::mt19937& rng, double distortion, double l1 = 2.0, double l2 = 1.5,
-                            double h = 0.4) {
-  const PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), l1, l2, 1, 1), h, 0.0);
-  BrickParams X = ply.element_parameters(0, ply.reference());
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int k = 0; k < kBrickFunctions; ++k)
-    for (int i = 0; i < 3; ++i) X(k, i) += distortion * u(rng);
-  return X;
-}
-
-// Random finite deformation: homogeneous F (|F - I| entries up to 0.3) plus noise,
-// every Gauss point with det F > 0.3.
-BrickParams current_brick(std::mt19937& rng, const BrickParams& X, double noise,
-                          const quadrature::TensorRule<3>& rule) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (;;) {
-    Mat3 F = Mat3::Identity();
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) F(i, j) += 0.3 * u(rng);
-    if (F.determinant() < 0.5) continue;
-    BrickParams x = X * F.transpose();
-    for (int k = 0; k < kBrickFunctions; ++k)
-      for (int i = 0; i < 3; ++i) x(k, i) += noise * u(rng);
-    bool ok = true;
-    for (const Mat3& f : brick_deformation_gradients(X, x, rule)) ok = ok && f.determinant() > 0.3;
-    if (ok) return x;
-  }
+  return std::make_shared<TransverselyIsotropic>(fixtures::ti_incompressible(1.0, 3.0, 50.0), a0);
 }
 
 PlaneParams reference_plane(std::mt19937& rng, double distortion) {
@@ -199,8 +162,8 @@ TEST(ConstraintElement, BrickForceAndTangentMatchFiniteDifferences) {
   double worst_k = 0.0, worst_f = 0.0, worst_kc = 0.0, worst_fc = 0.0;
   for (const auto& material : materials)
     for (const ConstraintTerms& c : constraint_settings()) {
-      const BrickParams X = reference_brick(rng, 0.08);
-      const BrickParams x = current_brick(rng, X, 0.05, rule);
+      const BrickParams X = fixtures::distorted_brick(rng, 0.08);
+      const BrickParams x = fixtures::deformed_brick(rng, X, 0.05, rule, 0.3);
       const ElementResult r = brick_element(X, x, *material, rule, true, c);
       ASSERT_TRUE(r.ok());
       // A genuinely constrained finite-deformation state.
@@ -269,8 +232,8 @@ TEST(ConstraintElement, DefaultIsUnconstrainedAndBadInputThrows) {
   std::mt19937 rng(test::kSeed + 103);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
   const auto material = trans_iso_incompressible(fibre_from_layup_angle(30.0));
-  const BrickParams X = reference_brick(rng, 0.05);
-  const BrickParams x = current_brick(rng, X, 0.03, rule);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.05);
+  const BrickParams x = fixtures::deformed_brick(rng, X, 0.03, rule, 0.3);
   const ElementResult plain = brick_element(X, x, *material, rule, true);
   const ElementResult off = brick_element(X, x, *material, rule, true, ConstraintTerms{});
   EXPECT_EQ(plain.energy, off.energy);
@@ -307,7 +270,7 @@ TEST(ConstraintHomogeneous, IsochoricGivesZeroGjAndFibrePreservingGivesZeroGt) {
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
   const Vec3 a0 = Vec3(0.6, -0.3, 0.5).normalized();
   const auto material = trans_iso_incompressible(a0);
-  const BrickParams X = reference_brick(rng, 0.1);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.1);
   ConstraintTerms c;
   c.incompressible = c.inextensible = true;
   c.kappa = 100.0;
@@ -384,7 +347,7 @@ TEST(ConstraintClosedForm, CaseBExactStateIsInEquilibrium) {
   std::mt19937 rng(test::kSeed);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
   const auto material = trans_iso_incompressible(Vec3::UnitX());
-  const BrickParams X = reference_brick(rng, 0.0, cb.l1, cb.l2, cb.h);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.0, cb.l1, cb.l2, cb.h);
   const BrickParams x = X * cb.F().transpose();
   ConstraintTerms c;
   c.incompressible = c.inextensible = true;
@@ -429,7 +392,7 @@ TEST(ConstraintClosedForm, CaseBNewtonUzawaConvergesToClosedForm) {
   std::mt19937 rng(test::kSeed + 105);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
   const auto material = trans_iso_incompressible(Vec3::UnitX());
-  const BrickParams X = reference_brick(rng, 0.0, cb.l1, cb.l2, cb.h);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.0, cb.l1, cb.l2, cb.h);
   const std::vector<bool> fixed = case_b_prescribed();
   std::vector<int> free;
   for (int j = 0; j < kBrickDofs; ++j)
@@ -543,7 +506,7 @@ class PointwisePenalty final : public Material {
 // small tip deflection in z: linear solve with the tangent at the reference state.
 double cantilever_tip_stiffness(const Material& material, const ConstraintTerms& constraints, double L, double b,
                                 double h, int n, bool plane_strain = true) {
-  const PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), L, b, n, 1), h, 0.0);
+  const PlyMesh ply = fixtures::rectangle_ply(L, b, h, n, 1);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
   const Index nd = ply.n_dofs();
   MatX K = MatX::Zero(nd, nd);

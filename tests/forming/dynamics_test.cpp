@@ -39,6 +39,7 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -89,15 +90,10 @@ struct PlyCase {
   VecX X;  // reference positions
 };
 
-PlyMesh make_ply(double l1, double l2, double h, int n1, int n2, const std::vector<double>& breaks1 = {}) {
-  return PlyMesh(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), l1, l2, n1, n2, breaks1), h,
-                 0.0);
-}
-
 PlyCase make_setup(int n1 = 2, int n2 = 1) {
   PlyCase s;
   s.model = std::make_unique<Model>();
-  s.model->add_ply(make_ply(kL1, kL2, kH, n1, n2),
+  s.model->add_ply(fixtures::rectangle_ply(kL1, kL2, kH, n1, n2),
                    std::make_shared<NeoHookean>(NeoHookeanParams::from_young_poisson(kE, kNu)));
   s.mass = mass_matrix(*s.model, {kRho});
   s.X = s.model->reference_positions();
@@ -106,15 +102,7 @@ PlyCase make_setup(int n1 = 2, int n2 = 1) {
 
 // Every parameter (both layers, 3 coordinates) of the surface nodes at x = 0 of body 0.
 std::vector<Index> clamped_dofs(const Model& model) {
-  const PlyMesh& ply = model.ply(0);
-  std::vector<Index> out;
-  for (Index s = 0; s < ply.n_surface_nodes(); ++s) {
-    if (std::abs(ply.surface().geometry()(mesh::SurfaceMesh::dof(s, 0), 0)) > 1e-12) continue;
-    for (int layer = 0; layer < 2; ++layer)
-      for (int d = 0; d < 4; ++d)
-        for (int i = 0; i < 3; ++i) out.push_back(model.dof(0, ply.node(s, layer), d, i));
-  }
-  return out;
+  return fixtures::node_dofs(model, 0, fixtures::surface_nodes_at_x(model.ply(0), 0.0));
 }
 
 std::vector<TimedDof> fixed(const std::vector<Index>& dofs, const VecX& X) {
@@ -175,8 +163,8 @@ TEST(DynamicsMass, TotalMassSecondMomentsSymmetryDefiniteness) {
   // Body 0: graded 2 x 1 mesh (unequal scale factors), body 1: 1 x 2 mesh.
   Model model;
   auto mat = std::make_shared<NeoHookean>(NeoHookeanParams::from_young_poisson(kE, kNu));
-  model.add_ply(make_ply(kL1, kL2, kH, 2, 1, {0.0, 0.7, 2.0}), mat);
-  model.add_ply(make_ply(1.0, 3.0, 0.3, 1, 2), mat);
+  model.add_ply(fixtures::rectangle_ply(kL1, kL2, kH, 2, 1, 0.0, PlyPlacement::kBottom, {0.0, 0.7, 2.0}), mat);
+  model.add_ply(fixtures::rectangle_ply(1.0, 3.0, 0.3, 1, 2), mat);
   const double rho0 = 1.5e-9, rho1 = 7.85e-9;
   const linalg::SparseMatrix m = mass_matrix(model, {rho0, rho1});
   const double v0 = kL1 * kL2 * kH, v1 = 1.0 * 3.0 * 0.3;

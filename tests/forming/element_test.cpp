@@ -24,9 +24,12 @@
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
 #include "tests/common/tolerances.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
+
+using fixtures::max_abs;
 
 // ---- Named tolerances (what each bounds and why it is that size) ----------------
 // Central-difference step in positions (element size O(1) mm): truncation
@@ -41,25 +44,10 @@ constexpr double kZeroForceRel = 1e-12;
 // F under homogeneous deformation (products of O(1) numbers).
 constexpr double kExactF = 1e-12;
 
-const double kPi = std::acos(-1.0);
-
-template <class Derived>
-double max_abs(const Eigen::MatrixBase<Derived>& m) {
-  return m.cwiseAbs().maxCoeff();
-}
-
-std::shared_ptr<const Material> neo_hookean() {
-  return std::make_shared<NeoHookean>(NeoHookeanParams{1.0, 4.0});
-}
+std::shared_ptr<const Material> neo_hookean() { return fixtures::neo_hookean(1.0, 4.0); }
 
 std::shared_ptr<const Material> trans_iso(const Vec3& a0) {
-  TransverselyIsotropicParams p;
-  p.mu_T = 1.0;
-  p.mu_L = 3.0;
-  p.kappa_f = 50.0;
-  p.incompressible = false;
-  p.lambda = 4.0;
-  return std::make_shared<TransverselyIsotropic>(p, a0);
+  return std::make_shared<TransverselyIsotropic>(fixtures::ti_compressible(1.0, 3.0, 50.0, 4.0), a0);
 }
 
 // Materials under test: neo-Hookean, and the TI law at in-plane layup angles and one
@@ -67,37 +55,6 @@ std::shared_ptr<const Material> trans_iso(const Vec3& a0) {
 std::vector<std::shared_ptr<const Material>> materials_under_test() {
   return {neo_hookean(), trans_iso(fibre_from_layup_angle(0.0)), trans_iso(fibre_from_layup_angle(30.0)),
           trans_iso(fibre_from_layup_angle(-75.0)), trans_iso(Vec3(0.6, -0.3, 0.5))};
-}
-
-// One brick from a 2 x 1.5 x 0.4 mm ply (a single element), reference parameters
-// perturbed by `distortion` (relative) so the reference is curved and skewed.
-BrickParams reference_brick(std::mt19937& rng, double distortion) {
-  const PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 2.0, 1.5, 1, 1), 0.4,
-                    0.0);
-  BrickParams X = ply.element_parameters(0, ply.reference());
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int k = 0; k < kBrickFunctions; ++k)
-    for (int i = 0; i < 3; ++i) X(k, i) += distortion * u(rng);
-  return X;
-}
-
-// Current parameters: a random homogeneous F (det > 0.5) applied to X plus a random
-// perturbation (relative size `noise`), redrawn until every Gauss point has det F > 0.2.
-BrickParams current_brick(std::mt19937& rng, const BrickParams& X, double noise,
-                          const quadrature::TensorRule<3>& rule) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (;;) {
-    Mat3 F = Mat3::Identity();
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) F(i, j) += 0.3 * u(rng);
-    if (F.determinant() < 0.5) continue;
-    BrickParams x = X * F.transpose();
-    for (int k = 0; k < kBrickFunctions; ++k)
-      for (int i = 0; i < 3; ++i) x(k, i) += noise * u(rng);
-    bool ok = true;
-    for (const Mat3& f : brick_deformation_gradients(X, x, rule)) ok = ok && f.determinant() > 0.2;
-    if (ok) return x;
-  }
 }
 
 // Worst relative errors of the tangent against FD of the force and of the force
@@ -136,8 +93,8 @@ TEST(FormingElement, TangentAndForceMatchFiniteDifferences) {
   double worst_k = 0.0, worst_f = 0.0;
   for (const auto& material : materials_under_test())
     for (int trial = 0; trial < 3; ++trial) {
-      const BrickParams X = reference_brick(rng, 0.08);
-      const BrickParams x = current_brick(rng, X, 0.05, rule);
+      const BrickParams X = fixtures::distorted_brick(rng, 0.08);
+      const BrickParams x = fixtures::deformed_brick(rng, X, 0.05, rule, 0.2);
       const FdErrors e = fd_errors(X, x, [&](const BrickParams& Xa, const BrickParams& xa, bool tangent) {
         return brick_element(Xa, xa, *material, rule, tangent);
       });
@@ -156,7 +113,7 @@ TEST(FormingElement, ZeroForceInReferenceStateAndUnderRigidRotation) {
   const Vec3 t(0.7, -1.1, 0.4);
   double worst_ref = 0.0, worst_rot = 0.0;
   for (const auto& material : materials_under_test()) {
-    const BrickParams X = reference_brick(rng, 0.08);
+    const BrickParams X = fixtures::distorted_brick(rng, 0.08);
     const ElementResult r0 = brick_element(X, X, *material, rule, true);
     ASSERT_TRUE(r0.ok());
     const double scale = max_abs(r0.tangent) * 2.0;  // stiffness x element size
@@ -178,7 +135,7 @@ TEST(FormingElement, ZeroForceInReferenceStateAndUnderRigidRotation) {
 TEST(FormingElement, HomogeneousDeformationGivesExactF) {
   std::mt19937 rng(test::kSeed + 2);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
-  const BrickParams X = reference_brick(rng, 0.1);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.1);
   Mat3 F0;
   F0 << 1.3, 0.2, -0.1, 0.05, 0.8, 0.3, -0.2, 0.1, 1.1;
   BrickParams x = X * F0.transpose();
@@ -191,7 +148,7 @@ TEST(FormingElement, HomogeneousDeformationGivesExactF) {
 TEST(FormingElement, InvertedStateIsReportedNotThrown) {
   std::mt19937 rng(test::kSeed + 3);
   const quadrature::TensorRule<3> rule = ElementRule{}.brick();
-  const BrickParams X = reference_brick(rng, 0.0);
+  const BrickParams X = fixtures::distorted_brick(rng, 0.0);
   BrickParams x = X;
   x.col(2) *= -1.0;  // mirror through the ply plane: det F = -1
   const ElementResult r = brick_element(X, x, *neo_hookean(), rule, true);

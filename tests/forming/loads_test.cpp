@@ -19,15 +19,13 @@
 #include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
 
 Model block_model(double lx, double ly, double h, int n1, int n2, double mu = 1.0, double lambda = 2.0) {
-  Model model;
-  PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), lx, ly, n1, n2), h, 0.0);
-  model.add_ply(std::move(ply), std::make_shared<NeoHookean>(NeoHookeanParams{mu, lambda}));
-  return model;
+  return fixtures::one_ply_model(fixtures::rectangle_ply(lx, ly, h, n1, n2), fixtures::neo_hookean(mu, lambda));
 }
 
 std::vector<FaceRef> all_faces(const Model& model, BrickFace face) {

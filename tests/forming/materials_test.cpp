@@ -23,9 +23,12 @@
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "tests/common/tolerances.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
+
+using fixtures::max_abs;
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -48,13 +51,6 @@ constexpr double kModuliRel = 1e-6;
 // Linear response measured as a secant at strain 1e-6: the quadratic term is ~1e-6
 // of the modulus times the stiffness ratio of the law.
 constexpr double kSecantRel = 1e-4;
-
-const double kPi = std::acos(-1.0);
-
-template <class Derived>
-double max_abs(const Eigen::MatrixBase<Derived>& m) {
-  return m.cwiseAbs().maxCoeff();
-}
 
 Mat3 rotation(const Vec3& axis, double angle) {
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
@@ -128,20 +124,10 @@ struct NamedMaterial {
   std::shared_ptr<const Material> material;
 };
 
+using fixtures::ti_compressible;
+// The incompressible law's constants (the default form).
 TransverselyIsotropicParams ti(double mu_t, double mu_l, double kappa_f) {
-  TransverselyIsotropicParams p;
-  p.mu_T = mu_t;
-  p.mu_L = mu_l;
-  p.kappa_f = kappa_f;
-  return p;
-}
-
-TransverselyIsotropicParams ti_compressible(double mu_t, double mu_l, double kappa_f,
-                                            double lambda) {
-  TransverselyIsotropicParams p = ti(mu_t, mu_l, kappa_f);
-  p.incompressible = false;
-  p.lambda = lambda;
-  return p;
+  return fixtures::ti_incompressible(mu_t, mu_l, kappa_f);
 }
 
 // Molten unidirectional GF/PP scale: fibre stiffness 25000 times transverse.

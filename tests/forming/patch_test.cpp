@@ -36,6 +36,7 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -56,8 +57,6 @@ constexpr double kAsymptotic = 1e-2;
 constexpr double kRoundoffFloor = 1e-14;
 // Plane-stress F0 solve: |S e3| relative to mu.
 constexpr double kPlaneStress = 1e-14;
-
-const double kPi = std::acos(-1.0);
 
 struct Patch {
   std::unique_ptr<Model> model;
@@ -120,27 +119,9 @@ Mat3 plane_stress_f0(const Material& material) {
   return F0;
 }
 
-// x = F0 X + t on the parameters (translation on values only), flattened.
-VecX affine(const PlyMesh& ply, const Mat3& F0, const Vec3& t) {
-  MatX x = ply.reference();
-  for (Index p = 0; p < x.rows(); ++p) {
-    x.row(p) = (F0 * x.row(p).transpose()).transpose();
-    if (p % 4 == mesh::kValue) x.row(p) += t.transpose();
-  }
-  return PlyMesh::flatten(x);
-}
-
+// Every parameter of the ply's lateral boundary nodes (both layers) at its value in target.
 std::vector<PrescribedDof> prescribe_boundary(const Model& model, const VecX& target) {
-  const PlyMesh& ply = model.ply(0);
-  std::vector<PrescribedDof> bcs;
-  for (Index s : ply.boundary_surface_nodes())
-    for (int layer = 0; layer < 2; ++layer)
-      for (int d = 0; d < 4; ++d)
-        for (int i = 0; i < 3; ++i) {
-          const Index dof = model.dof(0, ply.node(s, layer), d, i);
-          bcs.push_back({dof, target(dof)});
-        }
-  return bcs;
+  return fixtures::held_at(fixtures::node_dofs(model, 0, model.ply(0).boundary_surface_nodes()), target);
 }
 
 void run_patch(const std::shared_ptr<const Material>& material, const PlyMesh& ply_in, const char* label) {
@@ -149,7 +130,7 @@ void run_patch(const std::shared_ptr<const Material>& material, const PlyMesh& p
   const PlyMesh& ply = model.ply(0);
   const Mat3 F0 = plane_stress_f0(*material);
   const Vec3 t(0.3, -0.2, 0.5);
-  const VecX exact = affine(ply, F0, t);
+  const VecX exact = fixtures::affine(ply, F0, t);
   const std::vector<PrescribedDof> bcs = prescribe_boundary(model, exact);
   ASSERT_EQ(bcs.size(), static_cast<std::size_t>(10 * 2 * 4 * 3));  // 10 boundary nodes of 12
 
@@ -218,7 +199,7 @@ TEST(FormingPatch, UnreachableStateEndsWithReportAndLastConvergedState) {
   // Mirror through the ply plane: the boundary passes through zero thickness at lambda 1/2.
   Mat3 M = Mat3::Identity();
   M(2, 2) = -1.0;
-  const VecX target = affine(model.ply(0), M, Vec3::Zero());
+  const VecX target = fixtures::affine(model.ply(0), M, Vec3::Zero());
   StaticOptions options;
   options.initial_increment = 0.25;
   options.min_increment = 1e-3;

@@ -11,18 +11,12 @@
 #include "common/core/error.hpp"
 #include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 TEST(Restart, SplitRunMatchesUninterruptedRun) {
   const FormingCase spec = load_case(std::string(SF_SOURCE_DIR) + "/data/forming/cantilever.yaml");
@@ -38,15 +32,15 @@ TEST(Restart, SplitRunMatchesUninterruptedRun) {
   first.stop_after = 3;
   const RunReport a = run_case(spec, first);
   EXPECT_EQ(a.status, RunReport::Status::kStopped);
-  EXPECT_EQ(nlohmann::json::parse(slurp(tmp / "split" / "summary.json"))["status"], "stopped");
+  EXPECT_EQ(nlohmann::json::parse(fixtures::read_text(tmp / "split" / "summary.json"))["status"], "stopped");
   RunOptions second = first;
   second.stop_after = 0;
   second.restart = true;
   const RunReport b = run_case(spec, second);
   ASSERT_EQ(b.status, RunReport::Status::kConverged) << b.message;
 
-  const nlohmann::json rw = nlohmann::json::parse(slurp(tmp / "whole" / "restart.json"));
-  const nlohmann::json rs = nlohmann::json::parse(slurp(tmp / "split" / "restart.json"));
+  const nlohmann::json rw = nlohmann::json::parse(fixtures::read_text(tmp / "whole" / "restart.json"));
+  const nlohmann::json rs = nlohmann::json::parse(fixtures::read_text(tmp / "split" / "restart.json"));
   const std::vector<double> xw = rw["positions"], xs = rs["positions"];
   ASSERT_EQ(xw.size(), xs.size());
   double diff = 0.0;
@@ -54,11 +48,11 @@ TEST(Restart, SplitRunMatchesUninterruptedRun) {
   EXPECT_LT(diff, 1e-9) << "final positions of the split run differ by " << diff << " mm";
   // History: same number of rows; the collection lists every frame once.
   auto rows = [](const std::string& t) { return std::count(t.begin(), t.end(), '\n'); };
-  EXPECT_EQ(rows(slurp(tmp / "whole" / "history.csv")), rows(slurp(tmp / "split" / "history.csv")));
+  EXPECT_EQ(rows(fixtures::read_text(tmp / "whole" / "history.csv")), rows(fixtures::read_text(tmp / "split" / "history.csv")));
   // Every frame of the whole run is in the split run's collection (which also has the
   // frame written where it stopped).
-  const std::string pvd_split = slurp(tmp / "split" / "result.pvd");
-  std::istringstream pvd_whole(slurp(tmp / "whole" / "result.pvd"));
+  const std::string pvd_split = fixtures::read_text(tmp / "split" / "result.pvd");
+  std::istringstream pvd_whole(fixtures::read_text(tmp / "whole" / "result.pvd"));
   for (std::string line; std::getline(pvd_whole, line);)
     if (line.find("<DataSet") != std::string::npos) {
       EXPECT_NE(pvd_split.find(line), std::string::npos) << line;

@@ -42,11 +42,11 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
 
-const double kPi = std::acos(-1.0);
 constexpr double kL = 100.0, kB = 10.0, kH = 1.0;
 constexpr double kMu = 500.0;  // MPa; lambda = 0 -> E = 2 mu, nu = 0
 constexpr double kE = 2.0 * kMu;
@@ -58,40 +58,22 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 Model make_strip(int n_along = kElementsAlong) {
-  Model model;
-  PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), kL, kB, n_along, 1), kH,
-              0.0, PlyPlacement::kMiddle);
-  model.add_ply(std::move(ply), std::make_shared<NeoHookean>(NeoHookeanParams{kMu, 0.0}));
-  return model;
+  return fixtures::one_ply_model(fixtures::rectangle_ply(kL, kB, kH, n_along, 1, 0.0, PlyPlacement::kMiddle),
+                                 fixtures::neo_hookean(kMu, 0.0));
 }
 
-std::vector<Index> surface_nodes_at_x(const PlyMesh& ply, double x) {
-  std::vector<Index> out;
-  for (Index s = 0; s < ply.n_surface_nodes(); ++s)
-    if (std::abs(ply.surface().node_position(s).x() - x) < 1e-9) out.push_back(s);
-  return out;
-}
+using fixtures::Held;
+using fixtures::surface_nodes_at_x;
 
 // Section of the nodes at x held at `target` (both layers): kSection = values and the
 // along-edge tangent d/ds2 (the continuum Dirichlet condition: u given on the face);
 // kAllParameters also holds d/ds1 and d2/ds1ds2, i.e. additionally du/dx on the face,
 // which forces zero fibre strain there (over-constrains a bent section).
-enum class Hold { kSection, kAllParameters };
-std::vector<PrescribedDof> hold_nodes(const Model& model, double x, const VecX& X, Hold hold) {
-  const PlyMesh& ply = model.ply(0);
-  std::vector<PrescribedDof> bcs;
-  for (Index s : surface_nodes_at_x(ply, x))
-    for (int layer = 0; layer < 2; ++layer)
-      for (int d = 0; d < 4; ++d)
-        for (int i = 0; i < 3; ++i) {
-          if (hold == Hold::kSection && d != mesh::kValue && d != mesh::kD2) continue;
-          const Index dof = model.dof(0, ply.node(s, layer), d, i);
-          bcs.push_back({dof, X(dof)});
-        }
-  return bcs;
+std::vector<PrescribedDof> hold_nodes(const Model& model, double x, const VecX& X, Held held) {
+  return fixtures::held_at(fixtures::node_dofs(model, 0, surface_nodes_at_x(model.ply(0), x), held), X);
 }
-std::vector<PrescribedDof> clamp_root(const Model& model, Hold hold = Hold::kAllParameters) {
-  return hold_nodes(model, 0.0, model.reference_positions(), hold);
+std::vector<PrescribedDof> clamp_root(const Model& model, Held held = Held::kAllParameters) {
+  return hold_nodes(model, 0.0, model.reference_positions(), held);
 }
 
 // Consistent generalised forces of a uniform dead traction on the lateral faces over
@@ -168,7 +150,7 @@ double solve_elastica(const Model& model, const std::vector<PrescribedDof>& bcs,
 TEST(VerificationElastica, TipLoadedCantileverMatchesEulerElastica) {
   const Model model = make_strip();
   // Root clamp = the section (values and d/ds2 of the root nodes): the continuum clamp.
-  const std::vector<PrescribedDof> bcs = clamp_root(model, Hold::kSection);
+  const std::vector<PrescribedDof> bcs = clamp_root(model, Held::kSection);
   // Relative tolerances on v/L and u/L (measured errors printed; see the file header).
   constexpr double kTolV = 5e-3, kTolU = 1e-2;
   // alpha = 5 and 10 also pass (+1.1e-4 / +1.5e-4 on v) but take 8 s each: left out.
@@ -178,7 +160,7 @@ TEST(VerificationElastica, TipLoadedCantileverMatchesEulerElastica) {
   // is largest): stiffer by a boundary layer of one element; measured at alpha = 1:
   // v 2.5 % low with 20 elements, 0.96 % with 40, 0.41 % with 80 (first order in the
   // element length). Asserted loosely, to show the trend's sign and size.
-  const double ev = solve_elastica(model, clamp_root(model, Hold::kAllParameters), ElasticaRow{1.0, 0.30172, 0.05643},
+  const double ev = solve_elastica(model, clamp_root(model, Held::kAllParameters), ElasticaRow{1.0, 0.30172, 0.05643},
                                    3e-2, 5e-2, "all-parameter clamp");
   EXPECT_LT(ev, 0.0);
 }
@@ -266,8 +248,8 @@ TEST(VerificationRollUp, EndRotationBendsStripIntoCircularArc) {
   for (double turns : {0.125, 0.25, 0.5, 1.0}) {
     const double theta = 2.0 * kPi * turns;
     const VecX target = rolled(model, theta);
-    std::vector<PrescribedDof> bcs = hold_nodes(model, 0.0, target, Hold::kSection);
-    const std::vector<PrescribedDof> tip_bcs = hold_nodes(model, kL, target, Hold::kSection);
+    std::vector<PrescribedDof> bcs = hold_nodes(model, 0.0, target, Held::kSection);
+    const std::vector<PrescribedDof> tip_bcs = hold_nodes(model, kL, target, Held::kSection);
     bcs.insert(bcs.end(), tip_bcs.begin(), tip_bcs.end());
     const StaticResult res = solve_static(model, target, bcs, VecX());
     ASSERT_TRUE(res.report.ok()) << "theta " << theta << ": " << res.report.brief();

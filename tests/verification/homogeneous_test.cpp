@@ -38,6 +38,7 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -48,27 +49,9 @@ constexpr double kRoundoff = 1e-12;
 // Newton stopping tolerance relative to the force scale.
 constexpr double kNewtonTol = 1e-13;
 
-const double kPi = std::acos(-1.0);
+TransverselyIsotropicParams ti_params() { return fixtures::ti_compressible(1.0, 2.5, 40.0, 3.0); }
 
-TransverselyIsotropicParams ti_params() {
-  TransverselyIsotropicParams p;
-  p.mu_T = 1.0;
-  p.mu_L = 2.5;
-  p.kappa_f = 40.0;
-  p.incompressible = false;
-  p.lambda = 3.0;
-  return p;
-}
-
-// Affine field x = F X + t on every parameter (translation on values only), flattened.
-VecX affine(const PlyMesh& ply, const Mat3& F, const Vec3& t) {
-  MatX x = ply.reference();
-  for (Index p = 0; p < x.rows(); ++p) {
-    x.row(p) = (F * x.row(p).transpose()).transpose();
-    if (p % 4 == mesh::kValue) x.row(p) += t.transpose();
-  }
-  return PlyMesh::flatten(x);
-}
+using fixtures::affine;
 
 // Rigid motion x -> R x + t of a flattened position field.
 VecX rigid(const VecX& x, const Mat3& R, const Vec3& t) {
@@ -83,23 +66,11 @@ VecX rigid(const VecX& x, const Mat3& R, const Vec3& t) {
 // Rotation of a flattened force field (per parameter).
 VecX rotate(const VecX& f, const Mat3& R) { return rigid(f, R, Vec3::Zero()); }
 
+// Every parameter of the lateral boundary nodes (or of every node), at its value in target.
 std::vector<PrescribedDof> prescribe(const Model& model, const VecX& target, bool lateral_only) {
   const PlyMesh& ply = model.ply(0);
-  std::vector<Index> nodes;
-  if (lateral_only) {
-    nodes = ply.boundary_surface_nodes();
-  } else {
-    for (Index s = 0; s < ply.n_surface_nodes(); ++s) nodes.push_back(s);
-  }
-  std::vector<PrescribedDof> bcs;
-  for (Index s : nodes)
-    for (int layer = 0; layer < 2; ++layer)
-      for (int d = 0; d < 4; ++d)
-        for (int i = 0; i < 3; ++i) {
-          const Index dof = model.dof(0, ply.node(s, layer), d, i);
-          bcs.push_back({dof, target(dof)});
-        }
-  return bcs;
+  const std::vector<Index> nodes = lateral_only ? ply.boundary_surface_nodes() : fixtures::all_surface_nodes(ply);
+  return fixtures::held_at(fixtures::node_dofs(model, 0, nodes), target);
 }
 
 StaticResult solve(const Model& model, const std::vector<PrescribedDof>& bcs, const VecX& start) {
@@ -110,7 +81,7 @@ StaticResult solve(const Model& model, const std::vector<PrescribedDof>& bcs, co
   return solve_static(model, start, bcs, VecX(), o);
 }
 
-double max_abs(const VecX& v) { return v.lpNorm<Eigen::Infinity>(); }
+using fixtures::max_abs;
 
 TEST(VerificationObjectivity, TransverselyIsotropicEnergyAndReactionsAreFrameIndifferent) {
   PlyMesh ply0(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 3.0, 2.0, 3, 2,

@@ -58,7 +58,7 @@ struct ArcLengthPoint {
 
 // The steps of a continuation (forming/solve/step_history.hpp): one record per attempt
 // (target = the load factor it ended at, increment = its arc length Delta l, the
-// residual norm of every iteration), status kConverged when it stopped as asked
+// residual norm of its last iteration), status kConverged when it stopped as asked
 // (max_load_factor, max_steps or the callback), with the message saying which.
 struct ArcLengthResult : StepHistory {
   std::vector<ArcLengthPoint> path;  // converged points, the start (lambda 0) first

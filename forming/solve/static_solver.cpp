@@ -76,6 +76,203 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   return solve_static(model, x_start, prescribed, load, false, options);
 }
 
+namespace {
+
+// Residual and (optionally) tangent at (lambda, x): internal minus external.
+struct Residual {
+  Assembly a;
+  VecX residual;
+  double scale = 0.0;  // max(|f_int|, |f_ext|)
+};
+
+// The load steps of one static solve: the dof classes, the tangent solver, and the
+// predictor and corrector of a step. solve_static() drives them.
+class LoadStepping {
+ public:
+  LoadStepping(const Model& model, const Eigen::Ref<const VecX>& x_start, const LoadFunction& load, bool unsymmetric,
+               const StaticOptions& options)
+      : model_(model),
+        x_start_(x_start),
+        load_(load),
+        options_(options),
+        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()) {}
+
+  // Free, prescribed (with their targets at lambda = 1) and held (used by no element)
+  // dofs; returns why the input is invalid (empty when valid).
+  std::string classify(const std::vector<PrescribedDof>& prescribed);
+  Residual evaluate(double lambda, const VecX& x, bool want_tangent) const;
+
+  enum class Predicted { kOk, kFailed, kInadmissible };
+  // Predictor from the converged state x to lam_new: tangent at x, prescribed dofs
+  // moved; the first iterate in xt (kFailed: rec.failure says why; kInadmissible: the
+  // converged state no longer assembles, `why`).
+  Predicted predict(double lam_new, const VecX& x, VecX& xt, StepRecord& rec, std::string& why);
+  // Corrector: Newton from xt until converged (rec.converged, force_scale set) or
+  // failed (rec.failure).
+  void correct(double lam_new, VecX& xt, StepRecord& rec, double& force_scale);
+
+ private:
+  enum : char { kFree, kPrescribed, kHeld };
+  VecX prescribed_at(double lambda, const VecX& x) const;
+  // Line-search factor along dx; < 0 (rec.failure) when every trial inverted an element.
+  double line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec) const;
+
+  const Model& model_;
+  const Eigen::Ref<const VecX>& x_start_;
+  const LoadFunction& load_;
+  const StaticOptions& options_;
+  TangentSolver solver_;
+  std::vector<char> kind_;
+  VecX target_;
+  FreeDofs free_;
+  double length_scale_ = 0.0;
+};
+
+std::string LoadStepping::classify(const std::vector<PrescribedDof>& prescribed) {
+  const Index n = model_.n_dofs();
+  kind_.assign(static_cast<std::size_t>(n), kFree);
+  target_ = x_start_;
+  for (const PrescribedDof& p : prescribed) {
+    if (p.dof < 0 || p.dof >= n)
+      return "prescribed dof " + std::to_string(p.dof) + " is outside 0.." + std::to_string(n - 1);
+    if (!std::isfinite(p.value)) return "prescribed dof " + std::to_string(p.dof) + " has a non-finite value";
+    kind_[p.dof] = kPrescribed;
+    target_(p.dof) = p.value;
+  }
+  const std::vector<bool> used = model_.used_dofs();
+  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
+  for (Index d = 0; d < n; ++d) {
+    if (!used[d] && kind_[d] == kFree) kind_[d] = kHeld;
+    is_free[static_cast<std::size_t>(d)] = kind_[d] == kFree;
+  }
+  free_ = FreeDofs(is_free);
+  for (Index d = 0; d < n; ++d) length_scale_ = std::max(length_scale_, std::abs(x_start_(d)));
+  length_scale_ = std::max(length_scale_, 1e-300);
+  return {};
+}
+
+Residual LoadStepping::evaluate(double lambda, const VecX& x, bool want_tangent) const {
+  Residual st;
+  st.a = model_.assemble(x, want_tangent);
+  if (!st.a.ok) return st;
+  ExternalLoad ext = load_(lambda, x, want_tangent);
+  SF_ASSERT(ext.force.size() == model_.n_dofs(), "external load must have n_dofs entries");
+  st.residual = st.a.force - ext.force;
+  st.scale = std::max(st.a.force.norm(), ext.force.norm());
+  if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
+  return st;
+}
+
+// x with the prescribed dofs moved to their values at lambda (linear from the start).
+VecX LoadStepping::prescribed_at(double lambda, const VecX& x) const {
+  VecX v = x;
+  for (Index d = 0; d < model_.n_dofs(); ++d)
+    if (kind_[d] == kPrescribed) v(d) = x_start_(d) + lambda * (target_(d) - x_start_(d));
+  return v;
+}
+
+LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, VecX& xt, StepRecord& rec,
+                                              std::string& why) {
+  const linalg::SparseMatrix& select = free_.select;
+  xt = x;
+  rec.iterations = 1;
+  const Residual st = evaluate(lam_new, x, true);
+  const Assembly& a = st.a;
+  if (!a.ok) {
+    why = "converged state became inadmissible: " + a.message;
+    return Predicted::kInadmissible;
+  }
+  const VecX x_new = prescribed_at(lam_new, x);
+  const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
+  const VecX rhs = -free_.restrict(st.residual + a.tangent * dxp);
+  const linalg::SparseMatrix kff = select.transpose() * a.tangent * select;
+  if (free_.size() == 0) {
+    xt = x_new;
+    return Predicted::kOk;
+  }
+  const linalg::SolveReport& sr = solver_.factorize(kff);
+  if (!sr.ok()) {
+    rec.failure = "predictor: linear solve " + sr.brief();
+    return Predicted::kFailed;
+  }
+  const VecX dxf = solver_.solve(rhs);
+  xt = x_new + select * dxf;
+  return Predicted::kOk;
+}
+
+void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& force_scale) {
+  const linalg::SparseMatrix& select = free_.select;
+  double first_norm = -1.0;
+  for (;;) {
+    const Residual st = evaluate(lam_new, xt, true);
+    const Assembly& a = st.a;
+    if (!a.ok) {
+      rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + a.message;
+      return;
+    }
+    const VecX rf = free_.restrict(st.residual);
+    const double rnorm = rf.norm();
+    rec.residual_norms.push_back(rnorm);
+    const double scale = st.scale;
+    if (first_norm < 0.0) first_norm = rnorm;
+    const double tol = std::max(options_.residual_tol_abs, options_.residual_tol_rel * scale);
+    if (rnorm <= tol) {
+      rec.converged = true;
+      force_scale = scale;
+      return;
+    }
+    if (!std::isfinite(rnorm) || rnorm > options_.divergence_factor * std::max(first_norm, 1e-300)) {
+      rec.failure = "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) +
+                    " iterations";
+      return;
+    }
+    if (rec.iterations >= options_.max_iterations) {
+      rec.failure = "no convergence in " + std::to_string(options_.max_iterations) + " iterations (|r| " +
+                    detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
+      return;
+    }
+    const linalg::SolveReport& sr = solver_.factorize(select.transpose() * a.tangent * select);
+    if (!sr.ok()) {
+      rec.failure = "linear solve " + sr.brief();
+      return;
+    }
+    const VecX dxf = solver_.solve(-rf);
+    ++rec.iterations;
+    if (!dxf.allFinite()) {
+      rec.failure = "linear solve returned non-finite values";
+      return;
+    }
+    const VecX dx = select * dxf;
+    // Round-off floor: a correction this small cannot reduce |r| further.
+    if (dxf.size() == 0 || dxf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale_) {
+      xt += dx;
+      rec.step_lengths.push_back(1.0);
+      rec.converged = true;
+      force_scale = scale;
+      return;
+    }
+    const double alpha = options_.line_search ? line_search(lam_new, xt, dx, rnorm, rec) : 1.0;
+    if (alpha < 0.0) return;
+    xt += alpha * dx;
+    rec.step_lengths.push_back(alpha);
+  }
+}
+
+double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm,
+                                 StepRecord& rec) const {
+  const double alpha =
+      detail::backtrack(rnorm, options_.max_line_search, [&](double trial_step, bool&) -> std::optional<double> {
+        const Residual trial = evaluate(lam_new, xt + trial_step * dx, false);
+        if (!trial.a.ok) return std::nullopt;
+        return free_.restrict(trial.residual).norm();
+      }).step;
+  if (alpha < 0.0)
+    rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+  return alpha;
+}
+
+}  // namespace
+
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
                           const std::vector<PrescribedDof>& prescribed, const LoadFunction& load_at,
                           bool unsymmetric, const StaticOptions& options) {
@@ -93,65 +290,13 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   if (x_start.size() != n)
     return invalid("start positions have " + std::to_string(x_start.size()) + " entries, expected " +
                    std::to_string(n));
-  // Residual and (optionally) tangent at lambda, x: internal minus external.
-  struct State {
-    Assembly a;
-    VecX residual;
-    double scale = 0.0;  // max(|f_int|, |f_ext|)
-  };
-  auto evaluate = [&](double lam, const VecX& xs, bool want_tangent) {
-    State st;
-    st.a = model.assemble(xs, want_tangent);
-    if (!st.a.ok) return st;
-    ExternalLoad ext = load_at(lam, xs, want_tangent);
-    SF_ASSERT(ext.force.size() == n, "external load must have n_dofs entries");
-    st.residual = st.a.force - ext.force;
-    st.scale = std::max(st.a.force.norm(), ext.force.norm());
-    if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
-    return st;
-  };
+  LoadStepping steps(model, x_start, load_at, unsymmetric, options);
+  if (const std::string why = steps.classify(prescribed); !why.empty()) return invalid(why);
+  if (const Assembly a0 = model.assemble(x_start, false); !a0.ok) return invalid("start state: " + a0.message);
 
-  // Dof classes: free, prescribed, held (used by no element).
-  enum : char { kFree, kPrescribed, kHeld };
-  std::vector<char> kind(n, kFree);
-  VecX target = x_start;
-  for (const PrescribedDof& p : prescribed) {
-    if (p.dof < 0 || p.dof >= n)
-      return invalid("prescribed dof " + std::to_string(p.dof) + " is outside 0.." + std::to_string(n - 1));
-    if (!std::isfinite(p.value)) return invalid("prescribed dof " + std::to_string(p.dof) + " has a non-finite value");
-    kind[p.dof] = kPrescribed;
-    target(p.dof) = p.value;
-  }
-  const std::vector<bool> used = model.used_dofs();
-  std::vector<bool> is_free(static_cast<std::size_t>(n), false);
-  for (Index d = 0; d < n; ++d) {
-    if (!used[d] && kind[d] == kFree) kind[d] = kHeld;
-    is_free[static_cast<std::size_t>(d)] = kind[d] == kFree;
-  }
-  const FreeDofs free_dofs(is_free);
-  const Index nf = free_dofs.size();
-  const linalg::SparseMatrix& select = free_dofs.select;
-  double length_scale = 0.0;
-  for (Index d = 0; d < n; ++d) length_scale = std::max(length_scale, std::abs(x_start(d)));
-  length_scale = std::max(length_scale, 1e-300);
-
-  {
-    const Assembly a0 = model.assemble(x_start, false);
-    if (!a0.ok) return invalid("start state: " + a0.message);
-  }
-
-  TangentSolver solver(options.linear_solver, unsymmetric || !model.symmetric_tangent());
   VecX x = x_start;
   double lambda = 0.0;
   double increment = std::min(options.initial_increment, options.max_increment);
-  auto prescribed_at = [&](double lam) {
-    VecX v = x;
-    for (Index d = 0; d < n; ++d)
-      if (kind[d] == kPrescribed) v(d) = x_start(d) + lam * (target(d) - x_start(d));
-    return v;
-  };
-  auto free_part = [&](const VecX& v) { return free_dofs.restrict(v); };
-
   int attempts = 0;
   while (lambda < 1.0) {
     if (attempts >= options.max_steps) {
@@ -165,102 +310,11 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     StepRecord rec;
     rec.target = lam_new;
     rec.increment = lam_new - lambda;
-
-    // Predictor: tangent at the converged state, prescribed dofs moved.
-    VecX xt = x;
-    bool failed = false;
-    {
-      const State st = evaluate(lam_new, x, true);
-      const Assembly& a = st.a;
-      if (!a.ok) return invalid("converged state became inadmissible: " + a.message);
-      const VecX x_new = prescribed_at(lam_new);
-      const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
-      const VecX rhs = -free_part(st.residual + a.tangent * dxp);
-      const linalg::SparseMatrix kff = select.transpose() * a.tangent * select;
-      if (nf > 0) {
-        const linalg::SolveReport& sr = solver.factorize(kff);
-        if (!sr.ok()) {
-          rec.failure = "predictor: linear solve " + sr.brief();
-          failed = true;
-        } else {
-          const VecX dxf = solver.solve(rhs);
-          xt = x_new + select * dxf;
-        }
-      } else {
-        xt = x_new;
-      }
-      rec.iterations = 1;
-    }
-    // Corrector.
-    double first_norm = -1.0;
-    while (!failed) {
-      const State st = evaluate(lam_new, xt, true);
-      const Assembly& a = st.a;
-      if (!a.ok) {
-        rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + a.message;
-        failed = true;
-        break;
-      }
-      const VecX rf = free_part(st.residual);
-      const double rnorm = rf.norm();
-      rec.residual_norms.push_back(rnorm);
-      const double scale = st.scale;
-      if (first_norm < 0.0) first_norm = rnorm;
-      if (rnorm <= std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) {
-        rec.converged = true;
-        report.force_scale = scale;
-        break;
-      }
-      if (!std::isfinite(rnorm) || rnorm > options.divergence_factor * std::max(first_norm, 1e-300)) {
-        rec.failure = "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
-        failed = true;
-        break;
-      }
-      if (rec.iterations >= options.max_iterations) {
-        rec.failure = "no convergence in " + std::to_string(options.max_iterations) + " iterations (|r| " +
-                      detail::short_number(rnorm) + ", tolerance " +
-                      detail::short_number(std::max(options.residual_tol_abs, options.residual_tol_rel * scale)) + ")";
-        failed = true;
-        break;
-      }
-      const linalg::SolveReport& sr = solver.factorize(select.transpose() * a.tangent * select);
-      if (!sr.ok()) {
-        rec.failure = "linear solve " + sr.brief();
-        failed = true;
-        break;
-      }
-      const VecX dxf = solver.solve(-rf);
-      ++rec.iterations;
-      if (!dxf.allFinite()) {
-        rec.failure = "linear solve returned non-finite values";
-        failed = true;
-        break;
-      }
-      const VecX dx = select * dxf;
-      // Round-off floor: a correction this small cannot reduce |r| further.
-      if (dxf.size() == 0 || dxf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale) {
-        xt += dx;
-        rec.step_lengths.push_back(1.0);
-        rec.converged = true;
-        report.force_scale = scale;
-        break;
-      }
-      double alpha = 1.0;
-      if (options.line_search) {
-        alpha = detail::backtrack(rnorm, options.max_line_search, [&](double trial_step, bool&) -> std::optional<double> {
-                  const State trial = evaluate(lam_new, xt + trial_step * dx, false);
-                  if (!trial.a.ok) return std::nullopt;
-                  return free_part(trial.residual).norm();
-                }).step;
-        if (alpha < 0.0) {
-          rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
-          failed = true;
-          break;
-        }
-      }
-      xt += alpha * dx;
-      rec.step_lengths.push_back(alpha);
-    }
+    VecX xt;
+    std::string why;
+    const LoadStepping::Predicted predicted = steps.predict(lam_new, x, xt, rec, why);
+    if (predicted == LoadStepping::Predicted::kInadmissible) return invalid(why);
+    if (predicted == LoadStepping::Predicted::kOk) steps.correct(lam_new, xt, rec, report.force_scale);
     if (rec.converged) {
       x = xt;
       lambda = lam_new;
@@ -269,7 +323,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       report.add(std::move(rec));
       continue;
     }
-    const std::string why = rec.failure;
+    why = rec.failure;
     report.add(std::move(rec));
     increment *= 0.5;
     if (increment < options.min_increment) {
@@ -285,7 +339,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   }
   report.load_factor = lambda;
   result.positions = x;
-  result.reactions = evaluate(lambda, x, false).residual;
+  result.reactions = steps.evaluate(lambda, x, false).residual;
   return result;
 }
 

@@ -61,7 +61,8 @@ class Reader {
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         std::string list;
         for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        problem(ProblemKind::kUnknownKey, it->first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
+        problem(ProblemKind::kUnknownKey, it->first,
+                what + ": unknown key '" + key + "' (expected one of: " + list + ")");
       } else if (!seen.insert(key).second) {
         problem(ProblemKind::kDuplicate, it->first, what + ": key '" + key + "' given twice");
       }
@@ -108,8 +109,9 @@ class Reader {
       return std::nullopt;
     }
     if (v < lo || v > hi) {
-      problem(ProblemKind::kOutOfRange, n, what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], found " + s);
+      problem(ProblemKind::kOutOfRange, n,
+              what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " +
+                  s);
       return std::nullopt;
     }
     return static_cast<int>(v);
@@ -147,6 +149,92 @@ class Reader {
 const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "boundary_conditions", "loads", "solver",
                                            "output"};
 
+// The law of material `what` under key `law` (neo_hookean: {E, nu} or {mu, lambda});
+// false (with a problem) when it cannot be read or the law rejects the constants.
+bool read_neo_hookean(Reader& r, const std::string& what, const YAML::Node& law, const YAML::Node& p,
+                      CaseMaterial& m) {
+  const std::string lw = what + " neo_hookean";
+  m.kind = CaseMaterial::Kind::kNeoHookean;
+  if (!r.mapping(p, lw, {"E", "nu", "mu", "lambda"})) return false;
+  const bool young = p["E"].IsDefined() || p["nu"].IsDefined();
+  const bool lame = p["mu"].IsDefined() || p["lambda"].IsDefined();
+  if (young == lame) {
+    r.problem(ProblemKind::kWrongType, law, lw + ": give either {E, nu} or {mu, lambda}");
+    return false;
+  }
+  try {
+    if (young) {
+      const auto E = r.number(r.required(p, "E", lw), lw + " E");
+      const auto nu = r.number(r.required(p, "nu", lw), lw + " nu");
+      if (!E || !nu) return false;
+      m.neo_hookean = NeoHookeanParams::from_young_poisson(*E, *nu);
+      m.given_as = "E, nu";
+    } else {
+      const auto mu = r.number(r.required(p, "mu", lw), lw + " mu");
+      const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
+      if (!mu || !la) return false;
+      m.neo_hookean = NeoHookeanParams{*mu, *la};
+      m.neo_hookean.validate();
+      m.given_as = "mu, lambda";
+    }
+  } catch (const InputError& e) {
+    r.problem(ProblemKind::kOutOfRange, law, what + ": " + e.what());
+    return false;
+  }
+  return true;
+}
+
+// The transversely isotropic law ({E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f,
+// lambda}; always the compressible form), as read_neo_hookean().
+bool read_transversely_isotropic(Reader& r, const std::string& what, const YAML::Node& law, const YAML::Node& p,
+                                 CaseMaterial& m) {
+  const std::string lw = what + " transversely_isotropic";
+  m.kind = CaseMaterial::Kind::kTransverselyIsotropic;
+  if (!r.mapping(p, lw, {"mu_T", "mu_L", "kappa_f", "lambda", "E_f", "E_T", "G_L", "G_T"})) return false;
+  const bool engineering = p["E_f"].IsDefined() || p["E_T"].IsDefined() || p["G_L"].IsDefined() ||
+                           p["G_T"].IsDefined();
+  const bool direct = p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() ||
+                      p["lambda"].IsDefined();
+  if (engineering == direct) {
+    r.problem(ProblemKind::kWrongType, law, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
+    return false;
+  }
+  try {
+    if (engineering) {
+      TransverselyIsotropicEngineering e;
+      const auto Ef = r.number(r.required(p, "E_f", lw), lw + " E_f");
+      const auto Et = r.number(r.required(p, "E_T", lw), lw + " E_T");
+      const auto Gl = r.number(r.required(p, "G_L", lw), lw + " G_L");
+      const auto Gt = r.number(r.required(p, "G_T", lw), lw + " G_T");
+      if (!Ef || !Et || !Gl || !Gt) return false;
+      e.E_f = *Ef;
+      e.E_T = *Et;
+      e.G_L = *Gl;
+      e.G_T = *Gt;
+      e.incompressible = false;
+      m.ti = e.to_params();
+      m.given_as = "E_f, E_T, G_L, G_T";
+    } else {
+      const auto mt = r.number(r.required(p, "mu_T", lw), lw + " mu_T");
+      const auto ml = r.number(r.required(p, "mu_L", lw), lw + " mu_L");
+      const auto kf = r.number(r.required(p, "kappa_f", lw), lw + " kappa_f");
+      const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
+      if (!mt || !ml || !kf || !la) return false;
+      m.ti.mu_T = *mt;
+      m.ti.mu_L = *ml;
+      m.ti.kappa_f = *kf;
+      m.ti.lambda = *la;
+      m.ti.incompressible = false;
+      m.ti.validate();
+      m.given_as = "mu_T, mu_L, kappa_f, lambda";
+    }
+  } catch (const InputError& e) {
+    r.problem(ProblemKind::kOutOfRange, law, what + ": " + e.what());
+    return false;
+  }
+  return true;
+}
+
 void read_material(Reader& r, const std::string& name, const YAML::Node& key, const YAML::Node& body,
                    FormingCase& spec) {
   const std::string what = "material '" + name + "'";
@@ -167,7 +255,8 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
       (std::string(flag) == "incompressible" ? m.incompressible : m.inextensible) = *v;
   }
   if (body.size() != extras + 1) {
-    r.problem(ProblemKind::kWrongType, key, what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
+    r.problem(ProblemKind::kWrongType, key,
+              what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
     return;
   }
   auto law = body.begin();
@@ -175,85 +264,14 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
     ++law;
   if (law == body.end()) return;
   if (m.inextensible && law->first.Scalar() == "neo_hookean")
-    r.problem(ProblemKind::kUnsupported, body["inextensible"], what + ": inextensible needs fibres (a transversely_isotropic law)");
+    r.problem(ProblemKind::kUnsupported, body["inextensible"],
+              what + ": inextensible needs fibres (a transversely_isotropic law)");
   const std::string law_name = law->first.Scalar();
   const YAML::Node p = law->second;
   if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
-  const std::string lw = what + " " + law_name;
-  if (law_name == "neo_hookean") {
-    m.kind = CaseMaterial::Kind::kNeoHookean;
-    if (!r.mapping(p, lw, {"E", "nu", "mu", "lambda"})) return;
-    const bool young = p["E"].IsDefined() || p["nu"].IsDefined();
-    const bool lame = p["mu"].IsDefined() || p["lambda"].IsDefined();
-    if (young == lame) {
-      r.problem(ProblemKind::kWrongType, law->first, lw + ": give either {E, nu} or {mu, lambda}");
-      return;
-    }
-    try {
-      if (young) {
-        const auto E = r.number(r.required(p, "E", lw), lw + " E");
-        const auto nu = r.number(r.required(p, "nu", lw), lw + " nu");
-        if (!E || !nu) return;
-        m.neo_hookean = NeoHookeanParams::from_young_poisson(*E, *nu);
-        m.given_as = "E, nu";
-      } else {
-        const auto mu = r.number(r.required(p, "mu", lw), lw + " mu");
-        const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
-        if (!mu || !la) return;
-        m.neo_hookean = NeoHookeanParams{*mu, *la};
-        m.neo_hookean.validate();
-        m.given_as = "mu, lambda";
-      }
-    } catch (const InputError& e) {
-      r.problem(ProblemKind::kOutOfRange, law->first, what + ": " + e.what());
-      return;
-    }
-  } else {  // transversely_isotropic (the mapping check rejected anything else)
-    m.kind = CaseMaterial::Kind::kTransverselyIsotropic;
-    if (!r.mapping(p, lw, {"mu_T", "mu_L", "kappa_f", "lambda", "E_f", "E_T", "G_L", "G_T"})) return;
-    const bool engineering = p["E_f"].IsDefined() || p["E_T"].IsDefined() || p["G_L"].IsDefined() ||
-                             p["G_T"].IsDefined();
-    const bool direct = p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() ||
-                        p["lambda"].IsDefined();
-    if (engineering == direct) {
-      r.problem(ProblemKind::kWrongType, law->first, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
-      return;
-    }
-    try {
-      if (engineering) {
-        TransverselyIsotropicEngineering e;
-        const auto Ef = r.number(r.required(p, "E_f", lw), lw + " E_f");
-        const auto Et = r.number(r.required(p, "E_T", lw), lw + " E_T");
-        const auto Gl = r.number(r.required(p, "G_L", lw), lw + " G_L");
-        const auto Gt = r.number(r.required(p, "G_T", lw), lw + " G_T");
-        if (!Ef || !Et || !Gl || !Gt) return;
-        e.E_f = *Ef;
-        e.E_T = *Et;
-        e.G_L = *Gl;
-        e.G_T = *Gt;
-        e.incompressible = false;
-        m.ti = e.to_params();
-        m.given_as = "E_f, E_T, G_L, G_T";
-      } else {
-        const auto mt = r.number(r.required(p, "mu_T", lw), lw + " mu_T");
-        const auto ml = r.number(r.required(p, "mu_L", lw), lw + " mu_L");
-        const auto kf = r.number(r.required(p, "kappa_f", lw), lw + " kappa_f");
-        const auto la = r.number(r.required(p, "lambda", lw), lw + " lambda");
-        if (!mt || !ml || !kf || !la) return;
-        m.ti.mu_T = *mt;
-        m.ti.mu_L = *ml;
-        m.ti.kappa_f = *kf;
-        m.ti.lambda = *la;
-        m.ti.incompressible = false;
-        m.ti.validate();
-        m.given_as = "mu_T, mu_L, kappa_f, lambda";
-      }
-    } catch (const InputError& e) {
-      r.problem(ProblemKind::kOutOfRange, law->first, what + ": " + e.what());
-      return;
-    }
-  }
-  spec.materials.push_back(m);
+  const bool ok = law_name == "neo_hookean" ? read_neo_hookean(r, what, law->first, p, m)
+                                            : read_transversely_isotropic(r, what, law->first, p, m);
+  if (ok) spec.materials.push_back(m);
 }
 
 // [a, b] of positive numbers, or [n1, n2] of integers.
@@ -318,8 +336,8 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
       for (std::size_t i = 0; i < spec.materials.size(); ++i)
         if (spec.materials[i].name == *name) ply.material_index = static_cast<int>(i);
       if (ply.material_index < 0) {
-        r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + *name + "' (not defined under materials)",
-                  *name);
+        r.problem(ProblemKind::kUnknownMaterial, m,
+                  what + ": unknown material '" + *name + "' (not defined under materials)", *name);
         ok = false;
       }
     } else ok = false;
@@ -336,8 +354,9 @@ std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string
     if (s == "y1") return PlySide::kY1;
     if (allow_bottom && s == "bottom") return PlySide::kBottom;
   }
-  r.problem(ProblemKind::kWrongType, n, what + ": expected " + std::string(allow_bottom ? "x0, x1, y0, y1 or bottom" : "x0, x1, y0 or y1") +
-                   ", found " + describe(n));
+  r.problem(ProblemKind::kWrongType, n,
+            what + ": expected " + std::string(allow_bottom ? "x0, x1, y0, y1 or bottom" : "x0, x1, y0 or y1") +
+                ", found " + describe(n));
   return std::nullopt;
 }
 
@@ -409,7 +428,8 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     const YAML::Node v = r.required(b, "value", bw);
     if (v.IsDefined()) {
       if (!v.IsSequence() || v.size() != 3) {
-        r.problem(ProblemKind::kWrongType, v, bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
+        r.problem(ProblemKind::kWrongType, v,
+                  bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
         ok = false;
       } else {
         int given = 0;
@@ -443,12 +463,95 @@ std::optional<Vec3> vector3(Reader& r, const YAML::Node& n, const std::string& w
   return v;
 }
 
+// The keys of each load kind (the ply is read before); false (with problems) when one
+// is missing or bad.
+bool read_pressure(Reader& r, const YAML::Node& b, const std::string& lw, CaseLoad& load) {
+  bool ok = true;
+  if (const YAML::Node f = r.required(b, "face", lw); f.IsDefined()) {
+    if (f.IsScalar() && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
+      load.top = f.Scalar() == "top";
+    } else {
+      r.problem(ProblemKind::kWrongType, f, lw + " face: expected top or bottom, found " + describe(f));
+      ok = false;
+    }
+  } else ok = false;
+  if (const YAML::Node v = r.required(b, "value", lw); v.IsDefined()) {
+    if (const auto p = r.number(v, lw + " value (MPa)")) load.value = *p; else ok = false;
+  } else ok = false;
+  if (b["follower"].IsDefined()) {
+    if (const auto f = r.boolean(b["follower"], lw + " follower")) load.follower = *f; else ok = false;
+  }
+  return ok;
+}
+
+// Gravity also needs every material's density (reported at the load's key).
+bool read_gravity(Reader& r, const YAML::Node& b, const YAML::Node& key, const std::string& lw,
+                  const FormingCase& spec, CaseLoad& load) {
+  bool ok = true;
+  const YAML::Node a = b["acceleration"];
+  if (a.IsDefined()) {
+    if (const auto g = vector3(r, a, lw + " acceleration", "mm/s^2")) load.vector = *g; else ok = false;
+  } else {
+    load.vector = Vec3(0.0, 0.0, -9810.0);
+  }
+  for (const CaseMaterial& m : spec.materials)
+    if (!(m.density > 0.0)) {
+      r.problem(ProblemKind::kMissing, key,
+                lw + ": material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
+      ok = false;
+    }
+  return ok;
+}
+
+bool read_edge_force(Reader& r, const YAML::Node& b, const std::string& lw, CaseLoad& load) {
+  bool ok = true;
+  if (const YAML::Node e = r.required(b, "edge", lw); e.IsDefined()) {
+    if (const auto side = side_of(r, e, lw + " edge", false)) load.side = *side; else ok = false;
+  } else ok = false;
+  if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
+    if (const auto v = vector3(r, f, lw + " force", "N, total over the edge")) load.vector = *v; else ok = false;
+  } else ok = false;
+  return ok;
+}
+
+// The node must lie on the ply's grid (0..elements each way).
+bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, const FormingCase& spec,
+                      CaseLoad& load) {
+  bool ok = true;
+  if (const YAML::Node nd = r.required(b, "node", lw); nd.IsDefined()) {
+    if (pair_of(r, nd, lw + " node [i, j]")) {
+      const int ply = load.ply_index;
+      const int n1 = ply >= 0 ? spec.plies[ply].n1 : 1000, n2 = ply >= 0 ? spec.plies[ply].n2 : 1000;
+      const auto i = r.integer(nd[0], lw + " node i (0 at x0 .. elements along x)", 0, n1);
+      const auto j = r.integer(nd[1], lw + " node j (0 at y0 .. elements along y)", 0, n2);
+      if (i && j) {
+        load.node_i = *i;
+        load.node_j = *j;
+      } else ok = false;
+    } else ok = false;
+  } else ok = false;
+  if (const YAML::Node l = b["layer"]; l.IsDefined()) {
+    if (l.IsScalar() && l.Scalar() == "bottom") load.layer = 0;
+    else if (l.IsScalar() && l.Scalar() == "top") load.layer = 1;
+    else if (l.IsScalar() && l.Scalar() == "both") load.layer = -1;
+    else {
+      r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
+      ok = false;
+    }
+  }
+  if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
+    if (const auto v = vector3(r, f, lw + " force", "N")) load.vector = *v; else ok = false;
+  } else ok = false;
+  return ok;
+}
+
 void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   const std::string what = "load " + std::to_string(index + 1);
   const std::vector<std::string> kinds = {"pressure", "gravity", "edge_force", "point_force"};
   if (!r.mapping(n, what, kinds)) return;
   if (n.size() != 1) {
-    r.problem(ProblemKind::kWrongType, n, what + ": expected exactly one of pressure, gravity, edge_force, point_force");
+    r.problem(ProblemKind::kWrongType, n,
+              what + ": expected exactly one of pressure, gravity, edge_force, point_force");
     return;
   }
   const auto kv = n.begin();
@@ -475,73 +578,10 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   if (!r.mapping(b, lw, keys)) return;
   bool ok = load.kind == CaseLoad::Kind::kGravity || ply_of(r, b, lw, spec, load.ply, load.ply_index);
   switch (load.kind) {
-    case CaseLoad::Kind::kPressure: {
-      if (const YAML::Node f = r.required(b, "face", lw); f.IsDefined()) {
-        if (f.IsScalar() && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
-          load.top = f.Scalar() == "top";
-        } else {
-          r.problem(ProblemKind::kWrongType, f, lw + " face: expected top or bottom, found " + describe(f));
-          ok = false;
-        }
-      } else ok = false;
-      if (const YAML::Node v = r.required(b, "value", lw); v.IsDefined()) {
-        if (const auto p = r.number(v, lw + " value (MPa)")) load.value = *p; else ok = false;
-      } else ok = false;
-      if (b["follower"].IsDefined()) {
-        if (const auto f = r.boolean(b["follower"], lw + " follower")) load.follower = *f; else ok = false;
-      }
-      break;
-    }
-    case CaseLoad::Kind::kGravity: {
-      const YAML::Node a = b["acceleration"];
-      if (a.IsDefined()) {
-        if (const auto g = vector3(r, a, lw + " acceleration", "mm/s^2")) load.vector = *g; else ok = false;
-      } else {
-        load.vector = Vec3(0.0, 0.0, -9810.0);
-      }
-      for (const CaseMaterial& m : spec.materials)
-        if (!(m.density > 0.0)) {
-          r.problem(ProblemKind::kMissing, kv->first, lw + ": material '" + m.name + "' has no density (t/mm^3, e.g. density: 1.5e-9)");
-          ok = false;
-        }
-      break;
-    }
-    case CaseLoad::Kind::kEdgeForce: {
-      if (const YAML::Node e = r.required(b, "edge", lw); e.IsDefined()) {
-        if (const auto side = side_of(r, e, lw + " edge", false)) load.side = *side; else ok = false;
-      } else ok = false;
-      if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-        if (const auto v = vector3(r, f, lw + " force", "N, total over the edge")) load.vector = *v; else ok = false;
-      } else ok = false;
-      break;
-    }
-    case CaseLoad::Kind::kPointForce: {
-      if (const YAML::Node nd = r.required(b, "node", lw); nd.IsDefined()) {
-        if (pair_of(r, nd, lw + " node [i, j]")) {
-          const int ply = load.ply_index;
-          const int n1 = ply >= 0 ? spec.plies[ply].n1 : 1000, n2 = ply >= 0 ? spec.plies[ply].n2 : 1000;
-          const auto i = r.integer(nd[0], lw + " node i (0 at x0 .. elements along x)", 0, n1);
-          const auto j = r.integer(nd[1], lw + " node j (0 at y0 .. elements along y)", 0, n2);
-          if (i && j) {
-            load.node_i = *i;
-            load.node_j = *j;
-          } else ok = false;
-        } else ok = false;
-      } else ok = false;
-      if (const YAML::Node l = b["layer"]; l.IsDefined()) {
-        if (l.IsScalar() && l.Scalar() == "bottom") load.layer = 0;
-        else if (l.IsScalar() && l.Scalar() == "top") load.layer = 1;
-        else if (l.IsScalar() && l.Scalar() == "both") load.layer = -1;
-        else {
-          r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
-          ok = false;
-        }
-      }
-      if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-        if (const auto v = vector3(r, f, lw + " force", "N")) load.vector = *v; else ok = false;
-      } else ok = false;
-      break;
-    }
+    case CaseLoad::Kind::kPressure: ok = read_pressure(r, b, lw, load) && ok; break;
+    case CaseLoad::Kind::kGravity: ok = read_gravity(r, b, kv->first, lw, spec, load) && ok; break;
+    case CaseLoad::Kind::kEdgeForce: ok = read_edge_force(r, b, lw, load) && ok; break;
+    case CaseLoad::Kind::kPointForce: ok = read_point_force(r, b, lw, spec, load) && ok; break;
   }
   if (!ramp_of(r, b, lw, load.ramp)) ok = false;
   if (ok) spec.loads.push_back(load);
@@ -564,13 +604,16 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (arc) {
     const YAML::Node a = n["arc_length"];
     if (!a.IsDefined())
-      r.problem(ProblemKind::kMissing, n["control"], "solver control arc_length: give arc_length (the path length per step, mm)");
+      r.problem(ProblemKind::kMissing, n["control"],
+                "solver control arc_length: give arc_length (the path length per step, mm)");
     else if (const auto v = r.positive(a, "solver arc_length", "mm")) s.arc_length = *v;
     if (n["stop_displacement"].IsDefined())
       if (const auto v = r.positive(n["stop_displacement"], "solver stop_displacement", "mm")) s.stop_displacement = *v;
   } else {
     for (const char* key : {"arc_length", "stop_displacement"})
-      if (n[key].IsDefined()) r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with control: arc_length");
+      if (n[key].IsDefined())
+        r.problem(ProblemKind::kUnsupported, n[key],
+                  std::string("solver ") + key + ": only used with control: arc_length");
   }
   if (const YAML::Node a = n["analysis"]; a.IsDefined()) {
     if (a.IsScalar() && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
@@ -586,22 +629,26 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (i.IsScalar() && (i.Scalar() == "generalized-alpha" || i.Scalar() == "hht-alpha" || i.Scalar() == "newmark"))
       s.integrator = i.Scalar();
     else
-      r.problem(ProblemKind::kWrongType, i, "solver integrator: expected generalized-alpha, hht-alpha or newmark, found " + describe(i));
+      r.problem(ProblemKind::kWrongType, i,
+                "solver integrator: expected generalized-alpha, hht-alpha or newmark, found " + describe(i));
   }
   if (n["rho_inf"].IsDefined()) {
     const auto v = r.number(n["rho_inf"], "solver rho_inf");
     if (v && !(*v >= 0.0 && *v <= 1.0))
-      r.problem(ProblemKind::kOutOfRange, n["rho_inf"], "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
+      r.problem(ProblemKind::kOutOfRange, n["rho_inf"],
+                "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
     else if (v) s.rho_inf = *v;
   }
   for (const char* key : {"end_time", "time_step", "integrator", "rho_inf"})
     if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !n["analysis"].IsScalar()))
-      r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
+      r.problem(ProblemKind::kUnsupported, n[key],
+                std::string("solver ") + key + ": only used with analysis: dynamic");
   if (n["constraint_tolerance"].IsDefined()) {
     const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
     if (v && !(*v > 0.0 && *v < 0.1))
-      r.problem(ProblemKind::kOutOfRange, n["constraint_tolerance"], "solver constraint_tolerance: expected a value in (0, 0.1), found " +
-                                               n["constraint_tolerance"].Scalar());
+      r.problem(ProblemKind::kOutOfRange, n["constraint_tolerance"],
+                "solver constraint_tolerance: expected a value in (0, 0.1), found " +
+                    n["constraint_tolerance"].Scalar());
     else if (v) s.constraint_tolerance = *v;
   }
   if (n["steps"].IsDefined())
@@ -611,8 +658,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (n["tolerance"].IsDefined()) {
     const auto v = r.number(n["tolerance"], "solver tolerance");
     if (v && (*v <= 0.0 || *v >= 1.0))
-      r.problem(ProblemKind::kOutOfRange, n["tolerance"], "solver tolerance: expected a relative residual in (0, 1), found " +
-                                    n["tolerance"].Scalar());
+      r.problem(ProblemKind::kOutOfRange, n["tolerance"],
+                "solver tolerance: expected a relative residual in (0, 1), found " + n["tolerance"].Scalar());
     else if (v) s.tolerance = *v;
   }
   if (n["line_search"].IsDefined())
@@ -620,8 +667,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (n["min_increment"].IsDefined()) {
     const auto v = r.number(n["min_increment"], "solver min_increment");
     if (v && !(*v > 0.0 && *v <= 1.0))
-      r.problem(ProblemKind::kOutOfRange, n["min_increment"], "solver min_increment: expected a fraction of a step in (0, 1], found " +
-                                        n["min_increment"].Scalar());
+      r.problem(ProblemKind::kOutOfRange, n["min_increment"],
+                "solver min_increment: expected a fraction of a step in (0, 1], found " + n["min_increment"].Scalar());
     else if (v) s.min_increment = *v;
   }
 }
@@ -650,7 +697,8 @@ void drop_unknown_names(std::vector<CaseProblem>& problems, std::size_t from, Pr
 
 void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::vector<CaseProblem>& problems) {
   if (!root.IsDefined() || root.IsNull()) {
-    r.problem(ProblemKind::kMissing, SourcePlace{1, 1}, "empty case file: expected materials, plies, boundary_conditions");
+    r.problem(ProblemKind::kMissing, SourcePlace{1, 1},
+              "empty case file: expected materials, plies, boundary_conditions");
     return;
   }
   if (!r.mapping(root, "case", kTopKeys)) return;
@@ -660,8 +708,9 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
   }
   if (const YAML::Node ms = r.required(root, "materials", "case"); ms.IsDefined()) {
     if (!ms.IsMap()) {
-      r.problem(ProblemKind::kWrongType, ms, "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
-                        describe(ms));
+      r.problem(ProblemKind::kWrongType, ms,
+                "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
+                    describe(ms));
     } else {
       std::set<std::string> seen;
       for (auto it = ms.begin(); it != ms.end(); ++it) {
@@ -701,7 +750,8 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
   };
   if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
     if (!bs.IsSequence() || bs.size() == 0) {
-      r.problem(ProblemKind::kWrongType, bs, "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
+      r.problem(ProblemKind::kWrongType, bs,
+                "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
     } else {
       for (std::size_t i = 0; i < bs.size(); ++i) {
         const std::size_t before = problems.size();

@@ -164,6 +164,51 @@ TEST(FormingCase, ConflictingConditionsAreReported) {
   EXPECT_THAT(c.located(0), ::testing::MatchesRegex("conflict.yaml:12:[0-9]+: clamp on x1 .*displacement on x1.*"));
 }
 
+// Problems are data: a kind, a place and the name referred to. A reference to
+// something defined but itself bad is not reported again as unknown (compared by kind
+// and name, not by message text); a reference to something undefined is.
+TEST(FormingCase, ProblemsCarryKindPlaceAndName) {
+  const std::string text =
+      "materials:\n"                                                                        // 1
+      "  bad: {neo_hookean: {E: -1, nu: 0.3}}\n"                                            // 2
+      "plies:\n"                                                                            // 3
+      "  - {name: a, size: [1, 1], thickness: 1, elements: [1, 1], material: bad}\n"        // 4
+      "  - {name: b, size: [1, 1], thickness: oops, elements: [1, 1], material: bad}\n"     // 5
+      "  - {name: c, size: [1, 1], thickness: 1, elements: [1, 1], material: nothing}\n"    // 6
+      "boundary_conditions:\n"                                                              // 7
+      "  - clamp: {ply: b, edge: x0}\n"                                                     // 8
+      "  - clamp: {ply: z, edge: x0}\n";                                                    // 9
+  const CaseCheck c = check_case_text(text, "kinds.yaml");
+  std::vector<std::string> all;
+  for (std::size_t i = 0; i < c.problems.size(); ++i) all.push_back(c.located(i));
+  ASSERT_EQ(c.problems.size(), 4u) << ::testing::PrintToString(all);
+  const std::vector<std::pair<ProblemKind, int>> expected = {{ProblemKind::kOutOfRange, 2},
+                                                             {ProblemKind::kWrongType, 5},
+                                                             {ProblemKind::kUnknownMaterial, 6},
+                                                             {ProblemKind::kUnknownPly, 9}};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(c.problems[i].kind, expected[i].first) << all[i] << " is " << to_string(c.problems[i].kind);
+    EXPECT_EQ(c.problems[i].place.line, expected[i].second) << all[i];
+  }
+  EXPECT_EQ(c.problems[2].name, "nothing");
+  EXPECT_EQ(c.problems[3].name, "z");
+  // The cross-field kinds.
+  std::string conflict = uniaxial_case(0.0, 1.0);
+  conflict.insert(conflict.find("solver:"), "  - clamp: {ply: ply, edge: x1}\n");
+  const CaseCheck cc = check_case_text(conflict, "conflict.yaml");
+  ASSERT_EQ(cc.problems.size(), 1u);
+  EXPECT_EQ(cc.problems[0].kind, ProblemKind::kConflict);
+  const CaseCheck free = check_case_text(
+      "materials: {m: {neo_hookean: {mu: 1, lambda: 2}}}\n"
+      "plies: [{name: p, size: [1, 1], thickness: 1, elements: [1, 1], material: m}]\n"
+      "boundary_conditions: [{displacement: {ply: p, edge: x1, value: [1, ~, ~]}}]\n"
+      "solver: {control: arc_length, arc_length: 1}\n",
+      "free.yaml");
+  std::vector<ProblemKind> kinds;
+  for (const CaseProblem& p : free.problems) kinds.push_back(p.kind);
+  EXPECT_THAT(kinds, ::testing::UnorderedElementsAre(ProblemKind::kUnsupported, ProblemKind::kMissing));
+}
+
 TEST(FormingCase, SampleCasesCheckClean) {
   int n = 0;
   for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(SF_SOURCE_DIR) / "data/forming")) {

@@ -11,8 +11,9 @@
 //   x         current positions of all bodies, n_dofs (mm), Model numbering;
 //   velocity  dx/dt, n_dofs (mm/s), where the solver has one (dynamic runs: at the
 //             generalised-alpha point), else null;
-//   time      s in dynamic runs; the load factor in quasi-static runs (a process time
-//             once the run has one).
+//   time      s in dynamic runs (t_{n+1-af}); 0 in quasi-static solves for now (a tool
+//             moving with the process in a quasi-static run will need the stepper to
+//             pass the step's load factor down: the place for it is this field).
 // What it adds (InteractionSums, added to, never overwritten):
 //   energy    its stored energy, N mm (0 for a dissipative interaction);
 //   force     its force on the dofs with the sign of an internal force: the gradient of
@@ -39,7 +40,7 @@ namespace sf::forming {
 
 // Time and velocities an assembly is evaluated with (positions are passed separately).
 struct InteractionContext {
-  double time = 0.0;               // s (dynamic) or load factor (quasi-static)
+  double time = 0.0;               // s (dynamic); 0 in quasi-static solves
   const VecX* velocity = nullptr;  // n_dofs, mm/s; null where the solver has none
 };
 

@@ -30,11 +30,20 @@ std::vector<Index> PlyGrid::side_surface_nodes(PlySide side) const {
 std::vector<FaceRef> PlyGrid::side_faces(int body, PlySide side) const {
   std::vector<FaceRef> out;
   switch (side) {
-    case PlySide::kX0: for (int j = 0; j < n2; ++j) out.push_back({body, element(0, j), BrickFace::kXi1Min}); break;
-    case PlySide::kX1: for (int j = 0; j < n2; ++j) out.push_back({body, element(n1 - 1, j), BrickFace::kXi1Max}); break;
-    case PlySide::kY0: for (int i = 0; i < n1; ++i) out.push_back({body, element(i, 0), BrickFace::kXi2Min}); break;
-    case PlySide::kY1: for (int i = 0; i < n1; ++i) out.push_back({body, element(i, n2 - 1), BrickFace::kXi2Max}); break;
-    case PlySide::kBottom: break;  // a face, not an edge
+    case PlySide::kX0:
+      for (int j = 0; j < n2; ++j) out.push_back({body, element(0, j), BrickFace::kXi1Min});
+      break;
+    case PlySide::kX1:
+      for (int j = 0; j < n2; ++j) out.push_back({body, element(n1 - 1, j), BrickFace::kXi1Max});
+      break;
+    case PlySide::kY0:
+      for (int i = 0; i < n1; ++i) out.push_back({body, element(i, 0), BrickFace::kXi2Min});
+      break;
+    case PlySide::kY1:
+      for (int i = 0; i < n1; ++i) out.push_back({body, element(i, n2 - 1), BrickFace::kXi2Max});
+      break;
+    case PlySide::kBottom:  // a face, not an edge
+      break;
   }
   return out;
 }

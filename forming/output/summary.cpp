@@ -102,7 +102,8 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
   j["multiplier_updates"] = run.multiplier_updates;
   j["status"] = run.status;
   j["message"] = run.message;
-  j["restart"] = {{"file", "restart.json"}, {"restarted", run.restarted}, {"from_load_factor", run.restart_load_factor}};
+  j["restart"] = {
+      {"file", "restart.json"}, {"restarted", run.restarted}, {"from_load_factor", run.restart_load_factor}};
   j["steps"] = {{"requested", spec.solver.steps}, {"converged", run.steps_converged}, {"written", run.frames.size()}};
   j["load_factor"] = run.load_factor;
   j["final_residual"] = run.final_residual;

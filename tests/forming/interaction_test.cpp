@@ -233,7 +233,8 @@ class MassDamping final : public Interaction {
     sums.force += c_ * (mass_ * *context.velocity);
     if (!sums.damping) return;
     for (int k = 0; k < mass_.outerSize(); ++k)
-      for (linalg::SparseMatrix::InnerIterator it(mass_, k); it; ++it) sums.damping->add(it.row(), it.col(), c_ * it.value());
+      for (linalg::SparseMatrix::InnerIterator it(mass_, k); it; ++it)
+        sums.damping->add(it.row(), it.col(), c_ * it.value());
   }
 
  private:

@@ -77,7 +77,8 @@ NewtonianGrowthRates newtonian_sheet_growth_rates(const Mat2& rate, double visco
 
 double growth_factor(double tau, double fibre_angle_chi, FlowKind kind) {
   const double s = kind == FlowKind::kThickening ? 1.0 : -1.0;
-  return s * std::abs(std::cos(fibre_angle_chi) / std::sin(fibre_angle_chi)) - tau;
+  const double cot = std::abs(std::cos(fibre_angle_chi) / std::sin(fibre_angle_chi));
+  return s * (cot < 1e-12 ? 0.0 : cot) - tau;  // chi = 90 deg: exactly 0, not roundoff
 }
 
 }  // namespace sf::forming::stability

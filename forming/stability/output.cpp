@@ -106,7 +106,7 @@ nlohmann::json summary_json(const StabilityResult& r, const OutputOptions& o, co
   const double diff = std::abs(r.check.growth_rate - r.check_closed_form);
   const double scale = std::max({std::abs(r.check_closed_form), std::abs(s.rate33()),
                                  std::abs(m.resolved_tension) / s.viscosity, 1e-300});
-  j["numerical_check"] = {{"method", "Legendre-Galerkin through the thickness, generalised eigenproblem"},
+  j["numerical_check"] = {{"method", "Legendre-Galerkin through the thickness; eigenvalues of the convected evolution on the admissible displacements"},
                           {"degree", r.scan.spectral_degree},
                           {"wave_direction_deg", m.theta_deg},
                           {"wave_number", r.check_wave_number},

@@ -8,6 +8,7 @@
 #include "common/cli/progress.hpp"
 #include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
+#include "forming/stability/command.hpp"
 
 namespace sf::forming {
 namespace {
@@ -90,6 +91,8 @@ void register_commands(sf::cli::Program& program) {
             ->check(CLI::NonNegativeNumber);
       },
       [args, prog] { return run_run(*args, prog->common().quiet); });
+
+  stability::add_stability_command(program);
 }
 
 }  // namespace sf::forming

@@ -135,3 +135,7 @@ if(TARGET gsa)
     EXISTS ${sf_docs_results}/uniaxial_0/grid.csv
     FIXTURES_SETUP gsa_docs_docs_forming_uniaxial_0_grid_csv)
 endif()
+
+# ---------------------------------------------------------------- simform stability
+
+include(${CMAKE_CURRENT_LIST_DIR}/forming/stability_cli.cmake)

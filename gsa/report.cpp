@@ -8,24 +8,11 @@
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/io/xml_escape.hpp"
 
 namespace sf::gsa {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string number(double v) {
   if (!std::isfinite(v)) return "&ndash;";
@@ -42,13 +29,13 @@ std::string text_of(const nlohmann::json& j) {
   if (j.is_null()) return "&ndash;";
   if (j.is_number()) return number(j.get<double>());
   if (j.is_boolean()) return j.get<bool>() ? "yes" : "no";
-  if (j.is_string()) return escape(j.get<std::string>());
+  if (j.is_string()) return io::xml_escape(j.get<std::string>());
   if (j.is_array()) {
     std::string s;
     for (std::size_t i = 0; i < j.size(); ++i) s += (i ? ", " : "") + text_of(j[i]);
     return s;
   }
-  return escape(j.dump());
+  return io::xml_escape(j.dump());
 }
 
 const nlohmann::json& at(const nlohmann::json& j, std::initializer_list<const char*> path) {
@@ -63,10 +50,10 @@ const nlohmann::json& at(const nlohmann::json& j, std::initializer_list<const ch
 
 struct Table {
   std::ostringstream html;
-  explicit Table(const std::string& title) { html << "<h2>" << escape(title) << "</h2>\n<table>\n"; }
+  explicit Table(const std::string& title) { html << "<h2>" << io::xml_escape(title) << "</h2>\n<table>\n"; }
   void row(const std::string& key, const std::string& value_html) {
     if (value_html.empty() || value_html == "&ndash;") return;
-    html << "<tr><th>" << escape(key) << "</th><td>" << value_html << "</td></tr>\n";
+    html << "<tr><th>" << io::xml_escape(key) << "</th><td>" << value_html << "</td></tr>\n";
   }
   std::string str() { return html.str() + "</table>\n"; }
 };
@@ -100,7 +87,7 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
                   const PlotSummary& plots, const PlotOptions& o) {
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<title>gsa report: " << escape(case_name) << "</title>\n<style>\n"
+    << "<title>gsa report: " << io::xml_escape(case_name) << "</title>\n<style>\n"
     << "body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Arial,sans-serif;margin:0;color:#222;"
        "background:#fafafa}\n"
     << "header{padding:14px 24px;background:#fff;border-bottom:1px solid #ddd}\n"
@@ -117,9 +104,9 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
     << ".files a{margin-right:10px}.warn{color:#a40}\n"
     << "@media (max-width:1000px){.page{flex-direction:column}aside{position:static;flex:none;width:auto}}\n"
     << "</style>\n</head>\n<body>\n";
-  h << "<header><h1>Grid strain analysis: " << escape(case_name) << "</h1>\n<div>"
+  h << "<header><h1>Grid strain analysis: " << io::xml_escape(case_name) << "</h1>\n<div>"
     << text_of(at(s, {"tool"})) << " " << text_of(at(s, {"version"})) << " &middot; pictures in "
-    << escape(measure_name(o.measure)) << " strain &middot; <span class=\"files\">files: "
+    << io::xml_escape(measure_name(o.measure)) << " strain &middot; <span class=\"files\">files: "
     << "<a href=\"strains.csv\">strains.csv</a><a href=\"summary.json\">summary.json</a>";
   if (plots.pictures.size() > 1)
     h << "<a href=\"undeformed.vtp\">undeformed.vtp</a><a href=\"deformed.vtp\">deformed.vtp</a>";
@@ -183,14 +170,14 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
     if (r.is_object()) {
       h << "<h2>Strain ranges at the marks</h2>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
       for (auto it = r.begin(); it != r.end(); ++it)
-        h << "<tr><th>" << escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
+        h << "<tr><th>" << io::xml_escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
           << text_of(at(it.value(), {"max"})) << "</td></tr>\n";
       h << "</table>\n";
     }
   }
   if (plots.flc) {
     Table t("Forming limit");
-    t.row("curve", escape(o.flc_path));
+    t.row("curve", io::xml_escape(o.flc_path));
     t.row("marks beyond the curve", std::to_string(plots.n_beyond_flc) + " of " + std::to_string(plots.n_marks));
     t.row("smallest margin (" + measure_name(o.measure) + " strain)", number(plots.min_flc_margin));
     t.row("per mark", "column <code>flc_margin</code> of strains.csv");
@@ -206,8 +193,8 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
   }
   h << "</aside>\n<main>\n";
   for (const std::string& name : plots.pictures)
-    h << "<figure><a href=\"" << escape(name) << "\"><img src=\"" << escape(name) << "\" alt=\""
-      << escape(caption_of(name, o)) << "\"></a>\n<figcaption>" << escape(caption_of(name, o))
+    h << "<figure><a href=\"" << io::xml_escape(name) << "\"><img src=\"" << io::xml_escape(name) << "\" alt=\""
+      << io::xml_escape(caption_of(name, o)) << "\"></a>\n<figcaption>" << io::xml_escape(caption_of(name, o))
       << "</figcaption></figure>\n";
   if (plots.pictures.size() == 1)
     h << "<p>The triangle method has no fitted surfaces: only the principal strain plot is drawn. "

@@ -50,12 +50,12 @@ int main(int argc, char** argv) {
     const GridData g = read_grid(path);
     const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     AnalyseOptions o;
-    o.elements1 = o.elements2 = elements;  // 0: the automatic mesh
+    o.mesh.elements1 = o.mesh.elements2 = elements;  // 0: the automatic mesh
     AnalysisResult r = analyse(g, o);
     r.times.read = read_s;
     {
       io::AtomicOutputDir out((tmp / "out").string());
-      write_results(out, g, r, o, RunInfo{});
+      write_results(out, g, r, OutputOptions{}, RunInfo{});
       out.commit();
     }
     const auto& t = r.times;

@@ -1,45 +1,31 @@
 #include "gsa/commands.hpp"
 
 #include <CLI/CLI.hpp>
+
 #include <chrono>
-#include <cmath>
-#include <limits>
+#include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <optional>
-#include <iomanip>
 #include <sstream>
 
 #include "common/cli/app.hpp"
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
-#include "common/render/display.hpp"
+#include "common/io/csv.hpp"
 #include "common/io/grid_file.hpp"
+#include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/command_options.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/output.hpp"
 #include "gsa/plots.hpp"
 #include "gsa/synthetic.hpp"
-#include "common/io/csv.hpp"
-#include <filesystem>
-#include <fstream>
 
 namespace sf::gsa {
 
 namespace {
-
-constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
-
-struct AnalyseArgs {
-  std::string grid, undeformed, deformed, out, method = "surface", penalty = "jumps", elements, mesh, columns,
-      delimiter = ",", fibres, units = "mm";
-  double alpha = kUnset, beta = kUnset, gamma = kUnset, delta = kUnset, outlier_sigma = 6.0, smoothing_scale = 1.0;
-  int sample = 0;
-  bool no_plots = false;
-  std::string measure = "true", size = "1200x900", view = "auto", flc;
-  std::string command_line;
-};
 
 // Picture options shared by `analyse` and `plot`; usage errors name the option.
 PlotOptions make_plot_options(const std::string& measure, const std::string& size, const std::string& view,
@@ -66,111 +52,91 @@ void add_plot_options(CLI::App& app, std::string& measure, std::string& size, st
                  "principal strain plot; strains.csv gets flc_margin");
 }
 
-std::vector<double> parse_angles(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--fibres: expected angles in degrees separated by commas (e.g. 0,90), found '" + item + "'");
-    }
+// The grid, from one file or two, with the status lines of reading.
+struct Input {
+  GridData grid;
+  RunInfo info;
+  double read_seconds = 0.0;
+};
+Input read_input(const AnalyseFlags& a, bool quiet) {
+  const GridReadOptions ro = grid_read_options(a);
+  const auto t0 = std::chrono::steady_clock::now();
+  Input in;
+  in.info.command_line = "gsa analyse";
+  if (!a.grid.empty()) {
+    if (!a.undeformed.empty() || !a.deformed.empty())
+      throw UsageError("give either GRID.csv or --undeformed U.csv --deformed D.csv, not both");
+    cli::status(quiet, "gsa: reading " + a.grid);
+    in.grid = read_grid(a.grid, ro);
+    in.info.inputs = {a.grid};
+  } else {
+    if (a.undeformed.empty() || a.deformed.empty())
+      throw UsageError("give GRID.csv, or both --undeformed U.csv and --deformed D.csv");
+    cli::status(quiet, "gsa: reading " + a.undeformed + " and " + a.deformed);
+    in.grid = read_grid_pair(a.undeformed, a.deformed, ro);
+    in.info.inputs = {a.undeformed, a.deformed};
   }
-  return out;
+  in.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return in;
 }
 
-int run_analyse(const AnalyseArgs& a, bool quiet) {
-  AnalyseOptions o;
-  if (a.method == "surface") o.method = Method::kSurface;
-  else if (a.method == "triangles") o.method = Method::kTriangles;
-  else throw UsageError("--method: expected 'surface' or 'triangles', found '" + a.method + "'");
-  if (a.penalty == "third") o.penalty = PenaltyKind::kThirdOrder;
-  else if (a.penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
-  else if (a.penalty == "jumps") o.penalty = PenaltyKind::kJumps;
-  else throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + a.penalty + "'");
-  if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
-  o.mesh_file = a.mesh;
-  if (!a.elements.empty()) {
-    const auto x = a.elements.find('x');
-    try {
-      if (x == std::string::npos) throw std::invalid_argument("x");
-      o.elements1 = std::stoi(a.elements.substr(0, x));
-      o.elements2 = std::stoi(a.elements.substr(x + 1));
-    } catch (const std::exception&) {
-      throw UsageError("--elements: expected NxM (e.g. 8x6), found '" + a.elements + "'");
+// The status line of each stage of the analysis that has one.
+ProgressCallback stage_status_lines(bool quiet) {
+  return [quiet](const StageStart& s) {
+    switch (s.stage) {
+      case AnalysisStage::kUndeformedFit:
+        cli::status(quiet, "gsa: mesh " + s.mesh->layout + " (" + std::to_string(s.mesh->mesh.n_elements()) +
+                               " elements); fitting the undeformed surface");
+        break;
+      case AnalysisStage::kDeformedFit: cli::status(quiet, "gsa: fitting the deformed surface"); break;
+      case AnalysisStage::kSmoothingChoice:
+        cli::status(quiet, "gsa: choosing the smoothing by cross-validation");
+        break;
+      case AnalysisStage::kFrameAndMesh:
+      case AnalysisStage::kStrains: break;
     }
-    if (o.elements1 < 1 || o.elements2 < 1) throw UsageError("--elements: counts must be >= 1");
-  }
-  const std::pair<const char*, double> weights[] = {
-      {"--alpha", a.alpha}, {"--beta", a.beta}, {"--gamma", a.gamma}, {"--delta", a.delta}};
-  for (const auto& [name, value] : weights)
-    if (!std::isnan(value) && !(value >= 0.0))
-      throw UsageError(std::string(name) + ": a smoothing weight must be >= 0, found " + std::to_string(value));
-  if (!std::isnan(a.alpha)) o.alpha = a.alpha;
-  if (!std::isnan(a.beta)) o.beta = a.beta;
-  if (!std::isnan(a.gamma)) o.gamma = a.gamma;
-  if (!std::isnan(a.delta)) o.delta = a.delta;
-  if (!a.fibres.empty()) o.fibre_angles = parse_angles(a.fibres);
-  o.units = a.units;
-  o.outlier_sigma = a.outlier_sigma;
-  o.smoothing_scale = a.smoothing_scale;
-  o.sample = a.sample;
-  o.quiet = quiet;
-  o.validate();
+  };
+}
+
+// "gsa: 441 of 441 points analysed; results in DIR (mesh 7x7, ...)".
+std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out,
+                         const std::string& units, const std::optional<PlotSummary>& plots) {
+  Index ok = 0;
+  for (const auto& p : result.points) ok += p.strain ? 1 : 0;
+  std::ostringstream msg;
+  msg << "gsa: " << ok << " of " << n_points << " points analysed; results in " << out;
+  if (result.method == Method::kSurface)
+    msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements() << " elements; fit RMS residual "
+        << result.rms_undeformed << " / " << result.rms_deformed << " " << units << "; gauge length "
+        << std::setprecision(3) << result.gauge_length << " " << units << ")";
+  if (plots && plots->flc)
+    msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
+  return msg.str();
+}
+
+int run_analyse(const AnalyseFlags& a, bool quiet) {
+  const AnalyseOptions options = analyse_options(a);
+  const OutputOptions output = output_options(a);
   PlotOptions po;
   std::shared_ptr<render::DisplayGuard> display;
   if (!a.no_plots) {
     po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
     display = render::acquire_display();  // no display: fail now, not after the analysis
   }
-
-  GridReadOptions ro;
-  ro.delimiter = parse_delimiter(a.delimiter);
-  if (!a.columns.empty()) ro.columns = parse_column_map(a.columns);
-  const auto t0 = std::chrono::steady_clock::now();
-  GridData grid;
-  RunInfo info;
-  info.command_line = a.command_line;
-  if (!a.grid.empty()) {
-    if (!a.undeformed.empty() || !a.deformed.empty())
-      throw UsageError("give either GRID.csv or --undeformed U.csv --deformed D.csv, not both");
-    cli::status(quiet, "gsa: reading " + a.grid);
-    grid = read_grid(a.grid, ro);
-    info.inputs = {a.grid};
-  } else {
-    if (a.undeformed.empty() || a.deformed.empty())
-      throw UsageError("give GRID.csv, or both --undeformed U.csv and --deformed D.csv");
-    cli::status(quiet, "gsa: reading " + a.undeformed + " and " + a.deformed);
-    grid = read_grid_pair(a.undeformed, a.deformed, ro);
-    info.inputs = {a.undeformed, a.deformed};
-  }
-  const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  cli::status(quiet, "gsa: " + std::to_string(grid.n_points()) + " points; analysing (" + a.method + " method)");
-  AnalysisResult result = analyse(grid, o);
-  result.times.read = read_s;
+  Input in = read_input(a, quiet);
+  cli::status(quiet, "gsa: " + std::to_string(in.grid.n_points()) + " points; analysing (" + a.method + " method)");
+  AnalysisResult result = analyse(in.grid, options, stage_status_lines(quiet));
+  result.times.read = in.read_seconds;
   io::AtomicOutputDir out(a.out);
   cli::status(quiet, "gsa: writing results");
-  write_results(out, grid, result, o, info);
+  write_results(out, in.grid, result, output, in.info);
   std::optional<PlotSummary> plots;
   if (!a.no_plots) {
     cli::status(quiet, "gsa: drawing pictures");
     plots = write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
   }
   out.commit();
-  Index ok = 0;
-  for (const auto& p : result.points) ok += p.strain ? 1 : 0;
-  std::ostringstream msg;
-  msg << "gsa: " << ok << " of " << grid.n_points() << " points analysed; results in " << a.out;
-  if (result.method == Method::kSurface)
-    msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements()
-        << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
-        << "; gauge length " << std::setprecision(3) << result.gauge_length << " " << o.units << ")";
-  if (plots && plots->flc)
-    msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
-  cli::status(quiet, msg.str());
+  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, plots));
   return cli::kExitOk;
 }
 
@@ -234,11 +200,10 @@ int run_synth(const SynthArgs& a, bool quiet) {
   return cli::kExitOk;
 }
 
-}  // namespace
 
-void register_commands(sf::cli::Program& program) {
-  auto args = std::make_shared<AnalyseArgs>();
+void add_analyse_command(sf::cli::Program& program) {
   const sf::cli::Program* prog = &program;
+  auto args = std::make_shared<AnalyseFlags>();
   program.add_command(
       "analyse", "Grid strain analysis of a digitised part (surface fit or classical triangles)",
       [args](CLI::App& app) {
@@ -264,10 +229,11 @@ void register_commands(sf::cli::Program& program) {
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);
       },
-      [args, prog] {
-        args->command_line = "gsa analyse";
-        return run_analyse(*args, prog->common().quiet);
-      });
+      [args, prog] { return run_analyse(*args, prog->common().quiet); });
+}
+
+void add_plot_command(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
   auto plot = std::make_shared<PlotArgs>();
   program.add_command(
       "plot", "Redraw the pictures and report.html of a results folder (other measure, size, view, FLC)",
@@ -276,6 +242,10 @@ void register_commands(sf::cli::Program& program) {
         add_plot_options(app, plot->measure, plot->size, plot->view, plot->flc);
       },
       [plot, prog] { return run_plot(*plot, prog->common().quiet); });
+}
+
+void add_synth_command(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
   auto synth = std::make_shared<SynthArgs>();
   program.add_command(
       "synth", "Write a synthetic grid file from an analytic deformation with exact strains",
@@ -292,6 +262,14 @@ void register_commands(sf::cli::Program& program) {
         app.add_flag("--round", synth->grid.round, "A round blank: only the marks inside the inscribed circle");
       },
       [synth, prog] { return run_synth(*synth, prog->common().quiet); });
+}
+
+}  // namespace
+
+void register_commands(sf::cli::Program& program) {
+  add_analyse_command(program);
+  add_plot_command(program);
+  add_synth_command(program);
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},
       [] {

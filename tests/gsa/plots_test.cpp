@@ -51,7 +51,7 @@ void analyse_case(const std::string& name, const fs::path& dir, int n = 9, std::
   o.fibre_angles = std::move(fibres);
   AnalysisResult r = method == Method::kSurface ? analyse(grid, o) : analyse_triangles(grid, o);
   io::AtomicOutputDir out(dir);
-  write_results(out, grid, r, o, RunInfo{"test", {name}});
+  write_results(out, grid, r, OutputOptions{}, RunInfo{"test", {name}});
   out.commit();
 }
 

@@ -1,12 +1,15 @@
 #include "gsa/command_options.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "common/core/error.hpp"
 #include "common/io/grid_file.hpp"
+#include "common/render/scene.hpp"
+#include "gsa/flc.hpp"
 
 namespace sf::gsa {
 
@@ -101,8 +104,26 @@ OutputOptions output_options(const AnalyseFlags& a) {
   OutputOptions o;
   o.units = a.units;
   o.sample = a.sample;
+  o.measure = parse_measure(a.measure, "--measure");
+  if (!a.flc.empty()) o.flc = read_flc(a.flc);
   validate_for_the_command_line(o);
   return o;
+}
+
+PlotOptions plot_options(const std::string& size, const std::string& view) {
+  PlotOptions o;
+  o.size = render::parse_size(size, "--size");
+  o.view = render::parse_view(view, "--view");
+  return o;
+}
+
+StrainMeasure parse_measure(const std::string& text, const std::string& option) {
+  std::string t = text;
+  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (t == "true" || t == "logarithmic" || t == "natural") return StrainMeasure::kTrue;
+  if (t == "engineering") return StrainMeasure::kEngineering;
+  if (t == "lagrangian" || t == "green") return StrainMeasure::kLagrangian;
+  throw UsageError(option + ": expected true, engineering or lagrangian, found '" + text + "'");
 }
 
 GridReadOptions grid_read_options(const AnalyseFlags& a) {

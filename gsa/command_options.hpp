@@ -11,6 +11,8 @@
 #include "gsa/analysis.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/output.hpp"
+#include "gsa/plots.hpp"
+#include "gsa/strain_measure.hpp"
 
 namespace sf::gsa {
 
@@ -29,8 +31,14 @@ struct AnalyseFlags {
 // --method, --penalty, --mesh/--elements, --alpha.. --delta, --smoothing-scale,
 // --outlier-sigma, --fibres; validated, errors naming the flag.
 AnalyseOptions analyse_options(const AnalyseFlags& flags);
-// --units, --sample; validated, errors naming the flag.
+// --units, --sample, --measure and --flc (the curve is read here: a missing or bad file is
+// an sf::InputError naming it, with or without pictures); validated, errors naming the flag.
 OutputOptions output_options(const AnalyseFlags& flags);
+// --size, --view of the pictures.
+PlotOptions plot_options(const std::string& size, const std::string& view);
+// "true" (also "logarithmic", "natural"), "engineering" or "lagrangian" (also "green"), any
+// letter case; errors name `option`.
+StrainMeasure parse_measure(const std::string& text, const std::string& option = "--measure");
 // --columns, --delimiter.
 GridReadOptions grid_read_options(const AnalyseFlags& flags);
 

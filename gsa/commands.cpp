@@ -19,26 +19,15 @@
 #include "gsa/analysis.hpp"
 #include "gsa/command_options.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/flc.hpp"
 #include "gsa/output.hpp"
 #include "gsa/plots.hpp"
+#include "gsa/results_folder.hpp"
 #include "gsa/synthetic.hpp"
 
 namespace sf::gsa {
 
 namespace {
-
-// Picture options shared by `analyse` and `plot`; usage errors name the option.
-PlotOptions make_plot_options(const std::string& measure, const std::string& size, const std::string& view,
-                              const std::string& flc, bool quiet) {
-  PlotOptions po;
-  po.measure = parse_measure(measure, "--measure");
-  po.size = render::parse_size(size, "--size");
-  po.view = render::parse_view(view, "--view");
-  po.flc_path = flc;
-  po.quiet = quiet;
-  if (!flc.empty()) read_flc(flc);  // bad curve files fail before any work
-  return po;
-}
 
 void add_plot_options(CLI::App& app, std::string& measure, std::string& size, std::string& view,
                       std::string& flc) {
@@ -100,7 +89,7 @@ ProgressCallback stage_status_lines(bool quiet) {
 
 // "gsa: 441 of 441 points analysed; results in DIR (mesh 7x7, ...)".
 std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out,
-                         const std::string& units, const std::optional<PlotSummary>& plots) {
+                         const std::string& units, const std::optional<FlcMargins>& margins) {
   Index ok = 0;
   for (const auto& p : result.points) ok += p.strain ? 1 : 0;
   std::ostringstream msg;
@@ -109,18 +98,29 @@ std::string closing_line(const AnalysisResult& result, Index n_points, const std
     msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements() << " elements; fit RMS residual "
         << result.rms_undeformed << " / " << result.rms_deformed << " " << units << "; gauge length "
         << std::setprecision(3) << result.gauge_length << " " << units << ")";
-  if (plots && plots->flc)
-    msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
+  if (margins)
+    msg << "; " << margins->n_beyond << " of " << margins->n_marks << " marks beyond the forming limit curve";
   return msg.str();
+}
+
+// The progress bar of the pictures (on a terminal, unless quiet).
+PictureProgress picture_bar(bool quiet) {
+  auto bar = std::make_shared<std::unique_ptr<cli::Progress>>();
+  return [bar, quiet](int done, int total) {
+    if (!*bar) *bar = std::make_unique<cli::Progress>("gsa: drawing pictures", total, quiet);
+    (*bar)->update(done);
+    if (done == total) (*bar)->finish();
+  };
 }
 
 int run_analyse(const AnalyseFlags& a, bool quiet) {
   const AnalyseOptions options = analyse_options(a);
-  const OutputOptions output = output_options(a);
+  OutputOptions output = output_options(a);  // reads the forming limit curve, with or without pictures
+  output.keep_surfaces = !a.no_plots;
   PlotOptions po;
   std::shared_ptr<render::DisplayGuard> display;
   if (!a.no_plots) {
-    po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+    po = plot_options(a.size, a.view);
     display = render::acquire_display();  // no display: fail now, not after the analysis
   }
   Input in = read_input(a, quiet);
@@ -129,14 +129,17 @@ int run_analyse(const AnalyseFlags& a, bool quiet) {
   result.times.read = in.read_seconds;
   io::AtomicOutputDir out(a.out);
   cli::status(quiet, "gsa: writing results");
-  write_results(out, in.grid, result, output, in.info);
-  std::optional<PlotSummary> plots;
+  WrittenResults written = write_results(out, in.grid, result, output, in.info);
   if (!a.no_plots) {
     cli::status(quiet, "gsa: drawing pictures");
-    plots = write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
+    PlotData data = plot_data(result, written.summary, std::move(written.undeformed), std::move(written.deformed),
+                              a.out, output.measure);
+    data.flc = output.flc;
+    data.margins = written.margins;
+    write_pictures(data, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
   }
   out.commit();
-  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, plots));
+  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, written.margins));
   return cli::kExitOk;
 }
 
@@ -145,16 +148,20 @@ struct PlotArgs {
 };
 
 int run_plot(const PlotArgs& a, bool quiet) {
-  const PlotOptions po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+  const StrainMeasure measure = parse_measure(a.measure, "--measure");
+  const PlotOptions po = plot_options(a.size, a.view);
+  std::optional<FormingLimitCurve> flc;
+  if (!a.flc.empty()) flc = read_flc(a.flc);  // a bad curve file fails before any work
   if (!std::filesystem::is_directory(a.dir))
     throw InputError(a.dir + ": no such folder; give a results folder written by `gsa analyse`");
   io::AtomicOutputDir out(a.dir);
-  const PlotSummary s = write_pictures(a.dir, [&out](const std::string& name) { return out.path(name); }, po);
+  const Redrawn r = redraw_results_folder(a.dir, measure, flc, po, [&out](const std::string& name) { return out.path(name); },
+                                          picture_bar(quiet));
   out.commit();
   std::ostringstream msg;
-  msg << "gsa: " << s.pictures.size() << " pictures and report.html in " << a.dir;
-  if (s.flc)
-    msg << "; " << s.n_beyond_flc << " of " << s.n_marks << " marks beyond the forming limit curve"
+  msg << "gsa: " << r.pictures.pictures.size() << " pictures and report.html in " << a.dir;
+  if (r.margins)
+    msg << "; " << r.margins->n_beyond << " of " << r.margins->n_marks << " marks beyond the forming limit curve"
         << " (flc_margin in strains.csv)";
   cli::status(quiet, msg.str());
   return cli::kExitOk;

@@ -76,14 +76,16 @@ std::vector<std::string> strain_columns(const AnalysisResult& result) {
 }
 
 void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
-                       const OutputOptions& options) {
+                       const OutputOptions& options, const FlcMargins* margins) {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
       << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
       << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
       << options.units << "); thickness by incompressibility; method " << method_name(result.method) << "\n";
-  const std::vector<std::string> columns = strain_columns(result);
+  if (margins) out << flc_margin_comment(*margins) << "\n";
+  std::vector<std::string> columns = strain_columns(result);
+  if (margins) columns.push_back("flc_margin");
   std::unique_ptr<fe::SurfaceField> fu;
   if (result.method == Method::kSurface) fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
   // Rows [begin, end) as text (formatting numbers is most of the time: large
@@ -112,6 +114,7 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
         }
         w.add(pr.strain ? pr.shear_angle_deg : kNaN);
       }
+      if (margins) w.add(margins->margin[static_cast<std::size_t>(p)]);
       w.end_row();
     }
     return text.str();
@@ -190,7 +193,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   return j;
 }
 
-void write_surface_vtp(const std::string& path, const AnalysisResult& r, bool deformed, int subdiv) {
+io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv) {
   io::PolyMesh pm;
   const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
   const Index ne = r.mesh.n_elements();
@@ -260,7 +263,7 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, bool de
   for (Index e = 0; e < ne; ++e)
     for (int k = 0; k < subdiv * subdiv; ++k) elem.values.push_back(static_cast<double>(e));
   pm.cell_data.push_back(std::move(elem));
-  io::write_vtp(path, pm);
+  return pm;
 }
 
 void write_samples_csv(const std::string& path, const AnalysisResult& r, const OutputOptions& options) {
@@ -285,16 +288,23 @@ void write_samples_csv(const std::string& path, const AnalysisResult& r, const O
       }
 }
 
-void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
-                   const OutputOptions& options, const RunInfo& info) {
+WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
+                             const OutputOptions& options, const RunInfo& info) {
   const auto t0 = std::chrono::steady_clock::now();
+  WrittenResults written;
+  if (options.flc) written.margins = flc_margins(*options.flc, mark_strains(result, options.measure), options.measure);
+  const FlcMargins* margins = written.margins ? &*written.margins : nullptr;
   // The mark table on a second thread while the surfaces are written (independent
   // files and read-only inputs); its exception, if any, is rethrown by get().
-  auto csv = std::async(std::launch::async, [&] { write_strains_csv(out.path("strains.csv"), grid, result, options); });
+  auto csv = std::async(std::launch::async,
+                        [&] { write_strains_csv(out.path("strains.csv"), grid, result, options, margins); });
   try {
     if (result.method == Method::kSurface) {
-      write_surface_vtp(out.path("undeformed.vtp"), result, false);
-      write_surface_vtp(out.path("deformed.vtp"), result, true);
+      for (const bool deformed : {false, true}) {
+        io::PolyMesh surface = surface_polymesh(result, deformed);
+        io::write_vtp(out.path(deformed ? "deformed.vtp" : "undeformed.vtp"), surface);
+        if (options.keep_surfaces) (deformed ? written.deformed : written.undeformed) = std::move(surface);
+      }
       if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
     }
   } catch (...) {
@@ -303,7 +313,9 @@ void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResul
   }
   csv.get();
   result.times.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  io::write_json(out.path("summary.json"), make_summary(grid, result, options, info));
+  written.summary = make_summary(grid, result, options, info);
+  io::write_json(out.path("summary.json"), written.summary);
+  return written;
 }
 
 }  // namespace sf::gsa

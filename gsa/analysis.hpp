@@ -11,7 +11,7 @@
 //   deformed fit       fit_deformed, refit_deformed DeformedFit       gsa/deformed_fit.hpp
 //   smoothing choice   choose_smoothing_gcv         SmoothingChoice   gsa/smoothing.hpp
 //   outliers           detect_outliers, readmit     OutlierFlag       gsa/outliers.hpp
-//   strains            strains_at_marks             MarkStrain        gsa/mark_strains.hpp
+//   strains            strain_at (per mark)         MarkStrain        gsa/mark_strains.hpp
 //
 // analyse() runs them in that order and gathers an AnalysisResult. It never prints:
 // progress goes to a callback as each stage starts.

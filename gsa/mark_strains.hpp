@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/fe/surface_field.hpp"
 #include "common/mesh/surface_mesh.hpp"
 #include "gsa/fit.hpp"
 #include "gsa/strain.hpp"
@@ -26,11 +27,17 @@ struct MarkStrain {
   double shear_angle_deg = std::numeric_limits<double>::quiet_NaN();  // trellis shear of the two families
 };
 
-// Strains at `location` (m) between the surfaces `undeformed` and `deformed` (n_dofs x 3
-// each) on `mesh`, for the marks with wanted[k]; with two fibre angles (degrees from the X
-// axis on the undeformed sheet) also the fibre families and their shear angle.
-std::vector<MarkStrain> strains_at_marks(const mesh::SurfaceMesh& mesh, const MatX& undeformed, const MatX& deformed,
-                                         const std::vector<MeshLocation>& location, const std::vector<bool>& wanted,
-                                         const std::vector<double>& fibre_angles);
+// The two fitted surfaces over the same material coordinates (n_dofs x 3 parameters each).
+struct SurfacePair {
+  SurfacePair(const mesh::SurfaceMesh& mesh, const MatX& undeformed, const MatX& deformed);
+  fe::SurfaceField undeformed, deformed;
+};
+
+// Strains at one material point between the two surfaces; with two fibre angles (degrees
+// from the X axis on the undeformed sheet) also the fibre families and their shear angle.
+// Marks are independent: the caller loops, writing each result where it belongs (a batch
+// would allocate a second large array, and fresh memory costs 0.1 s per 16 MB on a
+// loaded machine).
+MarkStrain strain_at(const SurfacePair& surfaces, const MeshLocation& at, const std::vector<double>& fibre_angles);
 
 }  // namespace sf::gsa

@@ -88,13 +88,12 @@ TEST(GsaStages, OneUndeformedFitServesSeveralDeformedStates) {
     DeformedProblem problem(setup, marks, und, data);
     const DeformedFit fit = fit_deformed(problem, explicit_penalty(uo.smoothing), {}, setup.mark_spacing);
     EXPECT_TRUE(fit.flags.empty());
-    const std::vector<bool> all(static_cast<std::size_t>(marks.size()), true);
-    const std::vector<MarkStrain> strains =
-        strains_at_marks(setup.mesh, und.parameters, fit.fit.parameters, und.location, all, {});
-    for (std::size_t k = 0; k < strains.size(); ++k) {
-      ASSERT_TRUE(strains[k].strain) << "mark " << k;
-      EXPECT_NEAR(strains[k].strain->lambda1, stretches[s].first, kExactStrain) << "mark " << k;
-      EXPECT_NEAR(strains[k].strain->lambda2, stretches[s].second, kExactStrain) << "mark " << k;
+    const SurfacePair surfaces(setup.mesh, und.parameters, fit.fit.parameters);
+    for (std::size_t k = 0; k < und.location.size(); ++k) {
+      const MarkStrain m = strain_at(surfaces, und.location[k], {});
+      ASSERT_TRUE(m.strain) << "mark " << k;
+      EXPECT_NEAR(m.strain->lambda1, stretches[s].first, kExactStrain) << "mark " << k;
+      EXPECT_NEAR(m.strain->lambda2, stretches[s].second, kExactStrain) << "mark " << k;
     }
   }
 }

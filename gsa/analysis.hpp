@@ -10,7 +10,7 @@
 //   undeformed fit     fit_undeformed               UndeformedFit     gsa/undeformed_fit.hpp
 //   deformed fit       fit_deformed, refit_deformed DeformedFit       gsa/deformed_fit.hpp
 //   smoothing choice   choose_smoothing_gcv         SmoothingChoice   gsa/smoothing.hpp
-//   outliers           detect_outliers, readmit     OutlierFlag       gsa/outliers.hpp
+//   outliers           detect_outliers, take_readmitted  OutlierFlag  gsa/outliers.hpp
 //   strains            strain_at (per mark)         MarkStrain        gsa/mark_strains.hpp
 //
 // analyse() runs them in that order and gathers an AnalysisResult. It never prints:

@@ -31,10 +31,10 @@ int main(int argc, char** argv) {
         std::vector<ExactStrain> exact;
         const GridData g = make_synthetic_grid(synthetic_case(name), go, &exact);
         AnalyseOptions o;
-        o.smoothing_scale = scale;
-        if (penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
-        if (penalty == "jumps") o.penalty = PenaltyKind::kJumps;
-        if (penalty == "third") o.penalty = PenaltyKind::kThirdOrder;
+        o.smoothing.scale = scale;
+        if (penalty == "sobolev") o.smoothing.penalty = PenaltyKind::kSobolev;
+        if (penalty == "jumps") o.smoothing.penalty = PenaltyKind::kJumps;
+        if (penalty == "third") o.smoothing.penalty = PenaltyKind::kThirdOrder;
         if (std::string(name) == "trellis") o.fibre_angles = {0, 90};
         const AnalysisResult rs = analyse(g, o);
         o.method = Method::kTriangles;

@@ -10,10 +10,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 
 #include "common/io/atomic_file.hpp"
-#include "common/io/csv.hpp"
+#include "common/io/grid_file.hpp"
 #include "gsa/accuracy.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/grid.hpp"
@@ -46,26 +45,17 @@ int main(int argc, char** argv) {
     const GridData g0 = make_synthetic_grid(synthetic_case("dome"), go, &exact);
     // Write the grid so the read stage is measured on a real file.
     const std::string path = (tmp / "grid.csv").string();
-    {
-      std::ofstream os(path);
-      io::CsvWriter w(os, {"id", "i", "j", "X", "Y", "Z", "x", "y", "z"});
-      for (Index p = 0; p < g0.n_points(); ++p) {
-        w.begin_row().add(g0.ids[p]).add(static_cast<double>(g0.i[p])).add(static_cast<double>(g0.j[p]));
-        for (int k = 0; k < 3; ++k) w.add(g0.undeformed(p, k));
-        for (int k = 0; k < 3; ++k) w.add(g0.deformed(p, k));
-        w.end_row();
-      }
-    }
+    io::write_grid_file(path, g0);
     const auto t0 = std::chrono::steady_clock::now();
     const GridData g = read_grid(path);
     const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     AnalyseOptions o;
-    o.elements1 = o.elements2 = elements;  // 0: the automatic mesh
+    o.mesh.elements1 = o.mesh.elements2 = elements;  // 0: the automatic mesh
     AnalysisResult r = analyse(g, o);
     r.times.read = read_s;
     {
       io::AtomicOutputDir out((tmp / "out").string());
-      write_results(out, g, r, o, RunInfo{});
+      write_results(out, g, r, OutputOptions{}, RunInfo{});
       out.commit();
     }
     const auto& t = r.times;

@@ -2,16 +2,21 @@
 // `gsa analyse`: surface-fit grid strain analysis (BRIEF.md §1) and the classical
 // per-triangle method, from a GridData to per-point strains and fitted surfaces.
 //
-// Pipeline (surface method):
-//  1. frame: best-fit plane of the undeformed marks (PCA); a1 = longest in-plane axis;
-//  2. mesh: a structured bicubic Hermite mesh over the marks' bounding rectangle in
-//     that plane, element count from the number of marks per element (or given);
-//     elements holding no mark are dropped;
-//  3. undeformed fit, alternating with nearest-point projection of the marks until
-//     their xi settle; outliers (residual >> robust noise level) are flagged and left out;
-//  4. deformed fit on the same mesh and xi, smoothing the displacement;
-//  5. strains from the two surfaces' metrics at every mark (and on a sampling).
+// The surface method runs as named stages, each a function with its own inputs and
+// result (docs/theory/strain.md):
+//
+//   stage              function                     result            header
+//   frame and mesh     fit_marks, build_frame_and_mesh  FrameAndMesh  gsa/frame_mesh.hpp
+//   undeformed fit     fit_undeformed               UndeformedFit     gsa/undeformed_fit.hpp
+//   deformed fit       fit_deformed, refit_deformed DeformedFit       gsa/deformed_fit.hpp
+//   smoothing choice   choose_smoothing_gcv         SmoothingChoice   gsa/smoothing.hpp
+//   outliers           detect_outliers, take_readmitted  OutlierFlag  gsa/outliers.hpp
+//   strains            strain_at (per mark)         MarkStrain        gsa/mark_strains.hpp
+//
+// analyse() runs them in that order and gathers an AnalysisResult. It never prints:
+// progress goes to a callback as each stage starts.
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -20,29 +25,28 @@
 #include "common/core/types.hpp"
 #include "common/mesh/surface_mesh.hpp"
 #include "gsa/fit.hpp"
+#include "gsa/frame_mesh.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/mark_strains.hpp"
+#include "gsa/option_error.hpp"
+#include "gsa/outliers.hpp"
 #include "gsa/plane.hpp"
+#include "gsa/smoothing.hpp"
 #include "gsa/strain.hpp"
 
 namespace sf::gsa {
 
 enum class Method { kSurface, kTriangles };
-enum class PenaltyKind { kThirdOrder, kSobolev, kJumps };
-
 
 struct AnalyseOptions {
   Method method = Method::kSurface;
-  PenaltyKind penalty = PenaltyKind::kJumps;
-  int elements1 = 0, elements2 = 0;  // 0 = automatic (--elements NxM)
-  std::string mesh_file;              // --mesh FILE: the user's own mesh (gsa/mesh_file.hpp)
-  std::optional<double> alpha, beta, gamma, delta;  // unset = automatic
-  std::vector<double> fibre_angles;          // degrees from the X axis on the undeformed sheet
-  std::string units = "mm";
-  double smoothing_scale = 1.0;  // multiplies the automatic smoothing weights
-  double outlier_sigma = 6.0;   // residual threshold in robust noise sigmas
-  int max_projection_iterations = 5;
-  int sample = 0;               // >0: also sample fields on sample x sample points per element
-  bool quiet = true;
+  MeshOptions mesh;                   // frame and mesh
+  SmoothingOptions smoothing;         // both fits
+  OutlierOptions outliers;            // both fits
+  int max_projection_iterations = 5;  // undeformed fit
+  std::vector<double> fibre_angles;   // none, or two: degrees from the X axis on the undeformed sheet
+
+  // Throws OptionError naming the field (e.g. "smoothing.scale") for a value out of range.
   void validate() const;
 };
 
@@ -54,11 +58,6 @@ inline constexpr const char* kStatusOutlierUndeformed = "outlier_undeformed";
 inline constexpr const char* kStatusOutlierDeformed = "outlier_deformed";
 inline constexpr const char* kStatusDegenerate = "degenerate";
 inline constexpr const char* kStatusNoTriangle = "no_triangle";
-
-struct FibreResult {
-  Vec3 direction = Vec3::Zero();
-  double stretch = 0.0;
-};
 
 struct PointResult {
   std::string status = kStatusOk;
@@ -77,7 +76,9 @@ struct StageTimes {
 
 struct AnalysisResult {
   Method method = Method::kSurface;
-  std::vector<PointResult> points;
+  std::vector<PointResult> points;   // one per grid point, in grid order
+  std::vector<double> fibre_angles;  // as analysed (degrees)
+  double outlier_sigma = 0.0;        // the outlier threshold used (surface method)
   // Surface method only:
   mesh::SurfaceMesh mesh;
   MatX undeformed_parameters, deformed_parameters;  // n_dofs x 3
@@ -99,7 +100,18 @@ struct AnalysisResult {
   std::vector<std::string> warnings;
 };
 
-AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options);
+enum class AnalysisStage { kFrameAndMesh, kUndeformedFit, kDeformedFit, kSmoothingChoice, kStrains };
+
+// What the progress callback hears as each stage of the surface method starts.
+struct StageStart {
+  AnalysisStage stage = AnalysisStage::kFrameAndMesh;
+  const FrameAndMesh* mesh = nullptr;  // from kUndeformedFit on: the frame and mesh of the fits
+};
+using ProgressCallback = std::function<void(const StageStart&)>;
+
+// Validates the options, then runs the method. Throws sf::InputError naming the file for
+// grids that cannot be analysed (too few marks, marks on a line, a singular fit).
+AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options, const ProgressCallback& progress = {});
 
 // The classical method: triangles of neighbouring marks (grid i, j when every
 // point has them, else a Delaunay triangulation in the best-fit plane), homogeneous

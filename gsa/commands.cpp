@@ -1,56 +1,33 @@
 #include "gsa/commands.hpp"
 
 #include <CLI/CLI.hpp>
+
 #include <chrono>
-#include <cmath>
-#include <limits>
+#include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <optional>
-#include <iomanip>
 #include <sstream>
 
 #include "common/cli/app.hpp"
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/io/csv.hpp"
+#include "common/io/grid_file.hpp"
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/command_options.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/flc.hpp"
 #include "gsa/output.hpp"
 #include "gsa/plots.hpp"
+#include "gsa/results_folder.hpp"
 #include "gsa/synthetic.hpp"
-#include "common/io/csv.hpp"
-#include <filesystem>
-#include <fstream>
 
 namespace sf::gsa {
 
 namespace {
-
-constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
-
-struct AnalyseArgs {
-  std::string grid, undeformed, deformed, out, method = "surface", penalty = "jumps", elements, mesh, columns,
-      delimiter = ",", fibres, units = "mm";
-  double alpha = kUnset, beta = kUnset, gamma = kUnset, delta = kUnset, outlier_sigma = 6.0, smoothing_scale = 1.0;
-  int sample = 0;
-  bool no_plots = false;
-  std::string measure = "true", size = "1200x900", view = "auto", flc;
-  std::string command_line;
-};
-
-// Picture options shared by `analyse` and `plot`; usage errors name the option.
-PlotOptions make_plot_options(const std::string& measure, const std::string& size, const std::string& view,
-                              const std::string& flc, bool quiet) {
-  PlotOptions po;
-  po.measure = parse_measure(measure, "--measure");
-  po.size = render::parse_size(size, "--size");
-  po.view = render::parse_view(view, "--view");
-  po.flc_path = flc;
-  po.quiet = quiet;
-  if (!flc.empty()) read_flc(flc);  // bad curve files fail before any work
-  return po;
-}
 
 void add_plot_options(CLI::App& app, std::string& measure, std::string& size, std::string& view,
                       std::string& flc) {
@@ -64,111 +41,105 @@ void add_plot_options(CLI::App& app, std::string& measure, std::string& size, st
                  "principal strain plot; strains.csv gets flc_margin");
 }
 
-std::vector<double> parse_angles(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--fibres: expected angles in degrees separated by commas (e.g. 0,90), found '" + item + "'");
-    }
-  }
-  return out;
-}
-
-int run_analyse(const AnalyseArgs& a, bool quiet) {
-  AnalyseOptions o;
-  if (a.method == "surface") o.method = Method::kSurface;
-  else if (a.method == "triangles") o.method = Method::kTriangles;
-  else throw UsageError("--method: expected 'surface' or 'triangles', found '" + a.method + "'");
-  if (a.penalty == "third") o.penalty = PenaltyKind::kThirdOrder;
-  else if (a.penalty == "sobolev") o.penalty = PenaltyKind::kSobolev;
-  else if (a.penalty == "jumps") o.penalty = PenaltyKind::kJumps;
-  else throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + a.penalty + "'");
-  if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
-  o.mesh_file = a.mesh;
-  if (!a.elements.empty()) {
-    const auto x = a.elements.find('x');
-    try {
-      if (x == std::string::npos) throw std::invalid_argument("x");
-      o.elements1 = std::stoi(a.elements.substr(0, x));
-      o.elements2 = std::stoi(a.elements.substr(x + 1));
-    } catch (const std::exception&) {
-      throw UsageError("--elements: expected NxM (e.g. 8x6), found '" + a.elements + "'");
-    }
-    if (o.elements1 < 1 || o.elements2 < 1) throw UsageError("--elements: counts must be >= 1");
-  }
-  const std::pair<const char*, double> weights[] = {
-      {"--alpha", a.alpha}, {"--beta", a.beta}, {"--gamma", a.gamma}, {"--delta", a.delta}};
-  for (const auto& [name, value] : weights)
-    if (!std::isnan(value) && !(value >= 0.0))
-      throw UsageError(std::string(name) + ": a smoothing weight must be >= 0, found " + std::to_string(value));
-  if (!std::isnan(a.alpha)) o.alpha = a.alpha;
-  if (!std::isnan(a.beta)) o.beta = a.beta;
-  if (!std::isnan(a.gamma)) o.gamma = a.gamma;
-  if (!std::isnan(a.delta)) o.delta = a.delta;
-  if (!a.fibres.empty()) o.fibre_angles = parse_angles(a.fibres);
-  o.units = a.units;
-  o.outlier_sigma = a.outlier_sigma;
-  o.smoothing_scale = a.smoothing_scale;
-  o.sample = a.sample;
-  o.quiet = quiet;
-  o.validate();
-  PlotOptions po;
-  std::shared_ptr<render::DisplayGuard> display;
-  if (!a.no_plots) {
-    po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
-    display = render::acquire_display();  // no display: fail now, not after the analysis
-  }
-
-  GridReadOptions ro;
-  ro.delimiter = parse_delimiter(a.delimiter);
-  if (!a.columns.empty()) ro.columns = parse_column_map(a.columns);
-  const auto t0 = std::chrono::steady_clock::now();
+// The grid, from one file or two, with the status lines of reading.
+struct Input {
   GridData grid;
   RunInfo info;
-  info.command_line = a.command_line;
+  double read_seconds = 0.0;
+};
+Input read_input(const AnalyseFlags& a, bool quiet) {
+  const GridReadOptions ro = grid_read_options(a);
+  const auto t0 = std::chrono::steady_clock::now();
+  Input in;
+  in.info.command_line = "gsa analyse";
   if (!a.grid.empty()) {
     if (!a.undeformed.empty() || !a.deformed.empty())
       throw UsageError("give either GRID.csv or --undeformed U.csv --deformed D.csv, not both");
     cli::status(quiet, "gsa: reading " + a.grid);
-    grid = read_grid(a.grid, ro);
-    info.inputs = {a.grid};
+    in.grid = read_grid(a.grid, ro);
+    in.info.inputs = {a.grid};
   } else {
     if (a.undeformed.empty() || a.deformed.empty())
       throw UsageError("give GRID.csv, or both --undeformed U.csv and --deformed D.csv");
     cli::status(quiet, "gsa: reading " + a.undeformed + " and " + a.deformed);
-    grid = read_grid_pair(a.undeformed, a.deformed, ro);
-    info.inputs = {a.undeformed, a.deformed};
+    in.grid = read_grid_pair(a.undeformed, a.deformed, ro);
+    in.info.inputs = {a.undeformed, a.deformed};
   }
-  const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  cli::status(quiet, "gsa: " + std::to_string(grid.n_points()) + " points; analysing (" + a.method + " method)");
-  AnalysisResult result = analyse(grid, o);
-  result.times.read = read_s;
-  io::AtomicOutputDir out(a.out);
-  cli::status(quiet, "gsa: writing results");
-  write_results(out, grid, result, o, info);
-  std::optional<PlotSummary> plots;
-  if (!a.no_plots) {
-    cli::status(quiet, "gsa: drawing pictures");
-    plots = write_pictures(out.temp_dir().string(), [&out](const std::string& name) { return out.path(name); }, po);
-  }
-  out.commit();
+  in.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return in;
+}
+
+// The status line of each stage of the analysis that has one.
+ProgressCallback stage_status_lines(bool quiet) {
+  return [quiet](const StageStart& s) {
+    switch (s.stage) {
+      case AnalysisStage::kUndeformedFit:
+        cli::status(quiet, "gsa: mesh " + s.mesh->layout + " (" + std::to_string(s.mesh->mesh.n_elements()) +
+                               " elements); fitting the undeformed surface");
+        break;
+      case AnalysisStage::kDeformedFit: cli::status(quiet, "gsa: fitting the deformed surface"); break;
+      case AnalysisStage::kSmoothingChoice:
+        cli::status(quiet, "gsa: choosing the smoothing by cross-validation");
+        break;
+      case AnalysisStage::kFrameAndMesh:
+      case AnalysisStage::kStrains: break;
+    }
+  };
+}
+
+// "gsa: 441 of 441 points analysed; results in DIR (mesh 7x7, ...)".
+std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out,
+                         const std::string& units, const std::optional<FlcMargins>& margins) {
   Index ok = 0;
   for (const auto& p : result.points) ok += p.strain ? 1 : 0;
   std::ostringstream msg;
-  msg << "gsa: " << ok << " of " << grid.n_points() << " points analysed; results in " << a.out;
+  msg << "gsa: " << ok << " of " << n_points << " points analysed; results in " << out;
   if (result.method == Method::kSurface)
-    msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements()
-        << " elements; fit RMS residual " << result.rms_undeformed << " / " << result.rms_deformed << " " << o.units
-        << "; gauge length " << std::setprecision(3) << result.gauge_length << " " << o.units << ")";
-  if (plots && plots->flc)
-    msg << "; " << plots->n_beyond_flc << " of " << plots->n_marks << " marks beyond the forming limit curve";
-  cli::status(quiet, msg.str());
+    msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements() << " elements; fit RMS residual "
+        << result.rms_undeformed << " / " << result.rms_deformed << " " << units << "; gauge length "
+        << std::setprecision(3) << result.gauge_length << " " << units << ")";
+  if (margins)
+    msg << "; " << margins->n_beyond << " of " << margins->n_marks << " marks beyond the forming limit curve";
+  return msg.str();
+}
+
+// The progress bar of the pictures (on a terminal, unless quiet).
+PictureProgress picture_bar(bool quiet) {
+  auto bar = std::make_shared<std::unique_ptr<cli::Progress>>();
+  return [bar, quiet](int done, int total) {
+    if (!*bar) *bar = std::make_unique<cli::Progress>("gsa: drawing pictures", total, quiet);
+    (*bar)->update(done);
+    if (done == total) (*bar)->finish();
+  };
+}
+
+int run_analyse(const AnalyseFlags& a, bool quiet) {
+  const AnalyseOptions options = analyse_options(a);
+  OutputOptions output = output_options(a);  // reads the forming limit curve, with or without pictures
+  output.keep_surfaces = !a.no_plots;
+  PlotOptions po;
+  std::shared_ptr<render::DisplayGuard> display;
+  if (!a.no_plots) {
+    po = plot_options(a.size, a.view);
+    display = render::acquire_display();  // no display: fail now, not after the analysis
+  }
+  Input in = read_input(a, quiet);
+  cli::status(quiet, "gsa: " + std::to_string(in.grid.n_points()) + " points; analysing (" + a.method + " method)");
+  AnalysisResult result = analyse(in.grid, options, stage_status_lines(quiet));
+  result.times.read = in.read_seconds;
+  io::AtomicOutputDir out(a.out);
+  cli::status(quiet, "gsa: writing results");
+  WrittenResults written = write_results(out, in.grid, result, output, in.info);
+  if (!a.no_plots) {
+    cli::status(quiet, "gsa: drawing pictures");
+    PlotData data = plot_data(result, written.summary, std::move(written.undeformed), std::move(written.deformed),
+                              a.out, output.measure);
+    data.flc = output.flc;
+    data.margins = written.margins;
+    write_pictures(data, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
+  }
+  out.commit();
+  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, written.margins));
   return cli::kExitOk;
 }
 
@@ -177,16 +148,20 @@ struct PlotArgs {
 };
 
 int run_plot(const PlotArgs& a, bool quiet) {
-  const PlotOptions po = make_plot_options(a.measure, a.size, a.view, a.flc, quiet);
+  const StrainMeasure measure = parse_measure(a.measure, "--measure");
+  const PlotOptions po = plot_options(a.size, a.view);
+  std::optional<FormingLimitCurve> flc;
+  if (!a.flc.empty()) flc = read_flc(a.flc);  // a bad curve file fails before any work
   if (!std::filesystem::is_directory(a.dir))
     throw InputError(a.dir + ": no such folder; give a results folder written by `gsa analyse`");
   io::AtomicOutputDir out(a.dir);
-  const PlotSummary s = write_pictures(a.dir, [&out](const std::string& name) { return out.path(name); }, po);
+  const Redrawn r = redraw_results_folder(a.dir, measure, flc, po, [&out](const std::string& name) { return out.path(name); },
+                                          picture_bar(quiet));
   out.commit();
   std::ostringstream msg;
-  msg << "gsa: " << s.pictures.size() << " pictures and report.html in " << a.dir;
-  if (s.flc)
-    msg << "; " << s.n_beyond_flc << " of " << s.n_marks << " marks beyond the forming limit curve"
+  msg << "gsa: " << r.pictures.pictures.size() << " pictures and report.html in " << a.dir;
+  if (r.margins)
+    msg << "; " << r.margins->n_beyond << " of " << r.margins->n_marks << " marks beyond the forming limit curve"
         << " (flc_margin in strains.csv)";
   cli::status(quiet, msg.str());
   return cli::kExitOk;
@@ -208,20 +183,14 @@ int run_synth(const SynthArgs& a, bool quiet) {
     const auto parent = std::filesystem::path(f).parent_path();
     if (!f.empty() && !parent.empty()) std::filesystem::create_directories(parent);
   }
-  io::write_file_atomic(a.out, [&](std::ostream& os) {
-    os << "# synthetic grid '" << c.name << "': " << c.description << "\n";
-    os << "# generated by: gsa synth " << c.name << " --n " << a.grid.n << " --spacing " << a.grid.spacing
-       << " --noise " << a.grid.noise << " --missing " << a.grid.missing_deformed << " --outliers "
-       << a.grid.outliers << " --seed " << a.grid.seed << "\n# units: mm\n";
-    io::CsvWriter w(os, {"id", "X", "Y", "Z", "x", "y", "z", "i", "j"});
-    for (Index p = 0; p < g.n_points(); ++p) {
-      w.begin_row().add(g.ids[p]);
-      for (int k = 0; k < 3; ++k) w.add(g.undeformed(p, k));
-      for (int k = 0; k < 3; ++k) w.add(g.deformed(p, k));
-      w.add(g.i[p]).add(g.j[p]);
-      w.end_row();
-    }
-  });
+  std::ostringstream generated;
+  generated << "generated by: gsa synth " << c.name << " --n " << a.grid.n << " --spacing " << a.grid.spacing
+            << " --noise " << a.grid.noise << " --missing " << a.grid.missing_deformed << " --outliers "
+            << a.grid.outliers << " --seed " << a.grid.seed;
+  io::GridWriteOptions wo;
+  wo.comments = {"synthetic grid '" + c.name + "': " + c.description, generated.str()};
+  wo.units = "mm";
+  io::write_grid_file(a.out, g, wo);
   if (!a.exact.empty()) {
     io::write_file_atomic(a.exact, [&](std::ostream& os) {
       os << "# exact strains of synthetic case '" << c.name << "' at each mark (no noise); E = Green-Lagrange\n";
@@ -238,11 +207,10 @@ int run_synth(const SynthArgs& a, bool quiet) {
   return cli::kExitOk;
 }
 
-}  // namespace
 
-void register_commands(sf::cli::Program& program) {
-  auto args = std::make_shared<AnalyseArgs>();
+void add_analyse_command(sf::cli::Program& program) {
   const sf::cli::Program* prog = &program;
+  auto args = std::make_shared<AnalyseFlags>();
   program.add_command(
       "analyse", "Grid strain analysis of a digitised part (surface fit or classical triangles)",
       [args](CLI::App& app) {
@@ -268,10 +236,11 @@ void register_commands(sf::cli::Program& program) {
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);
       },
-      [args, prog] {
-        args->command_line = "gsa analyse";
-        return run_analyse(*args, prog->common().quiet);
-      });
+      [args, prog] { return run_analyse(*args, prog->common().quiet); });
+}
+
+void add_plot_command(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
   auto plot = std::make_shared<PlotArgs>();
   program.add_command(
       "plot", "Redraw the pictures and report.html of a results folder (other measure, size, view, FLC)",
@@ -280,6 +249,10 @@ void register_commands(sf::cli::Program& program) {
         add_plot_options(app, plot->measure, plot->size, plot->view, plot->flc);
       },
       [plot, prog] { return run_plot(*plot, prog->common().quiet); });
+}
+
+void add_synth_command(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
   auto synth = std::make_shared<SynthArgs>();
   program.add_command(
       "synth", "Write a synthetic grid file from an analytic deformation with exact strains",
@@ -296,6 +269,14 @@ void register_commands(sf::cli::Program& program) {
         app.add_flag("--round", synth->grid.round, "A round blank: only the marks inside the inscribed circle");
       },
       [synth, prog] { return run_synth(*synth, prog->common().quiet); });
+}
+
+}  // namespace
+
+void register_commands(sf::cli::Program& program) {
+  add_analyse_command(program);
+  add_plot_command(program);
+  add_synth_command(program);
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},
       [] {

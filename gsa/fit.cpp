@@ -43,17 +43,6 @@ std::array<double, 2> element_size(const mesh::Element& el) {
   return {h[0] / n[0], h[1] / n[1]};
 }
 
-// Derivative (o1, o2) of the 16 bicubic functions at xi: d^(o1+o2) N / dxi1^o1 dxi2^o2.
-Eigen::Matrix<double, 16, 1> bicubic_derivative(const Vec2& xi, int o1, int o2) {
-  const auto a = basis::cubic_hermite(xi[0], o1);
-  const auto b = basis::cubic_hermite(xi[1], o2);
-  Eigen::Matrix<double, 16, 1> out;
-  for (int n = 0; n < 4; ++n)
-    for (int d = 0; d < 4; ++d)
-      out[4 * n + d] = a[2 * (n & 1) + (d & 1)] * b[2 * (n >> 1) + (d >> 1)];
-  return out;
-}
-
 void add_element_block(linalg::TripletAssembler& asm_, const fe::ElementDofMap& dm,
                        const Eigen::Matrix<double, 16, 16>& ke) {
   const Eigen::MatrixXd kg = dm.t.transpose() * ke * dm.t;
@@ -115,15 +104,15 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
       const Vec2& xi = rule.points[g];
       const double w = rule.weights[g] * area;
       for (const auto& o : first) {
-        const Eigen::Matrix<double, 16, 1> v = bicubic_derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a1.noalias() += (w * o.w) * v * v.transpose();
       }
       for (const auto& o : second) {
-        const Eigen::Matrix<double, 16, 1> v = bicubic_derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a2.noalias() += (w * o.w) * v * v.transpose();
       }
       for (const auto& o : third) {
-        const Eigen::Matrix<double, 16, 1> v = bicubic_derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a3.noalias() += (w * o.w) * v * v.transpose();
       }
     }
@@ -168,8 +157,8 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const double t = line.points[g];
         const double tn_ = nb.reversed ? 1.0 - t : t;
         const Vec2 xe = mesh::edge_point(edge, t), xn = mesh::edge_point(nb.edge, tn_);
-        const Eigen::Matrix<double, 16, 1> ve = bicubic_derivative(xe, dir_e == 0 ? 2 : 0, dir_e == 0 ? 0 : 2) / (he[dir_e] * he[dir_e]);
-        const Eigen::Matrix<double, 16, 1> vn = bicubic_derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
+        const Eigen::Matrix<double, 16, 1> ve = basis::BicubicHermite::derivative(xe, dir_e == 0 ? 2 : 0, dir_e == 0 ? 0 : 2) / (he[dir_e] * he[dir_e]);
+        const Eigen::Matrix<double, 16, 1> vn = basis::BicubicHermite::derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
         const Eigen::VectorXd j = te.transpose() * ve - tn.transpose() * vn;
         kj.noalias() += (line.weights[g] * edge_len / h_normal) * j * j.transpose();
         k4j.noalias() += (w4 * kJumpCurvatureWeight * line.weights[g] * edge_len / (h_normal * h_normal * h_normal)) *
@@ -179,9 +168,9 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const double se = (edge == 1 || edge == 2) ? 1.0 : -1.0;
         const double sn = (nb.edge == 1 || nb.edge == 2) ? -1.0 : 1.0;  // same physical direction
         const Eigen::Matrix<double, 16, 1> we =
-            bicubic_derivative(xe, dir_e == 0 ? 3 : 0, dir_e == 0 ? 0 : 3) * (se / std::pow(he[dir_e], 3));
+            basis::BicubicHermite::derivative(xe, dir_e == 0 ? 3 : 0, dir_e == 0 ? 0 : 3) * (se / std::pow(he[dir_e], 3));
         const Eigen::Matrix<double, 16, 1> wn =
-            bicubic_derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) * (sn / std::pow(hn[dir_n], 3));
+            basis::BicubicHermite::derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) * (sn / std::pow(hn[dir_n], 3));
         const Eigen::VectorXd j3 = te.transpose() * we - tn.transpose() * wn;
         k4j.noalias() += (w4 * line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
       }
@@ -241,7 +230,7 @@ RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
     const MeshLocation& loc = locations[d];
     if (loc.element >= 0) {
       const fe::ElementDofMap& dm = maps[loc.element];
-      const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+      const Eigen::Matrix<double, 16, 1> b = basis::BicubicHermite::derivative(loc.xi, 0, 0);
       const Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 64> row = b.transpose() * dm.t;
       for (int j : ascending[loc.element]) {
         inner[p] = static_cast<int>(dm.dofs[j]);
@@ -309,7 +298,7 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penal
     for (std::size_t d = 0; d < locations.size(); ++d) {
       const MeshLocation& loc = locations[d];
       if (loc.element < 0 || !(s.w[static_cast<Index>(d)] > 0.0)) continue;
-      const Eigen::Matrix<double, 16, 1> b = bicubic_derivative(loc.xi, 0, 0);
+      const Eigen::Matrix<double, 16, 1> b = basis::BicubicHermite::derivative(loc.xi, 0, 0);
       local[loc.element].noalias() += (s.w[static_cast<Index>(d)] * b) * b.transpose();
     }
     return local;

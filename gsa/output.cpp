@@ -57,13 +57,17 @@ nlohmann::json range_of(const std::vector<double>& v) {
 }
 }  // namespace
 
-std::vector<std::string> strain_columns(const AnalyseOptions& options) {
+void OutputOptions::validate() const {
+  if (sample < 0 || sample > 50) throw OptionError("sample", "expected 0..50 points per element side, found " + std::to_string(sample));
+}
+
+std::vector<std::string> strain_columns(const AnalysisResult& result) {
   std::vector<std::string> c = {"id",      "status",  "element", "xi1",    "xi2",    "lambda1", "lambda2",
                                 "E1",      "E2",      "eng1",    "eng2",   "true1",  "true2",
                                 "thickness_change_pct", "dir1_x", "dir1_y", "dir1_z", "dir2_x", "dir2_y",
                                 "dir2_z",  "dir1u_x", "dir1u_y", "dir1u_z", "residual", "residual_undeformed",
                                 "X_fit",   "Y_fit",   "Z_fit"};
-  if (options.fibre_angles.size() == 2) {
+  if (result.fibre_angles.size() == 2) {
     for (const char* f : {"fibre1", "fibre2"})
       for (const char* s : {"_x", "_y", "_z", "_stretch"}) c.push_back(std::string(f) + s);
     c.push_back("shear_angle_deg");
@@ -72,14 +76,16 @@ std::vector<std::string> strain_columns(const AnalyseOptions& options) {
 }
 
 void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
-                       const AnalyseOptions& options) {
+                       const OutputOptions& options, const FlcMargins* margins) {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
       << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
       << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
       << options.units << "); thickness by incompressibility; method " << method_name(result.method) << "\n";
-  const std::vector<std::string> columns = strain_columns(options);
+  if (margins) out << flc_margin_comment(*margins) << "\n";
+  std::vector<std::string> columns = strain_columns(result);
+  if (margins) columns.push_back("flc_margin");
   std::unique_ptr<fe::SurfaceField> fu;
   if (result.method == Method::kSurface) fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
   // Rows [begin, end) as text (formatting numbers is most of the time: large
@@ -99,7 +105,7 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
       Vec3 xf = Vec3::Constant(kNaN);
       if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
       w.add(xf[0]).add(xf[1]).add(xf[2]);
-      if (options.fibre_angles.size() == 2) {
+      if (result.fibre_angles.size() == 2) {
         for (int k = 0; k < 2; ++k) {
           if (pr.fibres.size() == 2 && pr.strain)
             w.add(pr.fibres[k].direction[0]).add(pr.fibres[k].direction[1]).add(pr.fibres[k].direction[2]).add(pr.fibres[k].stretch);
@@ -108,6 +114,7 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
         }
         w.add(pr.strain ? pr.shear_angle_deg : kNaN);
       }
+      if (margins) w.add(margins->margin[static_cast<std::size_t>(p)]);
       w.end_row();
     }
     return text.str();
@@ -119,7 +126,7 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
   if (!out) throw Error(path + ": write failed");
 }
 
-nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const AnalyseOptions& options,
+nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const OutputOptions& options,
                             const RunInfo& info) {
   nlohmann::json j;
   j["tool"] = "gsa analyse";
@@ -169,25 +176,24 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     params["mark_spacing"] = r.mark_spacing;
     params["gauge_length"] = r.gauge_length;
     params["projection_iterations"] = r.projection_iterations;
-    params["outlier_sigma"] = options.outlier_sigma;
+    params["outlier_sigma"] = r.outlier_sigma;
     j["fit"] = {{"undeformed", {{"rms_residual", r.rms_undeformed}, {"max_residual", r.max_undeformed}}},
                 {"deformed", {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}}}};
   } else {
     params["triangles"] = r.n_triangles;
   }
-  if (!options.fibre_angles.empty()) params["fibre_angles_deg"] = options.fibre_angles;
+  if (!r.fibre_angles.empty()) params["fibre_angles_deg"] = r.fibre_angles;
   j["parameters"] = params;
   j["strain_ranges"] = {{"E1", range_of(e1)}, {"E2", range_of(e2)}, {"eng1", range_of(eng1)},
                         {"eng2", range_of(eng2)}, {"thickness_change_pct", range_of(th)}};
-  if (options.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
+  if (r.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
   j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh}, {"project", r.times.project},
                     {"fit", r.times.fit}, {"strain", r.times.strain}, {"write", r.times.write}};
   j["warnings"] = r.warnings;
   return j;
 }
 
-void write_surface_vtp(const std::string& path, const AnalysisResult& r, const AnalyseOptions& options,
-                       bool deformed, int subdiv) {
+io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv) {
   io::PolyMesh pm;
   const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
   const Index ne = r.mesh.n_elements();
@@ -199,7 +205,7 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, const A
   for (std::size_t k = 0; k < names.size(); ++k) scalars[k] = {names[k], 1, {}};
   io::FieldArray dir1{"dir1", 3, {}}, dir2{"dir2", 3, {}}, disp{"displacement", 3, {}}, shear{"shear_angle_deg", 1, {}};
   io::FieldArray f1{"fibre1", 3, {}}, f2{"fibre2", 3, {}}, s1{"fibre1_stretch", 1, {}}, s2{"fibre2_stretch", 1, {}};
-  const bool fibres = options.fibre_angles.size() == 2;
+  const bool fibres = r.fibre_angles.size() == 2;
   Index pt = 0;
   for (Index e = 0; e < ne; ++e) {
     for (int j = 0; j < np; ++j)
@@ -223,7 +229,7 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, const A
           // Fibre directions (undeformed or deformed surface), stretches and shear angle.
           Vec3 a[2] = {Vec3::Constant(kNaN), Vec3::Constant(kNaN)};
           double st[2] = {kNaN, kNaN};
-          const FibrePair fp = fibre_pair(pu.dx, pd.dx, options.fibre_angles[0], options.fibre_angles[1]);
+          const FibrePair fp = fibre_pair(pu.dx, pd.dx, r.fibre_angles[0], r.fibre_angles[1]);
           for (int k = 0; k < 2; ++k) {
             if (!fp.state[k]) continue;
             a[k] = deformed ? fp.state[k]->direction_deformed : *fp.undeformed[k];
@@ -257,10 +263,10 @@ void write_surface_vtp(const std::string& path, const AnalysisResult& r, const A
   for (Index e = 0; e < ne; ++e)
     for (int k = 0; k < subdiv * subdiv; ++k) elem.values.push_back(static_cast<double>(e));
   pm.cell_data.push_back(std::move(elem));
-  io::write_vtp(path, pm);
+  return pm;
 }
 
-void write_samples_csv(const std::string& path, const AnalysisResult& r, const AnalyseOptions& options) {
+void write_samples_csv(const std::string& path, const AnalysisResult& r, const OutputOptions& options) {
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   out << "# gsa fields on a regular xi sampling (" << options.sample << " x " << options.sample
@@ -282,16 +288,23 @@ void write_samples_csv(const std::string& path, const AnalysisResult& r, const A
       }
 }
 
-void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
-                   const AnalyseOptions& options, const RunInfo& info) {
+WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
+                             const OutputOptions& options, const RunInfo& info) {
   const auto t0 = std::chrono::steady_clock::now();
+  WrittenResults written;
+  if (options.flc) written.margins = flc_margins(*options.flc, mark_strains(result, options.measure), options.measure);
+  const FlcMargins* margins = written.margins ? &*written.margins : nullptr;
   // The mark table on a second thread while the surfaces are written (independent
   // files and read-only inputs); its exception, if any, is rethrown by get().
-  auto csv = std::async(std::launch::async, [&] { write_strains_csv(out.path("strains.csv"), grid, result, options); });
+  auto csv = std::async(std::launch::async,
+                        [&] { write_strains_csv(out.path("strains.csv"), grid, result, options, margins); });
   try {
     if (result.method == Method::kSurface) {
-      write_surface_vtp(out.path("undeformed.vtp"), result, options, false);
-      write_surface_vtp(out.path("deformed.vtp"), result, options, true);
+      for (const bool deformed : {false, true}) {
+        io::PolyMesh surface = surface_polymesh(result, deformed);
+        io::write_vtp(out.path(deformed ? "deformed.vtp" : "undeformed.vtp"), surface);
+        if (options.keep_surfaces) (deformed ? written.deformed : written.undeformed) = std::move(surface);
+      }
       if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
     }
   } catch (...) {
@@ -300,7 +313,9 @@ void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResul
   }
   csv.get();
   result.times.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  io::write_json(out.path("summary.json"), make_summary(grid, result, options, info));
+  written.summary = make_summary(grid, result, options, info);
+  io::write_json(out.path("summary.json"), written.summary);
+  return written;
 }
 
 }  // namespace sf::gsa

@@ -4,10 +4,14 @@
 // written into a temporary folder and moved into place only when all succeeded.
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "common/io/vtk_xml.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/flc.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/strain_measure.hpp"
 
 namespace sf::io {
 class AtomicOutputDir;
@@ -15,26 +19,47 @@ class AtomicOutputDir;
 
 namespace sf::gsa {
 
+struct OutputOptions {
+  std::string units = "mm";  // name of the grid's length unit, written into every file
+  int sample = 0;            // > 0: also samples.csv with sample x sample points per element (<= 50)
+  // A forming limit curve in the strain `measure`: strains.csv gets a last column
+  // flc_margin (gsa/flc.hpp), computed here once.
+  std::optional<FormingLimitCurve> flc;
+  StrainMeasure measure = StrainMeasure::kTrue;
+  bool keep_surfaces = false;  // return the tessellated surfaces (to draw pictures from them)
+  // Throws OptionError naming the field for a value out of range.
+  void validate() const;
+};
+
 struct RunInfo {
   std::string command_line;
   std::vector<std::string> inputs;
 };
 
 // Column names of strains.csv, in order.
-std::vector<std::string> strain_columns(const AnalyseOptions& options);
+std::vector<std::string> strain_columns(const AnalysisResult& result);
 
+// With margins, a comment line and a last column flc_margin.
 void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
-                       const AnalyseOptions& options);
-nlohmann::json make_summary(const GridData& grid, const AnalysisResult& result, const AnalyseOptions& options,
+                       const OutputOptions& options, const FlcMargins* margins = nullptr);
+nlohmann::json make_summary(const GridData& grid, const AnalysisResult& result, const OutputOptions& options,
                             const RunInfo& info);
-// Tessellated fitted surfaces (subdiv x subdiv quads per element) with the strain
-// fields as point data; `deformed` selects the surface.
-void write_surface_vtp(const std::string& path, const AnalysisResult& result, const AnalyseOptions& options,
-                       bool deformed, int subdiv = 8);
-void write_samples_csv(const std::string& path, const AnalysisResult& result, const AnalyseOptions& options);
+// A fitted surface tessellated (subdiv x subdiv quads per element) with the strain fields
+// as point data, as undeformed.vtp and deformed.vtp hold it; `deformed` selects the surface.
+io::PolyMesh surface_polymesh(const AnalysisResult& result, bool deformed, int subdiv = 8);
+void write_samples_csv(const std::string& path, const AnalysisResult& result, const OutputOptions& options);
 
-// Writes everything into `out` (not committed here).
-void write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
-                   const AnalyseOptions& options, const RunInfo& info);
+// What write_results() computed on the way.
+struct WrittenResults {
+  nlohmann::json summary;              // summary.json's content
+  std::optional<FlcMargins> margins;   // with OutputOptions::flc
+  io::PolyMesh undeformed, deformed;   // with OutputOptions::keep_surfaces (surface method)
+};
+
+// Writes everything into `out` (not committed here): strains.csv once (with the forming
+// limit margin when options.flc), the surfaces, samples.csv, summary.json. Records the
+// write time in result.times.write.
+WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
+                             const OutputOptions& options, const RunInfo& info);
 
 }  // namespace sf::gsa

@@ -7,10 +7,8 @@
 #include <limits>
 #include <sstream>
 
-#include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
-#include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "common/render/chart.hpp"
 #include "common/render/display.hpp"
@@ -73,71 +71,7 @@ double surface_area(const io::PolyMesh& m) {
   return a;
 }
 
-std::array<std::string, 2> measure_fields(StrainMeasure m) {
-  switch (m) {
-    case StrainMeasure::kTrue: return {"true1", "true2"};
-    case StrainMeasure::kEngineering: return {"eng1", "eng2"};
-    case StrainMeasure::kLagrangian: return {"E1", "E2"};
-  }
-  return {"true1", "true2"};
-}
-
-// Short label of a measure for titles: "true", "engineering", "Green".
-std::string measure_word(StrainMeasure m) {
-  switch (m) {
-    case StrainMeasure::kTrue: return "true";
-    case StrainMeasure::kEngineering: return "engineering";
-    case StrainMeasure::kLagrangian: return "Green";
-  }
-  return "true";
-}
-
-// ---------------------------------------------------------------------------------------
-// The results folder
-
-using Results = ResultsFolder;
-
-std::string case_name_of(const nlohmann::json& summary, const std::string& dir) {
-  if (summary.contains("inputs") && summary["inputs"].is_array() && !summary["inputs"].empty() &&
-      summary["inputs"][0].is_string()) {
-    const fs::path p = summary["inputs"][0].get<std::string>();
-    const std::string parent = p.parent_path().filename().string();
-    return parent.empty() ? p.filename().string() : parent + "/" + p.filename().string();
-  }
-  return fs::path(dir).filename().string();
-}
-
-Results read_results_impl(const std::string& dir) {
-  Results r;
-  r.dir = dir;
-  const fs::path d(dir);
-  const std::string strains = (d / "strains.csv").string();
-  if (!fs::exists(strains))
-    throw InputError(dir + ": no strains.csv here; give a folder written by `gsa analyse`");
-  r.strains = io::read_csv(strains);
-  const std::string summary = (d / "summary.json").string();
-  if (fs::exists(summary)) {
-    r.summary = io::read_json(summary);
-    if (r.summary.contains("units") && r.summary["units"].contains("length") &&
-        r.summary["units"]["length"].is_string())
-      r.units = r.summary["units"]["length"].get<std::string>();
-    const auto& params = r.summary.contains("parameters") ? r.summary["parameters"] : nlohmann::json();
-    if (params.is_object() && params.contains("fibre_angles_deg") && params["fibre_angles_deg"].is_array())
-      for (const auto& a : params["fibre_angles_deg"])
-        if (a.is_number()) r.fibre_angles.push_back(a.get<double>());
-  }
-  r.case_name = case_name_of(r.summary, dir);
-  const std::string u = (d / "undeformed.vtp").string(), v = (d / "deformed.vtp").string();
-  if (fs::exists(u) && fs::exists(v)) {
-    r.undeformed = io::read_vtp(u);
-    r.deformed = io::read_vtp(v);
-    if (r.undeformed.n_points() != r.deformed.n_points() ||
-        r.undeformed.polygons.size() != r.deformed.polygons.size())
-      throw InputError(v + ": does not match " + u + " point for point; rerun gsa analyse");
-    r.has_surfaces = r.undeformed.n_points() > 0 && !r.undeformed.polygons.empty();
-  }
-  return r;
-}
+using Results = PlotData;
 
 // ---------------------------------------------------------------------------------------
 // Sampling points for arrows and fibre lines
@@ -294,7 +228,7 @@ struct ArrowScale {
 
 ArrowScale arrow_scale(const Results& r, const Sampling& s, StrainMeasure m) {
   const auto names = measure_fields(m);
-  const std::string file = r.dir + "/undeformed.vtp";
+  const std::string file = r.source + "/undeformed.vtp";
   const auto& e1 = require_field(r.undeformed, names[0], 1, file);
   const auto& e2 = require_field(r.undeformed, names[1], 1, file);
   double emax = 0;
@@ -316,8 +250,8 @@ ArrowScale arrow_scale(const Results& r, const Sampling& s, StrainMeasure m) {
 render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale& a, bool deformed,
                           const PlotOptions& o) {
   const io::PolyMesh& m = deformed ? r.deformed : r.undeformed;
-  const std::string file = r.dir + (deformed ? "/deformed.vtp" : "/undeformed.vtp");
-  const auto names = measure_fields(o.measure);
+  const std::string file = r.source + (deformed ? "/deformed.vtp" : "/undeformed.vtp");
+  const auto names = measure_fields(r.measure);
   const auto& e1 = require_field(m, names[0], 1, file);
   const auto& e2 = require_field(m, names[1], 1, file);
   const auto& d1 = require_field(m, "dir1", 3, file);
@@ -325,7 +259,7 @@ render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale&
 
   render::Scene scene;
   scene.title = deformed ? "Principal strains on the formed part" : "Principal strains on the blank";
-  scene.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(o.measure) + " strain  \xC2\xB7  " +
+  scene.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain  \xC2\xB7  " +
                    (deformed ? "deformed surface" : "undeformed surface (material directions before forming)");
   scene.view = deformed ? o.view : render::View{};
   const double gap = 0.05 * a.spacing;
@@ -385,7 +319,7 @@ render::Scene arrow_scene(const Results& r, const Sampling& s, const ArrowScale&
   ref.glyph_set = 0;
   ref.model_length = a.model_per_strain * a.reference;
   ref.label = "length of " + render::format_fixed(a.reference, reference_decimals(a.reference)) + " " +
-              measure_word(o.measure) + " strain";
+              measure_word(r.measure) + " strain";
   render::LegendEntry edges;
   edges.kind = render::LegendEntry::Kind::kLine;
   edges.colour = kElementEdges;
@@ -411,7 +345,7 @@ render::Scene contour_scene(const Results& r, const std::vector<double>& values,
 }
 
 render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions& o) {
-  const std::string file = r.dir + "/deformed.vtp";
+  const std::string file = r.source + "/deformed.vtp";
   const auto& f1 = require_field(r.deformed, "fibre1", 3, file);
   const auto& f2 = require_field(r.deformed, "fibre2", 3, file);
   render::Scene scene;
@@ -467,28 +401,6 @@ render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions
 // ---------------------------------------------------------------------------------------
 // Principal strain plot
 
-struct MarkStrains {
-  std::vector<double> minor, major;
-};
-
-MarkStrains mark_strains(const Results& r, StrainMeasure m) {
-  const auto names = measure_fields(m);
-  const io::CsvTable& t = r.strains;
-  const std::size_t c1 = t.column_index(names[0]), c2 = t.column_index(names[1]);
-  const auto cs = t.find_column("status");
-  MarkStrains out;
-  for (std::size_t row = 0; row < t.n_rows(); ++row) {
-    double e1 = kNaN, e2 = kNaN;
-    if (!cs || t.cell(row, *cs) == "ok") {
-      e1 = t.number(row, c1, true);
-      e2 = t.number(row, c2, true);
-    }
-    out.major.push_back(e1);
-    out.minor.push_back(e2);
-  }
-  return out;
-}
-
 // Reference path lambda2 = lambda1^k for lambda1 >= 1 (both directions for k = 1).
 render::ChartSeries reference_line(double k, StrainMeasure m, const std::string& label,
                                    const render::Colour& colour, double dash) {
@@ -509,21 +421,24 @@ render::ChartSeries reference_line(double k, StrainMeasure m, const std::string&
   return s;
 }
 
-render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std::vector<double>& margin,
-                              const FormingLimitCurve* flc, const PlotOptions& o, PlotSummary& summary) {
-  const std::string w = measure_word(o.measure);
+render::Chart principal_chart(const Results& r, PlotSummary& summary) {
+  const MarkStrains& ms = r.marks;
+  const FormingLimitCurve* flc = r.flc ? &*r.flc : nullptr;
+  static const std::vector<double> kNoMargins;
+  const std::vector<double>& margin = r.margins ? r.margins->margin : kNoMargins;
+  const std::string w = measure_word(r.measure);
   render::Chart chart;
   chart.title = "Principal strains";
   chart.x_label = "minor strain (" + w + ")";
   chart.y_label = "major strain (" + w + ")";
   chart.equal_axes = true;
   chart.legend_title = "Key";
-  const std::string uni = o.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
-  const std::string shear = o.measure == StrainMeasure::kTrue ? "pure shear (major = -minor)" : "pure shear";
-  chart.series.push_back(reference_line(1.0, o.measure, "equibiaxial (major = minor)", {0.85, 0.45, 0.0}, 9));
-  chart.series.push_back(reference_line(0.0, o.measure, "plane strain (minor = 0)", {0.10, 0.55, 0.20}, 0));
-  chart.series.push_back(reference_line(-0.5, o.measure, uni, {0.50, 0.22, 0.68}, 5));
-  chart.series.push_back(reference_line(-1.0, o.measure, shear, {0.45, 0.33, 0.18}, 2.5));
+  const std::string uni = r.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
+  const std::string shear = r.measure == StrainMeasure::kTrue ? "pure shear (major = -minor)" : "pure shear";
+  chart.series.push_back(reference_line(1.0, r.measure, "equibiaxial (major = minor)", {0.85, 0.45, 0.0}, 9));
+  chart.series.push_back(reference_line(0.0, r.measure, "plane strain (minor = 0)", {0.10, 0.55, 0.20}, 0));
+  chart.series.push_back(reference_line(-0.5, r.measure, uni, {0.50, 0.22, 0.68}, 5));
+  chart.series.push_back(reference_line(-1.0, r.measure, shear, {0.45, 0.33, 0.18}, 2.5));
   render::ChartSeries safe, beyond;
   safe.colour = {0.10, 0.27, 0.60};
   beyond.colour = {0.80, 0.0, 0.45};
@@ -562,9 +477,8 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
     }
     beyond.label = "marks beyond the limit (" + std::to_string(beyond.x.size()) + ")";
     chart.series.push_back(beyond);
-    summary.n_beyond_flc = static_cast<Index>(beyond.x.size());
   }
-  chart.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(o.measure) + " strain  \xC2\xB7  " +
+  chart.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain  \xC2\xB7  " +
                    std::to_string(n) + " marks";
   chart.footnote = "One dot per analysed mark (strains.csv). Equal axes." +
                    std::string(flc ? " Forming limit curve from " + fs::path(flc->source).filename().string() +
@@ -577,142 +491,126 @@ render::Chart principal_chart(const Results& r, const MarkStrains& ms, const std
 
 // ---------------------------------------------------------------------------------------
 
-StrainMeasure parse_measure(const std::string& text, const std::string& option) {
-  std::string t = text;
-  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (t == "true" || t == "logarithmic" || t == "natural") return StrainMeasure::kTrue;
-  if (t == "engineering") return StrainMeasure::kEngineering;
-  if (t == "lagrangian" || t == "green") return StrainMeasure::kLagrangian;
-  throw UsageError(option + ": expected true, engineering or lagrangian, found '" + text + "'");
+PlotData plot_data(ResultsFolder folder, StrainMeasure measure) {
+  PlotData d;
+  d.source = folder.dir;
+  d.case_name = case_name_of(folder.summary, folder.dir);
+  d.units = units_of(folder.summary);
+  d.fibre_angles = fibre_angles_of(folder.summary);
+  d.measure = measure;
+  d.marks = mark_strains(folder.strains, measure);
+  d.summary = std::move(folder.summary);
+  d.has_surfaces = folder.has_surfaces;
+  d.undeformed = std::move(folder.undeformed);
+  d.deformed = std::move(folder.deformed);
+  return d;
 }
 
-std::string measure_name(StrainMeasure m) {
-  switch (m) {
-    case StrainMeasure::kTrue: return "true";
-    case StrainMeasure::kEngineering: return "engineering";
-    case StrainMeasure::kLagrangian: return "Lagrangian (Green)";
-  }
-  return "true";
+PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed,
+                   io::PolyMesh deformed, const std::string& dir, StrainMeasure measure) {
+  PlotData d;
+  d.source = dir;
+  d.case_name = case_name_of(summary, dir);
+  d.units = units_of(summary);
+  d.fibre_angles = fibre_angles_of(summary);
+  d.measure = measure;
+  d.marks = mark_strains(result, measure);
+  d.summary = std::move(summary);
+  d.has_surfaces = undeformed.n_points() > 0 && !undeformed.polygons.empty() &&
+                   deformed.n_points() == undeformed.n_points();
+  d.undeformed = std::move(undeformed);
+  d.deformed = std::move(deformed);
+  return d;
 }
 
-double strain_of_stretch(double l, StrainMeasure m) {
-  switch (m) {
-    case StrainMeasure::kTrue: return std::log(l);
-    case StrainMeasure::kEngineering: return l - 1;
-    case StrainMeasure::kLagrangian: return 0.5 * (l * l - 1);
-  }
-  return kNaN;
-}
-
-double FormingLimitCurve::major_at(double m) const {
-  if (minor.size() < 2 || !std::isfinite(m) || m < minor.front() || m > minor.back()) return kNaN;
-  const auto it = std::upper_bound(minor.begin(), minor.end(), m);
-  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - minor.begin()), minor.size() - 1);
-  const std::size_t a = i - 1, b = i;
-  if (minor[b] == minor[a]) return std::min(major[a], major[b]);
-  const double t = (m - minor[a]) / (minor[b] - minor[a]);
-  return (1 - t) * major[a] + t * major[b];
-}
-
-FormingLimitCurve read_flc(const std::string& path) {
-  const io::CsvTable t = io::read_csv(path);
-  const std::size_t cm = t.column_index("minor"), cM = t.column_index("major");
-  std::vector<std::pair<double, double>> pts;
-  for (std::size_t r = 0; r < t.n_rows(); ++r) pts.emplace_back(t.number(r, cm), t.number(r, cM));
-  if (pts.size() < 2)
-    throw InputError(path + ": a forming limit curve needs at least 2 rows (minor, major), found " +
-                     std::to_string(pts.size()));
-  std::stable_sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  FormingLimitCurve c;
-  c.source = path;
-  for (const auto& [m, M] : pts) {
-    c.minor.push_back(m);
-    c.major.push_back(M);
-  }
-  return c;
-}
-
-ResultsFolder read_results_folder(const std::string& dir) { return read_results_impl(dir); }
-
-render::Scene arrow_diagram(const ResultsFolder& r, bool deformed, const PlotOptions& o) {
+render::Scene arrow_diagram(const PlotData& r, bool deformed, const PlotOptions& o) {
   if (!r.has_surfaces)
-    throw InputError(r.dir + ": no undeformed.vtp / deformed.vtp (triangle method?): no arrow diagram");
+    throw InputError(r.source + ": no undeformed.vtp / deformed.vtp (triangle method?): no arrow diagram");
   const Sampling s = sample_surface(r.undeformed);
-  return arrow_scene(r, s, arrow_scale(r, s, o.measure), deformed, o);
+  return arrow_scene(r, s, arrow_scale(r, s, r.measure), deformed, o);
 }
 
-PlotSummary write_pictures(const std::string& in_dir,
+namespace {
+
+// The pictures of the fitted surfaces (surface method), in report order.
+void draw_surface_pictures(const Results& r, const std::function<void(const std::string&, const render::Scene&)>& draw,
+                           const PlotOptions& o, bool fibres) {
+  const Sampling s = sample_surface(r.undeformed);
+  const ArrowScale a = arrow_scale(r, s, r.measure);
+  draw("arrows_undeformed.png", arrow_scene(r, s, a, false, o));
+  draw("arrows_deformed.png", arrow_scene(r, s, a, true, o));
+  const std::string file = r.source + "/deformed.vtp";
+  const auto th = scalar_values(r.deformed, "thickness_change_pct", file);
+  draw("thickness.png", contour_scene(r, th, "Thickness change", "Thickness change", "%", 1.0,
+                                      "formed part, incompressible sheet, " + range_text(th, 1, " %", 1.0), o));
+  const auto names = measure_fields(r.measure);
+  const std::string w = measure_word(r.measure);
+  const auto e1 = scalar_values(r.deformed, names[0], file);
+  const auto e2 = scalar_values(r.deformed, names[1], file);
+  draw("major_strain.png",
+       contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
+                     measure_name(r.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o));
+  draw("minor_strain.png",
+       contour_scene(r, e2, "Minor strain", "Minor " + w + " strain", "-", 0.01,
+                     measure_name(r.measure) + " strain, " + range_text(e2, decimals_for(e2), "", 0.01), o));
+  if (!fibres) return;
+  const auto sh = scalar_values(r.deformed, "shear_angle_deg", file);
+  draw("shear_angle.png",
+       contour_scene(r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
+                     "initial angle between the fibre families minus the current one, " +
+                         range_text(sh, 1, "\xC2\xB0", 1.0),
+                     o));
+  draw("fibres.png", fibre_scene(r, s, o));
+}
+
+}  // namespace
+
+PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
                            const std::function<std::string(const std::string&)>& out_path,
-                           const PlotOptions& o) {
-  const Results r = read_results_folder(in_dir);
-  std::optional<FormingLimitCurve> flc;
-  if (!o.flc_path.empty()) flc = read_flc(o.flc_path);
+                           const PictureProgress& progress) {
   PlotSummary summary;
-  summary.flc = flc.has_value();
-  summary.min_flc_margin = kNaN;
-
-  const MarkStrains ms = mark_strains(r, o.measure);
-  std::vector<double> margin(ms.major.size(), kNaN);
-  if (flc) {
-    for (std::size_t i = 0; i < ms.major.size(); ++i) {
-      margin[i] = flc->major_at(ms.minor[i]) - ms.major[i];
-      if (std::isfinite(margin[i]) &&
-          !(std::isfinite(summary.min_flc_margin) && summary.min_flc_margin <= margin[i]))
-        summary.min_flc_margin = margin[i];
-    }
-  }
-
   const bool fibres = r.has_surfaces && find_field(r.deformed, "shear_angle_deg", 1) != nullptr;
   const int n_pictures = r.has_surfaces ? (fibres ? 8 : 6) : 1;
   const auto display = render::acquire_display();  // one display for all pictures
-  cli::Progress progress("gsa: drawing pictures", n_pictures, o.quiet);
   int done = 0;
+  if (progress) progress(done, n_pictures);
   auto draw = [&](const std::string& name, const render::Scene& scene) {
     render::write_png(scene, o.size, out_path(name));
     summary.pictures.push_back(name);
-    progress.update(++done);
+    if (progress) progress(++done, n_pictures);
   };
-
-  if (r.has_surfaces) {
-    const Sampling s = sample_surface(r.undeformed);
-    const ArrowScale a = arrow_scale(r, s, o.measure);
-    draw("arrows_undeformed.png", arrow_scene(r, s, a, false, o));
-    draw("arrows_deformed.png", arrow_scene(r, s, a, true, o));
-    const std::string file = r.dir + "/deformed.vtp";
-    const auto th = scalar_values(r.deformed, "thickness_change_pct", file);
-    draw("thickness.png",
-         contour_scene(r, th, "Thickness change", "Thickness change", "%", 1.0,
-                       "formed part, incompressible sheet, " + range_text(th, 1, " %", 1.0), o));
-    const auto names = measure_fields(o.measure);
-    const std::string w = measure_word(o.measure);
-    const auto e1 = scalar_values(r.deformed, names[0], file);
-    const auto e2 = scalar_values(r.deformed, names[1], file);
-    draw("major_strain.png", contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
-                                           measure_name(o.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o));
-    draw("minor_strain.png", contour_scene(r, e2, "Minor strain", "Minor " + w + " strain", "-", 0.01,
-                                           measure_name(o.measure) + " strain, " + range_text(e2, decimals_for(e2), "", 0.01), o));
-    if (fibres) {
-      const auto sh = scalar_values(r.deformed, "shear_angle_deg", file);
-      draw("shear_angle.png",
-           contour_scene(r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
-                         "initial angle between the fibre families minus the current one, " +
-                             range_text(sh, 1, "\xC2\xB0", 1.0),
-                         o));
-      draw("fibres.png", fibre_scene(r, s, o));
-    }
-  }
+  if (r.has_surfaces) draw_surface_pictures(r, draw, o, fibres);
   {
-    const render::Chart chart = principal_chart(r, ms, margin, flc ? &*flc : nullptr, o, summary);
+    const render::Chart chart = principal_chart(r, summary);
     render::write_chart_png(chart, o.size, out_path("principal_strains.png"));
     // The strain plot reads best first after the arrows; keep report order stable.
     summary.pictures.push_back("principal_strains.png");
-    progress.update(++done);
+    if (progress) progress(++done, n_pictures);
   }
-  progress.finish();
-  if (flc) write_strains_with_margin(r.strains, fs::path(in_dir) / "strains.csv", out_path("strains.csv"), margin,
-                                     measure_word(o.measure), o.flc_path);
-  write_report(out_path("report.html"), r.summary, r.case_name, summary, o);
+  ReportPage page;
+  page.case_name = r.case_name;
+  page.measure = r.measure;
+  page.pictures = summary.pictures;
+  page.flc = r.margins ? &*r.margins : nullptr;
+  write_report(out_path("report.html"), r.summary, page);
   return summary;
+}
+
+Redrawn redraw_results_folder(const std::string& dir, StrainMeasure measure,
+                              const std::optional<FormingLimitCurve>& flc, const PlotOptions& options,
+                              const std::function<std::string(const std::string&)>& out_path,
+                              const PictureProgress& progress) {
+  ResultsFolder folder = read_results_folder(dir);
+  Redrawn out;
+  if (flc) {
+    out.margins = flc_margins(*flc, mark_strains(folder.strains, measure), measure);
+    write_strains_with_margin(folder, out_path("strains.csv"), *out.margins);
+  }
+  PlotData data = plot_data(std::move(folder), measure);
+  data.flc = flc;
+  data.margins = out.margins;
+  out.pictures = write_pictures(data, options, out_path, progress);
+  return out;
 }
 
 }  // namespace sf::gsa

@@ -1,8 +1,10 @@
 #pragma once
-// Pictures of a `gsa analyse` results folder (BRIEF.md §1 "Pictures", CONTRACT.md) and the
-// one page that shows them, report.html. Everything is read back from the folder's files
-// (strains.csv, summary.json, undeformed.vtp, deformed.vtp), so `gsa plot DIR` can redraw
-// any results folder with other options.
+// Pictures of the results of `gsa analyse` (BRIEF.md §1 "Pictures", CONTRACT.md) and the
+// one page that shows them, report.html. They are drawn from a PlotData: built from the
+// results in memory by `gsa analyse`, or from a results folder read back by `gsa plot DIR`
+// (strains.csv, summary.json, undeformed.vtp, deformed.vtp), which redraws any results
+// folder with other options. Drawing computes nothing new: the forming limit margins come
+// with the data (gsa/flc.hpp).
 //
 // Pictures (PNG, surface method; the triangle method has no fitted surfaces and gets only
 // the principal strain plot):
@@ -30,77 +32,70 @@
 #include <nlohmann/json.hpp>
 
 #include "common/core/types.hpp"
-#include "common/io/csv.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "common/render/scene.hpp"
+#include "gsa/analysis.hpp"
+#include "gsa/flc.hpp"
+#include "gsa/results_folder.hpp"
+#include "gsa/strain_measure.hpp"
 
 namespace sf::gsa {
 
-enum class StrainMeasure { kTrue, kEngineering, kLagrangian };
-
-// "true", "engineering" or "lagrangian" (also "green"); throws sf::UsageError naming
-// `option` otherwise.
-StrainMeasure parse_measure(const std::string& text, const std::string& option = "--measure");
-// "true", "engineering", "Lagrangian (Green)".
-std::string measure_name(StrainMeasure m);
-// Strain in measure `m` of a principal stretch.
-double strain_of_stretch(double stretch, StrainMeasure m);
-
-// A forming limit curve: major limit strain against minor strain, in the measure the
-// pictures use. Read from CSV with columns `minor` and `major` (any order, '#' comments),
-// at least 2 rows; sorted by minor strain on reading.
-struct FormingLimitCurve {
-  std::string source;
-  std::vector<double> minor, major;
-  // Linear interpolation at `minor`; NaN outside the curve's minor range.
-  double major_at(double minor_strain) const;
-};
-// Throws sf::InputError naming the file, line and column for bad content.
-FormingLimitCurve read_flc(const std::string& path);
-
 struct PlotOptions {
-  StrainMeasure measure = StrainMeasure::kTrue;
   render::ImageSize size;  // pixels (--size WxH)
   render::View view;       // for the pictures of the formed part (--view); the undeformed
                            // blank is always seen along its mean normal
-  std::string flc_path;    // --flc FILE: forming limit curve (minor, major) in `measure`
-  bool quiet = true;
 };
 
-// A results folder read back: what the pictures are drawn from.
-struct ResultsFolder {
-  std::string dir;
-  nlohmann::json summary;          // summary.json (empty if absent)
-  std::string units = "mm";        // length unit from summary.json
-  std::string case_name;           // e.g. "dome/grid.csv": the input's folder and name
+// The results of one analysis as the pictures show them.
+struct PlotData {
+  std::string source;                // the results folder, for messages
+  std::string case_name;             // e.g. "dome/grid.csv": the input's folder and name
+  std::string units = "mm";          // length unit
   std::vector<double> fibre_angles;  // degrees, fibre mode only
-  bool has_surfaces = false;       // undeformed.vtp and deformed.vtp present (surface method)
-  io::PolyMesh undeformed, deformed;
-  io::CsvTable strains;
+  nlohmann::json summary;            // summary.json's content
+  bool has_surfaces = false;         // fitted surfaces (surface method)
+  io::PolyMesh undeformed, deformed;  // tessellated surfaces with the strain fields, as in the .vtp files
+  StrainMeasure measure = StrainMeasure::kTrue;  // the strain the pictures show
+  MarkStrains marks;                             // every mark's principal strains in `measure`
+  std::optional<FormingLimitCurve> flc;          // drawn in the principal strain plot (in `measure`)
+  std::optional<FlcMargins> margins;             // of the marks against it
 };
-// Throws sf::InputError when DIR has no strains.csv or its files do not belong together.
-ResultsFolder read_results_folder(const std::string& dir);
+// From a results folder read back.
+PlotData plot_data(ResultsFolder folder, StrainMeasure measure);
+// From the results in memory: the analysis, its summary and its tessellated surfaces
+// (empty for the triangle method); `dir` is the results folder.
+PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed,
+                   io::PolyMesh deformed, const std::string& dir, StrainMeasure measure);
 
 // The arrow diagram on the undeformed (deformed = false) or deformed surface, as a scene
 // (write it with render::write_png). Needs has_surfaces.
-render::Scene arrow_diagram(const ResultsFolder& results, bool deformed, const PlotOptions& options);
+render::Scene arrow_diagram(const PlotData& data, bool deformed, const PlotOptions& options);
 
 struct PlotSummary {
   std::vector<std::string> pictures;  // file names written, in report order
-  bool flc = false;
-  Index n_marks = 0;           // marks in the principal strain plot
-  Index n_beyond_flc = 0;      // marks above the forming limit curve
-  double min_flc_margin = 0;   // smallest margin (NaN when none could be computed)
+  Index n_marks = 0;                  // marks in the principal strain plot
 };
 
-// Reads the results in `in_dir` and writes the pictures and report.html to the paths
-// `out_path(name)` gives (in `gsa analyse`: the atomic output folder). With a forming limit
-// curve, strains.csv is rewritten there with a column `flc_margin` (FLC major strain at
-// the mark's minor strain minus its major strain, in the plots' measure; negative =
-// beyond the limit). Throws sf::InputError for unreadable results, sf::Error when no
-// display can be had.
-PlotSummary write_pictures(const std::string& in_dir,
+// Pictures drawn so far of the total, after each one (done = 0 before the first).
+using PictureProgress = std::function<void(int done, int total)>;
+
+// Writes the pictures and report.html to the paths `out_path(name)` gives (in `gsa
+// analyse`: the atomic output folder). Throws sf::InputError for data that lack a field
+// the pictures need, sf::Error when no display can be had.
+PlotSummary write_pictures(const PlotData& data, const PlotOptions& options,
                            const std::function<std::string(const std::string&)>& out_path,
-                           const PlotOptions& options);
+                           const PictureProgress& progress = {});
+
+// `gsa plot DIR`: reads the results folder, with a curve (in `measure`) writes its
+// strains.csv again with the margins (to out_path("strains.csv")), and draws the pictures.
+struct Redrawn {
+  PlotSummary pictures;
+  std::optional<FlcMargins> margins;  // with a curve
+};
+Redrawn redraw_results_folder(const std::string& dir, StrainMeasure measure,
+                              const std::optional<FormingLimitCurve>& flc, const PlotOptions& options,
+                              const std::function<std::string(const std::string&)>& out_path,
+                              const PictureProgress& progress = {});
 
 }  // namespace sf::gsa

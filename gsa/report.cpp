@@ -8,24 +8,11 @@
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/io/xml_escape.hpp"
 
 namespace sf::gsa {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string number(double v) {
   if (!std::isfinite(v)) return "&ndash;";
@@ -42,13 +29,13 @@ std::string text_of(const nlohmann::json& j) {
   if (j.is_null()) return "&ndash;";
   if (j.is_number()) return number(j.get<double>());
   if (j.is_boolean()) return j.get<bool>() ? "yes" : "no";
-  if (j.is_string()) return escape(j.get<std::string>());
+  if (j.is_string()) return io::xml_escape(j.get<std::string>());
   if (j.is_array()) {
     std::string s;
     for (std::size_t i = 0; i < j.size(); ++i) s += (i ? ", " : "") + text_of(j[i]);
     return s;
   }
-  return escape(j.dump());
+  return io::xml_escape(j.dump());
 }
 
 const nlohmann::json& at(const nlohmann::json& j, std::initializer_list<const char*> path) {
@@ -63,16 +50,16 @@ const nlohmann::json& at(const nlohmann::json& j, std::initializer_list<const ch
 
 struct Table {
   std::ostringstream html;
-  explicit Table(const std::string& title) { html << "<h2>" << escape(title) << "</h2>\n<table>\n"; }
+  explicit Table(const std::string& title) { html << "<h2>" << io::xml_escape(title) << "</h2>\n<table>\n"; }
   void row(const std::string& key, const std::string& value_html) {
     if (value_html.empty() || value_html == "&ndash;") return;
-    html << "<tr><th>" << escape(key) << "</th><td>" << value_html << "</td></tr>\n";
+    html << "<tr><th>" << io::xml_escape(key) << "</th><td>" << value_html << "</td></tr>\n";
   }
   std::string str() { return html.str() + "</table>\n"; }
 };
 
-std::string caption_of(const std::string& name, const PlotOptions& o) {
-  const std::string m = measure_name(o.measure);
+std::string caption_of(const std::string& name, StrainMeasure measure) {
+  const std::string m = measure_name(measure);
   static const std::map<std::string, std::string> captions = {
       {"arrows_undeformed.png",
        "Principal strain arrows on the undeformed blank: the material directions that become the "
@@ -94,13 +81,10 @@ std::string caption_of(const std::string& name, const PlotOptions& o) {
   return c;
 }
 
-}  // namespace
-
-void write_report(const std::string& path, const nlohmann::json& s, const std::string& case_name,
-                  const PlotSummary& plots, const PlotOptions& o) {
-  std::ostringstream h;
+// The page's head, style and header line.
+void page_head(std::ostream& h, const nlohmann::json& s, const ReportPage& page) {
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<title>gsa report: " << escape(case_name) << "</title>\n<style>\n"
+    << "<title>gsa report: " << io::xml_escape(page.case_name) << "</title>\n<style>\n"
     << "body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Arial,sans-serif;margin:0;color:#222;"
        "background:#fafafa}\n"
     << "header{padding:14px 24px;background:#fff;border-bottom:1px solid #ddd}\n"
@@ -117,14 +101,18 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
     << ".files a{margin-right:10px}.warn{color:#a40}\n"
     << "@media (max-width:1000px){.page{flex-direction:column}aside{position:static;flex:none;width:auto}}\n"
     << "</style>\n</head>\n<body>\n";
-  h << "<header><h1>Grid strain analysis: " << escape(case_name) << "</h1>\n<div>"
+  h << "<header><h1>Grid strain analysis: " << io::xml_escape(page.case_name) << "</h1>\n<div>"
     << text_of(at(s, {"tool"})) << " " << text_of(at(s, {"version"})) << " &middot; pictures in "
-    << escape(measure_name(o.measure)) << " strain &middot; <span class=\"files\">files: "
+    << io::xml_escape(measure_name(page.measure)) << " strain &middot; <span class=\"files\">files: "
     << "<a href=\"strains.csv\">strains.csv</a><a href=\"summary.json\">summary.json</a>";
-  if (plots.pictures.size() > 1)
+  if (page.pictures.size() > 1)
     h << "<a href=\"undeformed.vtp\">undeformed.vtp</a><a href=\"deformed.vtp\">deformed.vtp</a>";
   h << "</span></div></header>\n<div class=\"page\">\n<aside>\n";
 
+}
+
+// The summary's inputs and parameters.
+void parameter_tables(std::ostream& h, const nlohmann::json& s) {
   {
     Table t("Inputs");
     t.row("grid file(s)", text_of(at(s, {"inputs"})));
@@ -162,6 +150,10 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
     t.row("triangles", text_of(at(p, {"triangles"})));
     h << t.str();
   }
+}
+
+// Fit residuals, mark counts, strain ranges, the forming limit and warnings.
+void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& page) {
   if (at(s, {"fit"}).is_object()) {
     Table t("Fit residuals");
     const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
@@ -183,16 +175,16 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
     if (r.is_object()) {
       h << "<h2>Strain ranges at the marks</h2>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
       for (auto it = r.begin(); it != r.end(); ++it)
-        h << "<tr><th>" << escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
+        h << "<tr><th>" << io::xml_escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
           << text_of(at(it.value(), {"max"})) << "</td></tr>\n";
       h << "</table>\n";
     }
   }
-  if (plots.flc) {
+  if (page.flc) {
     Table t("Forming limit");
-    t.row("curve", escape(o.flc_path));
-    t.row("marks beyond the curve", std::to_string(plots.n_beyond_flc) + " of " + std::to_string(plots.n_marks));
-    t.row("smallest margin (" + measure_name(o.measure) + " strain)", number(plots.min_flc_margin));
+    t.row("curve", io::xml_escape(page.flc->source));
+    t.row("marks beyond the curve", std::to_string(page.flc->n_beyond) + " of " + std::to_string(page.flc->n_marks));
+    t.row("smallest margin (" + measure_name(page.measure) + " strain)", number(page.flc->min_margin));
     t.row("per mark", "column <code>flc_margin</code> of strains.csv");
     h << t.str();
   }
@@ -204,55 +196,30 @@ void write_report(const std::string& path, const nlohmann::json& s, const std::s
       h << "</ul>\n";
     }
   }
+}
+
+// Every picture with its caption.
+void figures(std::ostream& h, const ReportPage& page) {
   h << "</aside>\n<main>\n";
-  for (const std::string& name : plots.pictures)
-    h << "<figure><a href=\"" << escape(name) << "\"><img src=\"" << escape(name) << "\" alt=\""
-      << escape(caption_of(name, o)) << "\"></a>\n<figcaption>" << escape(caption_of(name, o))
+  for (const std::string& name : page.pictures)
+    h << "<figure><a href=\"" << io::xml_escape(name) << "\"><img src=\"" << io::xml_escape(name) << "\" alt=\""
+      << io::xml_escape(caption_of(name, page.measure)) << "\"></a>\n<figcaption>" << io::xml_escape(caption_of(name, page.measure))
       << "</figcaption></figure>\n";
-  if (plots.pictures.size() == 1)
+  if (page.pictures.size() == 1)
     h << "<p>The triangle method has no fitted surfaces: only the principal strain plot is drawn. "
          "Run with <code>--method surface</code> for arrow diagrams and contours.</p>\n";
   h << "</main>\n</div>\n</body>\n</html>\n";
-  io::write_file_atomic(path, h.str());
 }
 
-void write_strains_with_margin(const io::CsvTable& t, const std::filesystem::path& original, const std::string& out,
-                               const std::vector<double>& margin, const std::string& measure_word,
-                               const std::string& flc_path) {
-  // Keep the leading comment lines of the original file.
-  std::vector<std::string> comments;
-  {
-    std::ifstream in(original);
-    std::string line;
-    while (std::getline(in, line)) {
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (line.rfind('#', 0) != 0) break;
-      if (line.rfind("# flc_margin", 0) == 0) continue;
-      comments.push_back(line);
-    }
-  }
-  std::vector<std::string> header;
-  std::vector<std::size_t> keep;
-  for (std::size_t c = 0; c < t.n_columns(); ++c)
-    if (t.names()[c] != "flc_margin") {
-      header.push_back(t.names()[c]);
-      keep.push_back(c);
-    }
-  header.push_back("flc_margin");
-  io::write_file_atomic(out, [&](std::ostream& os) {
-    for (const auto& c : comments) os << c << "\n";
-    os << "# flc_margin: forming limit major strain at the mark's minor strain minus its major strain ("
-       << measure_word << " strain; curve " << flc_path
-       << "); negative = beyond the limit; empty where the mark has no strain or its minor strain is "
-          "outside the curve\n";
-    io::CsvWriter w(os, header);
-    for (std::size_t r = 0; r < t.n_rows(); ++r) {
-      w.begin_row();
-      for (std::size_t c : keep) w.add(t.cell(r, c));
-      w.add(r < margin.size() ? margin[r] : std::nan(""));
-      w.end_row();
-    }
-  });
+}  // namespace
+
+void write_report(const std::string& path, const nlohmann::json& summary, const ReportPage& page) {
+  std::ostringstream h;
+  page_head(h, summary, page);
+  parameter_tables(h, summary);
+  result_tables(h, summary, page);
+  figures(h, page);
+  io::write_file_atomic(path, h.str());
 }
 
 }  // namespace sf::gsa

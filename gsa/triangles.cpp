@@ -79,6 +79,7 @@ std::vector<std::array<Index, 3>> delaunay_triangles(const GridData& g, const st
 AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& options) {
   AnalysisResult r;
   r.method = Method::kTriangles;
+  r.fibre_angles = options.fibre_angles;
   const Index n = g.n_points();
   r.points.resize(n);
   const auto t0 = std::chrono::steady_clock::now();

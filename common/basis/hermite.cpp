@@ -3,19 +3,12 @@
 namespace sf::basis {
 
 std::array<double, 4> cubic_hermite(double t, int derivative_order) {
-  const double t2 = t * t;
   switch (derivative_order) {
-    case 0:
-      return {1.0 - 3.0 * t2 + 2.0 * t2 * t, t * (t - 1.0) * (t - 1.0), t2 * (3.0 - 2.0 * t),
-              t2 * (t - 1.0)};
-    case 1:
-      return {-6.0 * t + 6.0 * t2, 1.0 - 4.0 * t + 3.0 * t2, 6.0 * t - 6.0 * t2, -2.0 * t + 3.0 * t2};
-    case 2:
-      return {-6.0 + 12.0 * t, -4.0 + 6.0 * t, 6.0 - 12.0 * t, -2.0 + 6.0 * t};
-    case 3:
-      return {12.0, 6.0, -12.0, 6.0};
-    default:
-      return {0.0, 0.0, 0.0, 0.0};
+    case 0: return cubic_hermite_table<0>(t)[0];
+    case 1: return cubic_hermite_table<1>(t)[1];
+    case 2: return cubic_hermite_table<2>(t)[2];
+    case 3: return cubic_hermite_table<3>(t)[3];
+    default: return {0.0, 0.0, 0.0, 0.0};
   }
 }
 
@@ -67,6 +60,14 @@ BicubicValues BicubicHermite::evaluate(const Eigen::Vector2d& xi, unsigned updat
       }
     }
   }
+  return out;
+}
+
+Eigen::Matrix<double, 16, 1> BicubicHermite::derivative(const Eigen::Vector2d& xi, int o1, int o2) {
+  const std::array<double, 4> a = cubic_hermite(xi[0], o1), b = cubic_hermite(xi[1], o2);
+  Eigen::Matrix<double, 16, 1> out;
+  for (int n = 0; n < 4; ++n)
+    for (int d = 0; d < 4; ++d) out[4 * n + d] = a[2 * (n & 1) + (d & 1)] * b[2 * (n >> 1) + (d >> 1)];
   return out;
 }
 

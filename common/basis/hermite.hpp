@@ -35,7 +35,28 @@
 
 namespace sf::basis {
 
-// Values (order 0), first (1) or second (2) derivative of the four cubic Hermite functions.
+// The four cubic Hermite functions and their derivatives up to order N (0 <= N <= 3)
+// at t, in one inline call: table[k][i] = d^k H_i / dt^k. This is the fast path of the
+// hot loops (nearest-point projection evaluates values to second derivatives millions of
+// times; the fit's penalties need third derivatives) and the one place the polynomials
+// are written down: cubic_hermite() and every tensor basis below take them from here.
+template <int N>
+using CubicHermiteTable = std::array<std::array<double, 4>, N + 1>;
+
+template <int N>
+inline CubicHermiteTable<N> cubic_hermite_table(double t) {
+  static_assert(N >= 0 && N <= 3, "cubic Hermite derivatives of order 0 to 3");
+  const double t2 = t * t;
+  CubicHermiteTable<N> h;
+  h[0] = {1.0 - 3.0 * t2 + 2.0 * t2 * t, t * (t - 1.0) * (t - 1.0), t2 * (3.0 - 2.0 * t), t2 * (t - 1.0)};
+  if constexpr (N >= 1) h[1] = {-6.0 * t + 6.0 * t2, 1.0 - 4.0 * t + 3.0 * t2, 6.0 * t - 6.0 * t2, -2.0 * t + 3.0 * t2};
+  if constexpr (N >= 2) h[2] = {-6.0 + 12.0 * t, -4.0 + 6.0 * t, 6.0 - 12.0 * t, -2.0 + 6.0 * t};
+  if constexpr (N >= 3) h[3] = {12.0, 6.0, -12.0, 6.0};
+  return h;
+}
+
+// Derivative of order `derivative_order` (0 = values) of the four cubic Hermite functions;
+// zeros above order 3.
 std::array<double, 4> cubic_hermite(double t, int derivative_order);
 // Values or first derivative of the two linear Lagrange functions (second derivative is 0).
 std::array<double, 2> linear_lagrange(double t, int derivative_order);
@@ -70,6 +91,9 @@ struct BicubicHermite {
   static constexpr int kNumNodes = 4;
   static constexpr int kParamsPerNode = 4;
   static BicubicValues evaluate(const Eigen::Vector2d& xi, unsigned updates);
+  // d^(o1+o2) N_k / dxi1^o1 dxi2^o2 of the 16 functions at xi, for any o1, o2 in 0..3
+  // (third derivatives: the fit's third-order penalty and edge jumps).
+  static Eigen::Matrix<double, 16, 1> derivative(const Eigen::Vector2d& xi, int o1, int o2);
 };
 
 // Bicubic Hermite in (xi1, xi2) x linear Lagrange in xi3 (32 functions).

@@ -33,6 +33,7 @@
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/io/xml_escape.hpp"
 
 namespace sf::io {
 
@@ -400,23 +401,6 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOp
   writer->SetInputData(grid);
   run_writer(writer, path);
 }
-
-namespace {
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-}  // namespace
 
 void write_pvd(const std::string& path,
                const std::vector<std::pair<double, std::string>>& time_and_relative_file) {

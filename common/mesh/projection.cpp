@@ -20,6 +20,7 @@
 #include <thread>
 #include <utility>
 
+#include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
 
 namespace sf::mesh {
@@ -56,53 +57,31 @@ struct Local {
   Vec3 x11 = Vec3::Zero(), x12 = Vec3::Zero(), x22 = Vec3::Zero();
 };
 
-inline void hermite(double t, double* h, double* d, double* dd) {
-  const double t2 = t * t, t3 = t2 * t;
-  h[0] = 1.0 - 3.0 * t2 + 2.0 * t3;
-  h[1] = t - 2.0 * t2 + t3;
-  h[2] = 3.0 * t2 - 2.0 * t3;
-  h[3] = t3 - t2;
-  d[0] = -6.0 * t + 6.0 * t2;
-  d[1] = 1.0 - 4.0 * t + 3.0 * t2;
-  d[2] = 6.0 * t - 6.0 * t2;
-  d[3] = -2.0 * t + 3.0 * t2;
-  dd[0] = -6.0 + 12.0 * t;
-  dd[1] = -4.0 + 6.0 * t;
-  dd[2] = 6.0 - 12.0 * t;
-  dd[3] = -2.0 + 6.0 * t;
-}
-
+// x and its first and second xi-derivatives at xi: the 1-D Hermite tables of
+// common/basis (inline) contracted with the tensor coefficients.
 inline Local evaluate(const ElementData& el, const Vec2& xi) {
-  double a0[4], a1[4], a2[4], b0[4], b1[4], b2[4];
-  hermite(xi[0], a0, a1, a2);
-  hermite(xi[1], b0, b1, b2);
+  const basis::CubicHermiteTable<2> a = basis::cubic_hermite_table<2>(xi[0]);
+  const basis::CubicHermiteTable<2> b = basis::cubic_hermite_table<2>(xi[1]);
   Local out;
   for (int i2 = 0; i2 < 4; ++i2) {
     const Vec3* c = &el.c[4 * i2];
-    const Vec3 s0 = a0[0] * c[0] + a0[1] * c[1] + a0[2] * c[2] + a0[3] * c[3];
-    const Vec3 s1 = a1[0] * c[0] + a1[1] * c[1] + a1[2] * c[2] + a1[3] * c[3];
-    const Vec3 s2 = a2[0] * c[0] + a2[1] * c[1] + a2[2] * c[2] + a2[3] * c[3];
-    out.x += b0[i2] * s0;
-    out.x1 += b0[i2] * s1;
-    out.x2 += b1[i2] * s0;
-    out.x11 += b0[i2] * s2;
-    out.x12 += b1[i2] * s1;
-    out.x22 += b2[i2] * s0;
+    const Vec3 s0 = a[0][0] * c[0] + a[0][1] * c[1] + a[0][2] * c[2] + a[0][3] * c[3];
+    const Vec3 s1 = a[1][0] * c[0] + a[1][1] * c[1] + a[1][2] * c[2] + a[1][3] * c[3];
+    const Vec3 s2 = a[2][0] * c[0] + a[2][1] * c[1] + a[2][2] * c[2] + a[2][3] * c[3];
+    out.x += b[0][i2] * s0;
+    out.x1 += b[0][i2] * s1;
+    out.x2 += b[1][i2] * s0;
+    out.x11 += b[0][i2] * s2;
+    out.x12 += b[1][i2] * s1;
+    out.x22 += b[2][i2] * s0;
   }
   return out;
 }
 
+// x alone (the kd-tree samples).
 inline Vec3 position(const ElementData& el, const Vec2& xi) {
-  double a[4], b[4];
-  const double s = xi[0], s2 = s * s, t = xi[1], t2 = t * t;
-  a[0] = 1.0 - 3.0 * s2 + 2.0 * s2 * s;
-  a[1] = s - 2.0 * s2 + s2 * s;
-  a[2] = 3.0 * s2 - 2.0 * s2 * s;
-  a[3] = s2 * s - s2;
-  b[0] = 1.0 - 3.0 * t2 + 2.0 * t2 * t;
-  b[1] = t - 2.0 * t2 + t2 * t;
-  b[2] = 3.0 * t2 - 2.0 * t2 * t;
-  b[3] = t2 * t - t2;
+  const std::array<double, 4> a = basis::cubic_hermite_table<0>(xi[0])[0];
+  const std::array<double, 4> b = basis::cubic_hermite_table<0>(xi[1])[0];
   Vec3 x = Vec3::Zero();
   for (int i2 = 0; i2 < 4; ++i2) {
     const Vec3* c = &el.c[4 * i2];

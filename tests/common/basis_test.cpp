@@ -108,6 +108,32 @@ TEST(BasisCubicHermite, ReproducesEveryCubic) {
   }
 }
 
+// The inline table (the fast path of projection and fitting) is the same polynomials:
+// bit for bit what cubic_hermite() returns for every order, whatever order the table
+// stops at.
+TEST(BasisCubicHermite, TableIsCubicHermiteBitForBit) {
+  std::mt19937 rng(test::kSeed + 3);
+  std::uniform_real_distribution<double> u(-0.25, 1.25);
+  for (int s = 0; s < 50; ++s) {
+    const double t = s < 2 ? double(s) : u(rng);
+    const CubicHermiteTable<3> t3 = cubic_hermite_table<3>(t);
+    const CubicHermiteTable<2> t2 = cubic_hermite_table<2>(t);
+    const CubicHermiteTable<0> t0 = cubic_hermite_table<0>(t);
+    for (int order = 0; order <= 3; ++order) {
+      const auto h = cubic_hermite(t, order);
+      for (int f = 0; f < 4; ++f) {
+        EXPECT_EQ(t3[order][f], h[f]) << "H" << f << " order " << order << " at t=" << t;
+        if (order <= 2) {
+          EXPECT_EQ(t2[order][f], h[f]) << "H" << f << " order " << order << " at t=" << t;
+        }
+      }
+    }
+    for (int f = 0; f < 4; ++f) EXPECT_EQ(t0[0][f], t3[0][f]) << "H" << f << " at t=" << t;
+  }
+  // Above the third derivative a cubic has none.
+  for (double h : cubic_hermite(0.3, 4)) EXPECT_EQ(h, 0.0);
+}
+
 TEST(BasisLinearLagrange, InterpolationAndPartitionOfUnity) {
   for (int end = 0; end < 2; ++end) {
     const auto l = linear_lagrange(end, 0);
@@ -412,6 +438,39 @@ TEST(BasisBicubic, IsTensorProductInDocumentedOrder) {
           << "function " << k << " at xi=" << str(xi);
     }
   }
+}
+
+// derivative(xi, o1, o2): the same numbers as evaluate() up to second order, and third
+// derivatives (which evaluate() does not give) against central differences of second ones.
+TEST(BasisBicubic, DerivativeOfAnyOrderUpToThree) {
+  std::mt19937 rng(test::kSeed + 14);
+  for (int s = 0; s < 10; ++s) {
+    const Vec2 xi = random_point<BicubicHermite>(rng);
+    const auto b = BicubicHermite::evaluate(xi, kValues | kFirst | kSecond);
+    const std::pair<int, int> orders[] = {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1}, {0, 2}};
+    const Eigen::Matrix<double, 16, 1> expected[] = {b.value,        b.first.col(0),  b.first.col(1),
+                                                     b.second.col(0), b.second.col(1), b.second.col(2)};
+    for (int q = 0; q < 6; ++q) {
+      const Eigen::Matrix<double, 16, 1> d = BicubicHermite::derivative(xi, orders[q].first, orders[q].second);
+      for (int k = 0; k < 16; ++k)
+        EXPECT_NEAR(d[k], expected[q][k], kRoundoff)
+            << "function " << k << " order (" << orders[q].first << "," << orders[q].second << ") at " << str(xi);
+    }
+    for (int o1 = 0; o1 <= 3; ++o1) {
+      const int o2 = 3 - o1;  // (3,0) (2,1) (1,2) (0,3): differentiate a second derivative once more
+      const int dir = o1 > 0 ? 0 : 1;
+      const Vec2 step = dir == 0 ? Vec2(kFdStep, 0) : Vec2(0, kFdStep);
+      const int l1 = o1 - (dir == 0), l2 = o2 - (dir == 1);
+      const Eigen::Matrix<double, 16, 1> fd =
+          (BicubicHermite::derivative(xi + step, l1, l2) - BicubicHermite::derivative(xi - step, l1, l2)) /
+          (2 * kFdStep);
+      const Eigen::Matrix<double, 16, 1> d = BicubicHermite::derivative(xi, o1, o2);
+      for (int k = 0; k < 16; ++k)
+        EXPECT_NEAR(d[k], fd[k], kFdFirst) << "function " << k << " order (" << o1 << "," << o2 << ") at " << str(xi);
+    }
+  }
+  // Fourth derivatives in one direction vanish (cubic in each variable).
+  EXPECT_EQ(BicubicHermite::derivative(Vec2(0.2, 0.6), 4, 0).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(BasisBicubic, RecordsRequestedUpdates) {

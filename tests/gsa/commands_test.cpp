@@ -403,6 +403,49 @@ TEST_F(GsaCli, HelpAndVersion) {
   EXPECT_THAT(r.out, AllOf(HasSubstr("--method"), HasSubstr("--out")));
 }
 
+// The forming limit margin does not depend on the pictures: with --no-plots the curve is
+// still read and strains.csv still gets flc_margin (docs/usage.md, "--flc"); a missing
+// curve file is an error naming it.
+TEST_F(GsaCli, FormingLimitMarginIsWrittenWithoutPictures) {
+  const std::string grid = synth("stretch");
+  const std::string flc = dir_.file("flc.csv");
+  write_text(flc, "# test curve\nminor,major\n-0.2,0.3\n0,0.1\n");
+  const std::string folder = dir_.file("out");
+  const CommandResult r =
+      run_gsa(dir_, "analyse " + quoted(grid) + " --no-plots --flc " + quoted(flc) + " --out " + quoted(folder));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("0 of 441 marks beyond the forming limit curve"));
+  EXPECT_EQ(entries(folder).count("report.html"), 0u);
+  const Strains s = read_strains(folder);
+  ASSERT_TRUE(s.t.has_column("flc_margin"));
+  EXPECT_EQ(s.t.column_index("flc_margin"), s.t.n_columns() - 1);
+  EXPECT_THAT(read_text(folder + "/strains.csv"), HasSubstr("# flc_margin: "));
+  for (const auto& [id, row] : s.row) {
+    // The curve's major strain at the mark's minor true strain, minus its major true strain.
+    const double minor = s.num(id, "true2"), major = s.num(id, "true1");
+    const double expected = 0.1 + (0.3 - 0.1) * (minor / -0.2) - major;
+    EXPECT_NEAR(s.num(id, "flc_margin"), expected, 1e-12) << id;
+  }
+  // With --measure engineering the margin is in engineering strain.
+  const std::string eng = dir_.file("eng");
+  ASSERT_EQ(run_gsa(dir_, "analyse " + quoted(grid) + " --no-plots --measure engineering --flc " + quoted(flc) +
+                              " --out " + quoted(eng))
+                .exit_code,
+            0);
+  const Strains e = read_strains(eng);
+  const std::string id(e.t.cell(0, e.t.column_index("id")));
+  EXPECT_NEAR(e.num(id, "flc_margin"), 0.1 + 0.2 * (e.num(id, "eng2") / -0.2) - e.num(id, "eng1"), 1e-12);
+  // A missing curve file: exit 1 naming it, with or without pictures, and no output.
+  for (const std::string plots : {" --no-plots", ""}) {
+    const std::string missing = dir_.file("no_such_flc.csv"), out = dir_.file("missing_out");
+    const CommandResult m =
+        run_gsa(dir_, "analyse " + quoted(grid) + plots + " --flc " + quoted(missing) + " --out " + quoted(out));
+    EXPECT_EQ(m.exit_code, 1) << plots;
+    EXPECT_THAT(m.err, HasSubstr(missing)) << plots;
+    EXPECT_FALSE(fs::exists(out)) << plots;
+  }
+}
+
 // LIBRARY BUG (reported to the lead): option VALUES that are wrong are usage errors
 // (CONTRACT.md: exit 2), but `gsa analyse G --out O --delimiter xx` and
 // `... --columns foo` exit 1 (parse_delimiter / parse_column_map throw InputError),

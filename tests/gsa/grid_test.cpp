@@ -1,7 +1,6 @@
-// Reading grid files (CONTRACT.md "Grid file"): the one-file and two-file forms,
-// column mapping with displacements, missing cells, and the messages of bad input
-// (file:line:column, both lines of a duplicate, the columns found), plus the
-// grids `gsa analyse` must refuse (too few points, collinear points).
+// Grid input as gsa takes it: the texts of --columns and --delimiter (the command layer,
+// gsa/command_options.hpp) and the grids `gsa analyse` must refuse (too few points,
+// collinear points). Reading and writing grid files: tests/common/io_grid_file_test.cpp.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -10,6 +9,7 @@
 
 #include "common/core/error.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/command_options.hpp"
 #include "gsa/grid.hpp"
 #include "tests/common/io_test_util.hpp"
 #include "tests/common/tolerances.hpp"
@@ -46,125 +46,14 @@ std::string seven_rows() {
   return s;
 }
 
-TEST(GsaGrid, ReadsOneFileWithColumnsInAnyOrderCommentsAndIJ) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path,
-             "# a grid\n"
-             "z,y,x,j,i,Z,Y,X,id\n"
-             "3.5,2.5,1.5,0,1,0.5,0.25,0.125,a\n"
-             "# comment in the middle\n"
-             "-3,-2,-1,1,1,0,-0.5,1e-3,b\n");
-  const GridData g = read_grid(path);
-  ASSERT_EQ(g.n_points(), 2);
-  EXPECT_THAT(g.ids, ElementsAre("a", "b"));
-  EXPECT_LT((row(g.undeformed, 0) - Vec3(0.125, 0.25, 0.5)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 0) - Vec3(1.5, 2.5, 3.5)).norm(), kRead);
-  EXPECT_LT((row(g.undeformed, 1) - Vec3(1e-3, -0.5, 0)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 1) - Vec3(-1, -2, -3)).norm(), kRead);
-  ASSERT_TRUE(g.has_ij);
-  EXPECT_THAT(g.i, ElementsAre(1, 1));
-  EXPECT_THAT(g.j, ElementsAre(0, 1));
-  // Each point knows where it came from, with the real line number (comments count).
-  EXPECT_EQ(g.where[0], path + ":3");
-  EXPECT_EQ(g.where[1], path + ":5");
-  EXPECT_THAT(g.sources, ElementsAre(path));
-}
-
-TEST(GsaGrid, IJAreOptional) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "id,X,Y,Z,x,y,z,i\np,0,0,0,1,1,1,4\n");  // i without j: no grid indices
-  const GridData g = read_grid(path);
-  EXPECT_FALSE(g.has_ij);
-  EXPECT_TRUE(g.i.empty());
-  EXPECT_TRUE(g.j.empty());
-}
-
-TEST(GsaGrid, NanOrEmptyCellMeansNotDigitised) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path,
-             "id,X,Y,Z,x,y,z\n"
-             "full,1,2,3,4,5,6\n"
-             "nodef,1,2,3,nan,5,6\n"
-             "nodef2,1,2,3,4,NaN,6\n"
-             "nodef3,1,2,3,4,5,\n"
-             "noundef,,2,3,4,5,6\n");
-  const GridData g = read_grid(path);
-  ASSERT_EQ(g.n_points(), 5);
-  EXPECT_TRUE(g.has_undeformed(0) && g.has_deformed(0));
-  for (Index p : {1, 2, 3}) {
-    EXPECT_TRUE(g.has_undeformed(p)) << g.ids[p];
-    EXPECT_FALSE(g.has_deformed(p)) << g.ids[p];
-    // A partly missing position is missing altogether (no half-known point).
-    EXPECT_TRUE(g.deformed.row(p).array().isNaN().all()) << g.ids[p];
-  }
-  EXPECT_FALSE(g.has_undeformed(4));
-  EXPECT_TRUE(g.has_deformed(4));
-}
-
-TEST(GsaGrid, PairOfFilesIsJoinedOnIdInAnyRowOrder) {
-  ScratchDir dir;
-  const std::string u = dir.file("u.csv"), d = dir.file("d.csv");
-  write_text(u, "id,x,y,z,i,j\np1,0,0,0,0,0\np2,1,0,0,0,1\np3,0,1,0,1,0\np4,1,1,0,1,1\n");
-  write_text(d, "# deformed, other order, p3 not digitised\nz,id,y,x\n0.4,p4,1.4,1.4\n0.2,p2,0.2,1.2\n0.1,p1,0.1,0.1\n");
-  const GridData g = read_grid_pair(u, d);
-  ASSERT_EQ(g.n_points(), 4);
-  EXPECT_THAT(g.ids, ElementsAre("p1", "p2", "p3", "p4"));
-  EXPECT_LT((row(g.undeformed, 3) - Vec3(1, 1, 0)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 0) - Vec3(0.1, 0.1, 0.1)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 1) - Vec3(1.2, 0.2, 0.2)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 3) - Vec3(1.4, 1.4, 0.4)).norm(), kRead);
-  EXPECT_TRUE(g.has_undeformed(2));
-  EXPECT_FALSE(g.has_deformed(2));
-  ASSERT_TRUE(g.has_ij);
-  EXPECT_THAT(g.i, ElementsAre(0, 0, 1, 1));
-  EXPECT_THAT(g.sources, ElementsAre(u, d));
-}
-
-TEST(GsaGrid, PairRejectsUnknownAndDuplicateIdsInTheDeformedFile) {
-  ScratchDir dir;
-  const std::string u = dir.file("u.csv"), d = dir.file("d.csv");
-  write_text(u, "id,x,y,z\np1,0,0,0\np2,1,0,0\n");
-  write_text(d, "id,x,y,z\np1,0,0,0\nq9,1,0,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_pair(u, d); }),
-              AllOf(HasSubstr(d + ":3:"), HasSubstr("'q9'"), HasSubstr(u)));
-  write_text(d, "id,x,y,z\np1,0,0,0\np2,1,0,0\np1,2,0,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_pair(u, d); }),
-              AllOf(HasSubstr(d + ":4:"), HasSubstr("duplicate id 'p1'")));
-}
-
-TEST(GsaGrid, ColumnMapWithDisplacements) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "label,x0,y0,z0,du,dv,dw\nk1,1,2,3,0.5,-0.5,0.25\nk2,10,20,30,,1,1\n");
-  GridReadOptions o;
-  o.columns = parse_column_map("id=label,X=x0,Y=y0,Z=z0,u=du,v=dv,w=dw");
-  EXPECT_EQ(o.columns.at("u"), "du");
-  const GridData g = read_grid(path, o);
-  ASSERT_EQ(g.n_points(), 2);
-  EXPECT_THAT(g.ids, ElementsAre("k1", "k2"));
-  EXPECT_LT((row(g.undeformed, 0) - Vec3(1, 2, 3)).norm(), kRead);
-  EXPECT_LT((row(g.deformed, 0) - Vec3(1.5, 1.5, 3.25)).norm(), kRead);  // x = X + u
-  EXPECT_TRUE(g.has_undeformed(1));
-  EXPECT_FALSE(g.has_deformed(1));  // a missing displacement is a missing deformed position
-}
-
-TEST(GsaGrid, ColumnMapRenamesPositions) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "id,X,Y,Z,xd,yd,zd\nk1,1,2,3,4,5,6\n");
-  GridReadOptions o;
-  o.columns = parse_column_map("x=xd,y=yd,z=zd");
-  const GridData g = read_grid(path, o);
-  EXPECT_LT((row(g.deformed, 0) - Vec3(4, 5, 6)).norm(), kRead);
-}
-
 TEST(GsaGrid, BadColumnMapTextIsRejectedNamingTheOption) {
   EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X=x0,Y"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Y'")));
   EXPECT_THAT(message_of<UsageError>([] { parse_column_map("Q=x0"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Q'")));
   EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X="); }), HasSubstr("--columns"));
+  const auto map = parse_column_map("id=label,X=x0,u=du");
+  EXPECT_EQ(map.size(), 3u);
+  EXPECT_EQ(map.at("id"), "label");
+  EXPECT_EQ(map.at("u"), "du");
 }
 
 TEST(GsaGrid, DelimiterNames) {
@@ -182,42 +71,6 @@ TEST(GsaGrid, DelimiterNames) {
   EXPECT_THAT(message_of<InputError>([&] { read_grid(path, o); }), HasSubstr(path + ":2:2:"));
   write_text(path, "id;X;Y;Z;x;y;z\nk1;1.5;2;3;4;5;6\n");
   EXPECT_LT((row(read_grid(path, o).undeformed, 0) - Vec3(1.5, 2, 3)).norm(), kRead);
-}
-
-TEST(GsaGrid, MalformedNumberNamesFileLineAndColumn) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "# header follows\nid,X,Y,Z,x,y,z\np1,0,0,0,0,0,0\np2,1,2x,3,4,5,6\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid(path); }),
-              AllOf(HasSubstr(path + ":4:3:"), HasSubstr("'Y'"), HasSubstr("2x")));
-  write_text(path, "id,X,Y,Z,x,y,z,i,j\np1,0,0,0,0,0,0,1.5,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid(path); }), AllOf(HasSubstr(path + ":2:8:"), HasSubstr("'i'")));
-}
-
-TEST(GsaGrid, DuplicateIdNamesBothLines) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "id,X,Y,Z,x,y,z\np1,0,0,0,0,0,0\np2,1,0,0,1,0,0\n\np1,2,0,0,2,0,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid(path); }),
-              AllOf(HasSubstr(path + ":5:"), HasSubstr("'p1'"), HasSubstr("line 2")));
-}
-
-TEST(GsaGrid, MissingColumnListsTheColumnsFound) {
-  ScratchDir dir;
-  const std::string path = dir.file("grid.csv");
-  write_text(path, "id,X,Y,x,y,z\np1,0,0,0,0,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid(path); }),
-              AllOf(HasSubstr(path), HasSubstr("'Z'"), HasSubstr("id, X, Y, x, y, z")));
-  // Displacement mapping: the displacement columns are the required ones.
-  write_text(path, "id,X,Y,Z,u,v\np1,0,0,0,0,0\n");
-  GridReadOptions o;
-  o.columns = parse_column_map("u=u,v=v,w=w");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid(path, o); }), AllOf(HasSubstr("'w'"), HasSubstr("id, X, Y, Z, u, v")));
-}
-
-TEST(GsaGrid, MissingFileIsNamed) {
-  EXPECT_THAT(message_of<InputError>([] { read_grid("/nonexistent/dir/grid.csv"); }),
-              HasSubstr("/nonexistent/dir/grid.csv"));
 }
 
 // ---------------------------------------------------------------- grids analyse refuses

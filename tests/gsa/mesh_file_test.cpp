@@ -54,7 +54,7 @@ TEST(GsaMeshFile, UserQuadMeshAnalysesTheDomeAccurately) {
   std::vector<ExactStrain> exact;
   const GridData g = make_synthetic_grid(synthetic_case("dome"), {}, &exact);
   AnalyseOptions o;
-  o.mesh_file = path;
+  o.mesh.file = path;
   const AnalysisResult r = analyse(g, o);
   EXPECT_EQ(r.mesh.n_elements(), 36);
   const StrainError e = strain_error(g, r, exact);

@@ -20,7 +20,10 @@
 #include "common/render/scene.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/output.hpp"
+#include "gsa/command_options.hpp"
+#include "gsa/flc.hpp"
 #include "gsa/plots.hpp"
+#include "gsa/results_folder.hpp"
 #include "gsa/synthetic.hpp"
 
 namespace sf::gsa {
@@ -51,7 +54,7 @@ void analyse_case(const std::string& name, const fs::path& dir, int n = 9, std::
   o.fibre_angles = std::move(fibres);
   AnalysisResult r = method == Method::kSurface ? analyse(grid, o) : analyse_triangles(grid, o);
   io::AtomicOutputDir out(dir);
-  write_results(out, grid, r, o, RunInfo{"test", {name}});
+  write_results(out, grid, r, OutputOptions{}, RunInfo{"test", {name}});
   out.commit();
 }
 
@@ -63,6 +66,13 @@ PlotOptions small_pictures() {
 
 std::function<std::string(const std::string&)> into(const fs::path& dir) {
   return [dir](const std::string& name) { return (dir / name).string(); };
+}
+
+// `gsa plot DIR` without the command line: the pictures of a results folder, redrawn in place.
+Redrawn redraw(const fs::path& dir, const PlotOptions& o, const std::string& flc = "") {
+  std::optional<FormingLimitCurve> curve;
+  if (!flc.empty()) curve = read_flc(flc);
+  return redraw_results_folder(dir.string(), StrainMeasure::kTrue, curve, o, into(dir));
 }
 
 std::string read_text(const fs::path& p) {
@@ -80,7 +90,7 @@ std::string read_text(const fs::path& p) {
 TEST(GsaPlots, ArrowsOnAHomogeneousStretchLandWhereExpected) {
   const fs::path dir = test_dir("stretch_arrows");
   analyse_case("stretch", dir);
-  const ResultsFolder r = read_results_folder(dir.string());
+  const PlotData r = plot_data(read_results_folder(dir.string()), StrainMeasure::kTrue);
   ASSERT_TRUE(r.has_surfaces);
   PlotOptions o = small_pictures();
   const render::Scene scene = arrow_diagram(r, false, o);
@@ -126,7 +136,7 @@ TEST(GsaPlots, ArrowsOnAHomogeneousStretchLandWhereExpected) {
 TEST(GsaPlots, WritesEveryPictureAndTheReport) {
   const fs::path dir = test_dir("all_pictures");
   analyse_case("dome", dir);
-  const PlotSummary s = write_pictures(dir.string(), into(dir), small_pictures());
+  const PlotSummary s = redraw(dir, small_pictures()).pictures;
   const std::vector<std::string> expected = {"arrows_undeformed.png", "arrows_deformed.png", "thickness.png",
                                              "major_strain.png",      "minor_strain.png",    "principal_strains.png"};
   EXPECT_EQ(s.pictures, expected);
@@ -151,7 +161,7 @@ TEST(GsaPlots, WritesEveryPictureAndTheReport) {
 TEST(GsaPlots, UniformThicknessIsOneBand) {
   const fs::path dir = test_dir("uniform_thickness");
   analyse_case("stretch", dir);
-  write_pictures(dir.string(), into(dir), small_pictures());
+  redraw(dir, small_pictures());
   const render::RgbImage img = render::read_png_rgb((dir / "thickness.png").string());
   // The part fills the middle of the frame; sample a small patch around its centre.
   const render::Colour c = img.at(150, 160);
@@ -167,13 +177,13 @@ TEST(GsaPlots, FormingLimitMarginIsWrittenPerMark) {
   // curve through (-0.2, 0.3) and (0, 0.1) has major 0.2054 there: margin 0.0231.
   const fs::path flc = dir / "flc.csv";
   std::ofstream(flc) << "# test curve\nmajor,minor\n0.1,0\n0.3,-0.2\n";
-  PlotOptions o = small_pictures();
-  o.flc_path = flc.string();
-  const PlotSummary s = write_pictures(dir.string(), into(dir), o);
-  EXPECT_TRUE(s.flc);
-  EXPECT_EQ(s.n_beyond_flc, 0);
+  const PlotOptions o = small_pictures();
+  const Redrawn s = redraw(dir, o, flc.string());
+  ASSERT_TRUE(s.margins);
+  EXPECT_EQ(s.margins->n_beyond, 0);
+  EXPECT_EQ(s.margins->n_marks, 81);
   const double expected = 0.1 + 0.2 * (-std::log(0.9) / 0.2) - std::log(1.2);
-  EXPECT_NEAR(s.min_flc_margin, expected, 1e-4);
+  EXPECT_NEAR(s.margins->min_margin, expected, 1e-4);
   const io::CsvTable t = io::read_csv((dir / "strains.csv").string());
   const std::size_t c = t.column_index("flc_margin");
   EXPECT_EQ(c, t.n_columns() - 1);
@@ -181,17 +191,58 @@ TEST(GsaPlots, FormingLimitMarginIsWrittenPerMark) {
   EXPECT_NE(read_text(dir / "strains.csv").find("# flc_margin"), std::string::npos);
   // Drawn again with a lower curve: every mark is beyond it; the column is replaced.
   std::ofstream(flc) << "minor,major\n-0.2,0.15\n0,0.05\n";
-  const PlotSummary s2 = write_pictures(dir.string(), into(dir), o);
-  EXPECT_EQ(s2.n_beyond_flc, 81);
+  const Redrawn s2 = redraw(dir, o, flc.string());
+  EXPECT_EQ(s2.margins->n_beyond, 81);
   const io::CsvTable t2 = io::read_csv((dir / "strains.csv").string());
   EXPECT_EQ(t2.n_columns(), t.n_columns());
   EXPECT_LT(t2.number(0, t2.column_index("flc_margin")), 0);
 }
 
+// `gsa analyse` draws from the results in memory, `gsa plot` from the files: the same
+// pictures, report and strains.csv (with the forming limit margin) byte for byte.
+TEST(GsaPlots, PicturesFromMemoryEqualPicturesRedrawnFromTheFolder) {
+  const fs::path dir = test_dir("memory"), again = test_dir("memory_again");
+  std::ofstream(dir.parent_path() / "memory_flc.csv") << "minor,major\n-0.3,0.3\n0,0.1\n0.3,0.25\n";
+  const FormingLimitCurve flc = read_flc((dir.parent_path() / "memory_flc.csv").string());
+  SyntheticGridOptions g;
+  g.n = 9;
+  g.spacing = 10;
+  const GridData grid = make_synthetic_grid(synthetic_case("dome"), g);
+  AnalysisResult r = analyse(grid, {});
+  OutputOptions out_options;
+  out_options.flc = flc;
+  out_options.keep_surfaces = true;
+  PlotSummary drawn;
+  {
+    io::AtomicOutputDir out(dir);
+    WrittenResults written = write_results(out, grid, r, out_options, RunInfo{"test", {"dome/grid.csv"}});
+    ASSERT_TRUE(written.margins);
+    EXPECT_EQ(written.margins->n_marks, 81);
+    PlotData data = plot_data(r, written.summary, std::move(written.undeformed), std::move(written.deformed),
+                              dir.string(), StrainMeasure::kTrue);
+    data.flc = flc;
+    data.margins = written.margins;
+    drawn = write_pictures(data, small_pictures(), [&out](const std::string& n) { return out.path(n); });
+    out.commit();
+  }
+  // Redrawn from the folder's files into another folder.
+  const Redrawn redrawn = redraw_results_folder(dir.string(), StrainMeasure::kTrue, flc, small_pictures(), into(again));
+  EXPECT_EQ(redrawn.pictures.pictures, drawn.pictures);
+  EXPECT_EQ(redrawn.pictures.n_marks, drawn.n_marks);
+  std::vector<std::string> files = drawn.pictures;
+  files.insert(files.end(), {"report.html", "strains.csv"});
+  for (const std::string& name : files) {
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(fs::exists(again / name));
+    EXPECT_TRUE(read_text(dir / name) == read_text(again / name)) << "differs";
+  }
+  EXPECT_NE(read_text(dir / "report.html").find("marks beyond the curve"), std::string::npos);
+}
+
 TEST(GsaPlots, FibreModeDrawsShearAngleAndFibres) {
   const fs::path dir = test_dir("fibres");
   analyse_case("trellis", dir, 9, {0, 90});
-  const PlotSummary s = write_pictures(dir.string(), into(dir), small_pictures());
+  const PlotSummary s = redraw(dir, small_pictures()).pictures;
   EXPECT_NE(std::find(s.pictures.begin(), s.pictures.end(), "shear_angle.png"), s.pictures.end());
   EXPECT_NE(std::find(s.pictures.begin(), s.pictures.end(), "fibres.png"), s.pictures.end());
   EXPECT_TRUE(fs::exists(dir / "shear_angle.png"));
@@ -201,7 +252,7 @@ TEST(GsaPlots, FibreModeDrawsShearAngleAndFibres) {
 TEST(GsaPlots, TriangleMethodGetsTheStrainPlotOnly) {
   const fs::path dir = test_dir("triangles");
   analyse_case("stretch", dir, 9, {}, Method::kTriangles);
-  const PlotSummary s = write_pictures(dir.string(), into(dir), small_pictures());
+  const PlotSummary s = redraw(dir, small_pictures()).pictures;
   EXPECT_EQ(s.pictures, std::vector<std::string>{"principal_strains.png"});
   EXPECT_TRUE(fs::exists(dir / "report.html"));
   EXPECT_FALSE(fs::exists(dir / "thickness.png"));

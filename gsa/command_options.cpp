@@ -1,0 +1,164 @@
+#include "gsa/command_options.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/core/error.hpp"
+#include "common/io/grid_file.hpp"
+#include "common/render/scene.hpp"
+#include "gsa/flc.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+std::vector<double> parse_angles(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--fibres: expected angles in degrees separated by commas (e.g. 0,90), found '" + item + "'");
+    }
+  }
+  return out;
+}
+
+// "--elements NxM" into the mesh options.
+void parse_elements(const std::string& text, MeshOptions& mesh) {
+  const auto x = text.find('x');
+  try {
+    if (x == std::string::npos) throw std::invalid_argument("x");
+    mesh.elements1 = std::stoi(text.substr(0, x));
+    mesh.elements2 = std::stoi(text.substr(x + 1));
+  } catch (const std::exception&) {
+    throw UsageError("--elements: expected NxM (e.g. 8x6), found '" + text + "'");
+  }
+  if (mesh.elements1 < 1 || mesh.elements2 < 1) throw UsageError("--elements: counts must be >= 1");
+}
+
+Method parse_method(const std::string& text) {
+  if (text == "surface") return Method::kSurface;
+  if (text == "triangles") return Method::kTriangles;
+  throw UsageError("--method: expected 'surface' or 'triangles', found '" + text + "'");
+}
+
+PenaltyKind parse_penalty(const std::string& text) {
+  if (text == "third") return PenaltyKind::kThirdOrder;
+  if (text == "sobolev") return PenaltyKind::kSobolev;
+  if (text == "jumps") return PenaltyKind::kJumps;
+  throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + text + "'");
+}
+
+// Runs a library validate() and turns its field into the user's flag.
+template <class Options>
+void validate_for_the_command_line(const Options& options) {
+  try {
+    options.validate();
+  } catch (const OptionError& e) {
+    throw UsageError(flag_of_field(e.field()) + ": " + e.problem());
+  }
+}
+
+}  // namespace
+
+std::string flag_of_field(const std::string& field) {
+  static const std::map<std::string, std::string> flags = {
+      {"mesh.elements1", "--elements"},    {"mesh.elements2", "--elements"},
+      {"mesh.file", "--mesh"},             {"smoothing.alpha", "--alpha"},
+      {"smoothing.beta", "--beta"},        {"smoothing.gamma", "--gamma"},
+      {"smoothing.delta", "--delta"},      {"smoothing.scale", "--smoothing-scale"},
+      {"outliers.sigma", "--outlier-sigma"}, {"fibre_angles", "--fibres"},
+      {"sample", "--sample"},              {"units", "--units"},
+  };
+  const auto it = flags.find(field);
+  return it == flags.end() ? field : it->second;
+}
+
+AnalyseOptions analyse_options(const AnalyseFlags& a) {
+  AnalyseOptions o;
+  o.method = parse_method(a.method);
+  o.smoothing.penalty = parse_penalty(a.penalty);
+  if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
+  o.mesh.file = a.mesh;
+  if (!a.elements.empty()) parse_elements(a.elements, o.mesh);
+  if (!std::isnan(a.alpha)) o.smoothing.alpha = a.alpha;
+  if (!std::isnan(a.beta)) o.smoothing.beta = a.beta;
+  if (!std::isnan(a.gamma)) o.smoothing.gamma = a.gamma;
+  if (!std::isnan(a.delta)) o.smoothing.delta = a.delta;
+  o.smoothing.scale = a.smoothing_scale;
+  o.outliers.sigma = a.outlier_sigma;
+  if (!a.fibres.empty()) o.fibre_angles = parse_angles(a.fibres);
+  validate_for_the_command_line(o);
+  return o;
+}
+
+OutputOptions output_options(const AnalyseFlags& a) {
+  OutputOptions o;
+  o.units = a.units;
+  o.sample = a.sample;
+  o.measure = parse_measure(a.measure, "--measure");
+  if (!a.flc.empty()) o.flc = read_flc(a.flc);
+  validate_for_the_command_line(o);
+  return o;
+}
+
+PlotOptions plot_options(const std::string& size, const std::string& view) {
+  PlotOptions o;
+  o.size = render::parse_size(size, "--size");
+  o.view = render::parse_view(view, "--view");
+  return o;
+}
+
+StrainMeasure parse_measure(const std::string& text, const std::string& option) {
+  std::string t = text;
+  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (t == "true" || t == "logarithmic" || t == "natural") return StrainMeasure::kTrue;
+  if (t == "engineering") return StrainMeasure::kEngineering;
+  if (t == "lagrangian" || t == "green") return StrainMeasure::kLagrangian;
+  throw UsageError(option + ": expected true, engineering or lagrangian, found '" + text + "'");
+}
+
+GridReadOptions grid_read_options(const AnalyseFlags& a) {
+  GridReadOptions o;
+  o.delimiter = parse_delimiter(a.delimiter);
+  if (!a.columns.empty()) o.columns = parse_column_map(a.columns);
+  return o;
+}
+
+std::map<std::string, std::string> parse_column_map(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    const std::size_t eq = item.find('=');
+    if (item.empty() || eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      throw UsageError("--columns: expected NAME=COLUMN pairs separated by commas (e.g. X=x0,u=disp_x), found '" +
+                       item + "'");
+    const std::string key = item.substr(0, eq);
+    if (!io::is_grid_column_key(key))
+      throw UsageError("--columns: unknown name '" + key + "' (expected one of id X Y Z x y z u v w i j)");
+    out[key] = item.substr(eq + 1);
+    start = end + 1;
+  }
+  return out;
+}
+
+char parse_delimiter(const std::string& text) {
+  if (text == "tab" || text == "\\t") return '\t';
+  if (text == "comma") return ',';
+  if (text == "semicolon") return ';';
+  if (text == "space") return ' ';
+  if (text.size() == 1) return text[0];
+  throw UsageError("--delimiter: expected one character or tab/comma/semicolon/space, found '" + text + "'");
+}
+
+}  // namespace sf::gsa

@@ -1,0 +1,54 @@
+#pragma once
+// The command layer of gsa: the flags of the command line, as typed, turned into the
+// fields of the library's option structs (AnalyseOptions, OutputOptions, GridReadOptions).
+// The library names fields in its errors; here they become the user's flags:
+// "--smoothing-scale: must be > 0, found 0". Errors are sf::UsageError (exit code 2).
+
+#include <limits>
+#include <map>
+#include <string>
+
+#include "gsa/analysis.hpp"
+#include "gsa/grid.hpp"
+#include "gsa/output.hpp"
+#include "gsa/plots.hpp"
+#include "gsa/strain_measure.hpp"
+
+namespace sf::gsa {
+
+// The flags of `gsa analyse` (docs/usage.md); NaN weights are "not given".
+struct AnalyseFlags {
+  std::string grid, undeformed, deformed, out;
+  std::string method = "surface", penalty = "jumps", elements, mesh, columns, delimiter = ",", fibres, units = "mm";
+  double alpha = std::numeric_limits<double>::quiet_NaN(), beta = std::numeric_limits<double>::quiet_NaN(),
+         gamma = std::numeric_limits<double>::quiet_NaN(), delta = std::numeric_limits<double>::quiet_NaN();
+  double outlier_sigma = 6.0, smoothing_scale = 1.0;
+  int sample = 0;
+  bool no_plots = false;
+  std::string measure = "true", size = "1200x900", view = "auto", flc;  // pictures
+};
+
+// --method, --penalty, --mesh/--elements, --alpha.. --delta, --smoothing-scale,
+// --outlier-sigma, --fibres; validated, errors naming the flag.
+AnalyseOptions analyse_options(const AnalyseFlags& flags);
+// --units, --sample, --measure and --flc (the curve is read here: a missing or bad file is
+// an sf::InputError naming it, with or without pictures); validated, errors naming the flag.
+OutputOptions output_options(const AnalyseFlags& flags);
+// --size, --view of the pictures.
+PlotOptions plot_options(const std::string& size, const std::string& view);
+// "true" (also "logarithmic", "natural"), "engineering" or "lagrangian" (also "green"), any
+// letter case; errors name `option`.
+StrainMeasure parse_measure(const std::string& text, const std::string& option = "--measure");
+// --columns, --delimiter.
+GridReadOptions grid_read_options(const AnalyseFlags& flags);
+
+// The flag that sets a field of AnalyseOptions or OutputOptions ("smoothing.scale" ->
+// "--smoothing-scale"); the field itself when no flag sets it.
+std::string flag_of_field(const std::string& field);
+
+// "--columns" text "X=x0,Y=y0,u=disp_x" -> key -> column name (keys: io::kGridColumnKeys).
+std::map<std::string, std::string> parse_column_map(const std::string& text);
+// "--delimiter": one character, or "tab", "comma", "semicolon", "space".
+char parse_delimiter(const std::string& text);
+
+}  // namespace sf::gsa

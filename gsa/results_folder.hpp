@@ -1,0 +1,42 @@
+#pragma once
+// A results folder of `gsa analyse` read back (for `gsa plot DIR`): strains.csv,
+// summary.json and, from the surface method, undeformed.vtp and deformed.vtp.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/io/csv.hpp"
+#include "common/io/vtk_xml.hpp"
+#include "gsa/flc.hpp"
+#include "gsa/strain_measure.hpp"
+
+namespace sf::gsa {
+
+struct ResultsFolder {
+  std::string dir;
+  nlohmann::json summary;            // summary.json (null if absent)
+  io::CsvTable strains;              // strains.csv
+  bool has_surfaces = false;         // undeformed.vtp and deformed.vtp present (surface method)
+  io::PolyMesh undeformed, deformed;
+};
+// Throws sf::InputError when DIR has no strains.csv or its files do not belong together.
+ResultsFolder read_results_folder(const std::string& dir);
+
+// What summary.json says about the run, with defaults for a missing summary.
+std::string units_of(const nlohmann::json& summary);                // length unit ("mm")
+std::vector<double> fibre_angles_of(const nlohmann::json& summary);  // degrees; empty unless fibre mode
+// "dome/grid.csv": the first input's folder and name; the folder's name without inputs.
+std::string case_name_of(const nlohmann::json& summary, const std::string& dir);
+
+// Major and minor strain per row of strains.csv in one measure (NaN unless status ok).
+// Throws sf::InputError when the measure's columns are missing or hold bad numbers.
+MarkStrains mark_strains(const io::CsvTable& strains, StrainMeasure m);
+
+// Writes the folder's strains.csv to `out` with a last column flc_margin (replacing one
+// already there), keeping its comment lines and adding flc_margin_comment().
+void write_strains_with_margin(const ResultsFolder& folder, const std::string& out, const FlcMargins& margins);
+
+}  // namespace sf::gsa

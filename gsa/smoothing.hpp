@@ -1,0 +1,63 @@
+#pragma once
+// The smoothing weights of `gsa analyse` (docs/theory/strain.md, "Automatic smoothing"):
+// explicit weights, the noise rule, and the choice of the deformed fit's weight by
+// generalised cross-validation (GCV).
+//
+// A smoothing choice is a replaceable step: any function that takes the deformed fit's
+// problem (its data, weights and least-squares system, gsa/deformed_fit.hpp) and returns
+// a SmoothingChoice can stand where choose_smoothing_gcv() stands in analyse().
+
+#include <limits>
+#include <optional>
+
+#include "gsa/fit.hpp"
+
+namespace sf::gsa {
+
+class DeformedProblem;
+
+enum class PenaltyKind {
+  kThirdOrder,  // gamma: third derivatives with edge jumps of the second (--penalty third)
+  kSobolev,     // alpha, beta: the brief's first and second derivatives (--penalty sobolev)
+  kJumps,       // delta: fourth-order edge jumps, weight by GCV (--penalty jumps, the default)
+};
+
+struct SmoothingOptions {
+  PenaltyKind penalty = PenaltyKind::kJumps;
+  // Explicit weights: giving any switches the automatic choice off; these are used for
+  // both fits and the unset ones are 0. Units: alpha 1, beta units^2, gamma units^4,
+  // delta units^6 (each >= 0).
+  std::optional<double> alpha, beta, gamma, delta;
+  double scale = 1.0;  // multiplies the automatic weights (> 0; > 1 smoother)
+
+  bool automatic() const { return !alpha && !beta && !gamma && !delta; }
+  // Automatic jumps: the deformed weight is chosen by cross-validation.
+  bool chooses_by_gcv() const { return automatic() && penalty == PenaltyKind::kJumps; }
+};
+
+// The explicit weights (unset ones 0).
+Penalty explicit_penalty(const SmoothingOptions& options);
+// The noise rule: weights of the options' penalty kind from the digitisation noise sigma
+// (per coordinate, units) and the mark spacing d (units).
+Penalty noise_rule_penalty(const SmoothingOptions& options, double sigma, double mark_spacing);
+// Explicit weights, or the noise rule when automatic.
+Penalty penalty_for_noise(const SmoothingOptions& options, double sigma, double mark_spacing);
+
+// Effective smoothing length (units) of a penalty: the largest of (gamma/rho)^(1/6),
+// (beta/rho)^(1/4), (delta/rho)^(1/8), rho = 1/d^2.
+double gauge_length(const Penalty& penalty, double mark_spacing);
+
+struct SmoothingChoice {
+  Penalty penalty;
+  int passes = 1;  // of the fit (iterated Tikhonov, gsa/fit.hpp)
+  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // GCV optimum, log10(delta / d^6)
+};
+
+// Generalised cross-validation of the deformed positions over log10(delta / d^6) in
+// [-6, 6], two candidates at a time (solved in parallel), each candidate fitted with two
+// passes; the weight used is 2 x the optimum (strains want more smoothing than
+// positions) times options.scale. Fits the problem's current data with its current
+// weights; leaves its data and weights as they are.
+SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOptions& options, double mark_spacing);
+
+}  // namespace sf::gsa

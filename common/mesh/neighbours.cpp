@@ -1,0 +1,71 @@
+#include "common/mesh/neighbours.hpp"
+
+// CGAL stays in this translation unit (header-only, slow to compile, private link).
+#include <CGAL/Fuzzy_sphere.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/property_map.h>
+
+#include <iterator>
+#include <utility>
+
+namespace sf::mesh {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Sample = std::pair<Point, Index>;
+using SamplePointMap = CGAL::First_of_pair_property_map<Sample>;
+using Traits = CGAL::Search_traits_adapter<Sample, SamplePointMap, CGAL::Search_traits_3<Kernel>>;
+using Search = CGAL::Orthogonal_k_neighbor_search<Traits>;
+using Tree = Search::Tree;
+using Sphere = CGAL::Fuzzy_sphere<Traits>;
+
+std::vector<Sample> finite_samples(const Points3& points) {
+  std::vector<Sample> s;
+  s.reserve(static_cast<std::size_t>(points.rows()));
+  for (Index p = 0; p < points.rows(); ++p)
+    if (points.row(p).allFinite()) s.emplace_back(Point(points(p, 0), points(p, 1), points(p, 2)), p);
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k) {
+  std::vector<std::vector<Index>> out(static_cast<std::size_t>(points.rows()));
+  const std::vector<Sample> samples = finite_samples(points);
+  if (samples.size() < 2 || k <= 0) return out;
+  Tree tree(samples.begin(), samples.end());
+  tree.build();
+  for (const Sample& s : samples) {
+    // k + 1: the query point finds itself first.
+    Search search(tree, s.first, static_cast<unsigned>(k) + 1);
+    std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
+    nb.reserve(static_cast<std::size_t>(k));
+    for (auto it = search.begin(); it != search.end(); ++it)
+      if (it->first.second != s.second && static_cast<int>(nb.size()) < k) nb.push_back(it->first.second);
+  }
+  return out;
+}
+
+std::vector<std::vector<Index>> neighbours_within(const Points3& points, double radius) {
+  std::vector<std::vector<Index>> out(static_cast<std::size_t>(points.rows()));
+  const std::vector<Sample> samples = finite_samples(points);
+  if (samples.size() < 2 || !(radius > 0.0)) return out;
+  Tree tree(samples.begin(), samples.end());
+  tree.build();
+  std::vector<Sample> found;
+  for (const Sample& s : samples) {
+    found.clear();
+    tree.search(std::back_inserter(found), Sphere(s.first, radius, 0.0));
+    std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
+    for (const Sample& f : found)
+      if (f.second != s.second) nb.push_back(f.second);
+  }
+  return out;
+}
+
+}  // namespace sf::mesh

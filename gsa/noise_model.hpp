@@ -1,0 +1,102 @@
+#pragma once
+// Measurement noise with spatial correlation, estimated from fit residuals.
+//
+// Digitised grid marks have independent errors; points of digital image
+// correlation do not: neighbouring points share image subsets, so their errors
+// are correlated over about a subset (a few point spacings). A smoothing choice
+// that assumes independent errors (cross-validation) takes correlated error for
+// signal and under-smooths. The model here, per coordinate:
+//
+//   cov(e_i, e_j) = sigma_c^2 exp(-r_ij^2 / (2 L^2)) + sigma_w^2 [i = j]
+//
+// r_ij the distance between the points' undeformed positions, L the correlation
+// length. It is estimated from the semivariogram of fit residuals,
+// gamma(r) = E |e_i - e_j|^2 / 2 per component, binned by distance with a robust
+// (median) estimate per bin. A smoother takes up part of the noise itself (all of
+// it at scales longer than its gauge), so the model is fitted to what its noise
+// would leave in the residuals: the variograms of (I - H) applied to noise probes
+// (fit_noise_model), plus b r^2 for the smooth bias of the fit. Units: mm.
+
+#include <array>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/core/types.hpp"
+
+namespace sf::gsa {
+
+struct NoiseEstimate {
+  double sigma_correlated = 0.0;   // mm, per coordinate
+  double correlation_length = 0.0; // mm (0: no correlated part found)
+  double sigma_white = 0.0;        // mm, per coordinate
+  double bias_slope = 0.0;         // b of the model, 1 (mm^2 / mm^2)
+  double sigma_total() const;
+  // The correlation length when the correlated part matters (> 30 % of the total
+  // sigma), else 0: the noise counts as independent.
+  double effective_length() const;
+  // Variance of the mean of the noise at `positions` (k x 3) per component, mm^2.
+  double mean_variance(const Points3& positions) const;
+  // Variogram bins used: mean distance, estimate, pairs.
+  std::vector<double> lag, gamma;
+  std::vector<int> count;
+};
+
+struct VariogramOptions {
+  double max_lag = 0.0;         // mm; 0 = 12 spacings
+  double bin_width = 0.0;       // mm; 0 = half a spacing
+  int max_query_points = 3000;  // points whose neighbourhoods are sampled (a random subset, fixed seed)
+};
+
+// One realisation of Gaussian noise with covariance sigma^2 exp(-r^2 / (2 L^2)): a
+// sum of random Fourier modes (3-D wave vectors drawn from the Gaussian spectral
+// density), so its covariance is the Gaussian one of the 3-D distance in expectation,
+// and it is smooth at every scale below L.
+class CorrelatedField {
+ public:
+  CorrelatedField(double sigma, double correlation_length, unsigned seed, int modes = 512);
+  // Three independent components at position p (mm).
+  Vec3 at(const Vec3& p) const;
+
+ private:
+  double amplitude_ = 0.0;
+  std::array<Eigen::MatrixX3d, 3> k_;  // wave vectors (1/mm), modes x 3, per component
+  std::array<VecX, 3> phase_;
+};
+
+// Point pairs of a variogram, sampled once (a random subset of query points and
+// all their neighbours within max_lag), binned by distance.
+class VariogramPairs {
+ public:
+  VariogramPairs(const Points3& positions, const std::vector<bool>& usable, double spacing,
+                 const VariogramOptions& options = {});
+  // Robust variogram of `values` (n x k, the first min(k, components) columns count):
+  // per bin, the median of |v_p - v_q|^2 / 2 over chi-square's median.
+  std::vector<double> gamma(const MatX& values, int components) const;
+  const std::vector<double>& lag() const { return lag_; }
+  const std::vector<int>& count() const { return count_; }
+  double spacing() const { return spacing_; }
+
+ private:
+  std::vector<std::vector<std::pair<Index, Index>>> bins_;
+  std::vector<double> lag_;
+  std::vector<int> count_;
+  double spacing_ = 0.0;
+};
+
+// The noise model whose residuals under a smoother match the residuals' variogram:
+// `smooth_residual(w)` returns (I - H) w for probe data w (n x k). Fits
+//   gamma(r) = s_c V_L(r) + s_w V_w(r) + b r^2
+// where V_L, V_w are the variograms of (I - H) applied to unit correlated (length L)
+// and white probes; L from a grid. Accounts for the noise the smoother itself takes up.
+NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed,
+                              const Points3& positions,
+                              const std::function<MatX(const MatX&)>& smooth_residual, double fixed_length = 0.0);
+
+// Probes for a trace estimate tr(H Sigma): `count` columns, each a draw of the
+// noise at the points (n x count; three independent columns per random field,
+// 64 Fourier modes each: unbiased, E[w w^T] = Sigma), fixed seed.
+MatX noise_probes(const NoiseEstimate& noise, const Points3& positions, int count, unsigned seed = 99);
+
+}  // namespace sf::gsa

@@ -2,10 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "gsa/deformed_fit.hpp"
+#include "gsa/local_smoothing.hpp"
+#include "gsa/noise_estimate.hpp"
 #include "gsa/undeformed_fit.hpp"
 
 namespace sf::gsa {
@@ -22,34 +25,50 @@ void tell(const ProgressCallback& progress, AnalysisStage stage, const FrameAndM
 }
 
 // The deformed fit and its smoothing: the first fit with the noise rule (or the explicit
-// weights), outlier rounds, the smoothing choice, readmission.
+// weights), the smoothing choice (noise model or GCV) with local relaxation, readmission.
 struct DeformedStages {
   DeformedFit fit;
   SmoothingChoice choice;
+  NoiseEstimate noise;         // of the deformed data (noise-model rule)
+  LocalSmoothing local;        // element multipliers (noise-model rule with local smoothing)
 };
-DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const UndeformedFit& und,
-                                   const AnalyseOptions& options, const ProgressCallback& progress) {
+DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const FitMarks& marks,
+                                   const UndeformedFit& und, const NoiseEstimate& undeformed_noise,
+                                   std::vector<OutlierFlag> flags, const AnalyseOptions& options,
+                                   const ProgressCallback& progress) {
   const double d = setup.mark_spacing;
+  const SmoothingOptions& so = options.smoothing;
   DeformedStages out;
-  out.fit = fit_deformed(problem, penalty_for_noise(options.smoothing, und.noise_estimate, d), options.outliers, d);
+  out.fit = fit_deformed(problem, penalty_for_noise(so, und.noise_estimate, d), std::move(flags));
   out.choice = {out.fit.penalty, out.fit.passes};
-  if (options.smoothing.chooses_by_gcv()) {
+  out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
+  if (so.chooses_by_gcv()) {
     tell(progress, AnalysisStage::kSmoothingChoice, &setup);
-    out.choice = choose_smoothing_gcv(problem, options.smoothing, d);
+    if (so.rule == SmoothingRule::kGcv) {
+      out.choice = choose_smoothing_gcv(problem, so, d);
+    } else {
+      out.noise = deformed_noise(problem, marks, setup, undeformed_noise);
+      auto choose = [&] { return choose_smoothing_noise_model(problem, so, out.noise, marks.undeformed, d); };
+      out.choice = choose();
+      if (so.local) out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose);
+    }
     refit_deformed(problem, out.fit, out.choice);
   }
-  readmit_deformed(problem, out.fit, options.outliers, d);
+  readmit_deformed(problem, out.fit);
   return out;
 }
 
 // Fills the per-point results in place (`points` was sized before the stages: fresh
 // memory for 1e5 points costs 0.1 s here): the status of every point (in order of
-// precedence), the fit marks' locations and residuals, and the strains of the ok ones.
+// precedence), the fit marks' locations and residuals, and the strains of every mark
+// with a material point (flagged outliers included: the strain is the fitted
+// surfaces' there).
 void fill_point_results(std::vector<PointResult>& points, const GridData& grid, const FitMarks& marks,
                         const UndeformedFit& und, const DeformedFit& def, const DeformedResiduals& residuals,
-                        const SurfacePair& surfaces, const std::vector<double>& fibre_angles) {
-  std::vector<char> flagged(static_cast<std::size_t>(marks.size()), 0);
-  for (const OutlierFlag& f : def.flags) flagged[static_cast<std::size_t>(f.mark)] = 1;
+                        const SurfacePair& surfaces, const AnalyseOptions& options) {
+  std::vector<const OutlierFlag*> flag_u(static_cast<std::size_t>(marks.size()), nullptr), flag_d = flag_u;
+  for (const OutlierFlag& f : und.flags) flag_u[static_cast<std::size_t>(f.mark)] = &f;
+  for (const OutlierFlag& f : def.flags) flag_d[static_cast<std::size_t>(f.mark)] = &f;
   std::size_t next = 0;  // marks.point is ascending: the points between marks have no undeformed position
   for (std::size_t p = 0; p < points.size(); ++p) {
     if (next < marks.point.size() && marks.point[next] == static_cast<Index>(p)) ++next;
@@ -58,16 +77,18 @@ void fill_point_results(std::vector<PointResult>& points, const GridData& grid, 
   for (Index k = 0; k < marks.size(); ++k) {
     const auto kk = static_cast<std::size_t>(k);
     PointResult& pr = points[static_cast<std::size_t>(marks.point[kk])];
-    pr.status = !(und.weight[k] > 0)                         ? kStatusOutlierUndeformed
-                : !grid.has_deformed(marks.point[kk])         ? kStatusMissingDeformed
-                : flagged[kk]                                 ? kStatusOutlierDeformed
-                                                              : kStatusOk;
+    const bool has_deformed = grid.has_deformed(marks.point[kk]);
+    pr.status = flag_u[kk]      ? kStatusOutlierUndeformed
+                : !has_deformed ? kStatusMissingDeformed
+                : flag_d[kk]    ? kStatusOutlierDeformed
+                                : kStatusOk;
+    if (const OutlierFlag* f = flag_u[kk] ? flag_u[kk] : flag_d[kk]) pr.flag = *f;
     pr.element = und.location[kk].element;
     pr.xi = und.location[kk].xi;
     pr.residual_undeformed = und.residual[k];
-    if (pr.status != kStatusOk) continue;
+    if (!has_deformed) continue;
     pr.residual = residuals.residual[k];
-    MarkStrain ms = strain_at(surfaces, und.location[kk], fibre_angles);
+    MarkStrain ms = strain_at(surfaces, und.location[kk], options.fibre_angles);
     if (!ms.strain) {
       pr.status = kStatusDegenerate;
       continue;
@@ -98,6 +119,8 @@ void record_parameters(AnalysisResult& r, FrameAndMesh& setup, const UndeformedF
   r.penalty_deformed = def.fit.penalty;
   r.noise_estimate = und.noise_estimate;
   r.gcv_log10_delta = def.choice.gcv_log10_delta;
+  r.smoothing_criterion = def.choice.criterion;
+  r.smoothing_criterion_value = def.choice.criterion_value;
   r.gauge_length = gauge_length(def.fit.penalty, setup.mark_spacing);
   r.rms_undeformed = und.rms;
   r.max_undeformed = und.max;
@@ -118,15 +141,25 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   FrameAndMesh setup = build_frame_and_mesh(grid, marks, options.mesh);
   res.times.mesh = seconds_since(t0);
 
+  tell(progress, AnalysisStage::kOutliers, &setup);
+  Points3 deformed_at_marks(marks.size(), 3);
+  for (Index k = 0; k < marks.size(); ++k) deformed_at_marks.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  MarkOutliers outliers = find_outliers(marks, deformed_at_marks, setup.mark_spacing, options.outliers);
+
   tell(progress, AnalysisStage::kUndeformedFit, &setup);
-  const UndeformedFit und = fit_undeformed(setup, marks, {options.smoothing, options.outliers,
+  const UndeformedFit und = fit_undeformed(setup, marks, {options.smoothing, std::move(outliers.undeformed),
                                                           options.max_projection_iterations});
   const DeformedMarks deformed = deformed_marks(grid, marks, und);
+  NoiseEstimate undeformed_noise;
+  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel)
+    undeformed_noise = gsa::undeformed_noise(setup, marks, und);
 
   tell(progress, AnalysisStage::kDeformedFit, &setup);
   const auto tf = Clock::now();
   DeformedProblem problem(setup, marks, und, deformed);
-  const DeformedStages def = run_deformed_stages(problem, setup, und, options, progress);
+  // Deformed flags of marks the undeformed fit readmitted or that lack a deformed position stay as found.
+  DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise,
+                                           std::move(outliers.deformed), options, progress);
   res.times.fit = und.fit_seconds + seconds_since(tf);
   res.times.project = und.project_seconds;
   const DeformedResiduals residuals = deformed_residuals(problem, def.fit);
@@ -134,9 +167,35 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   tell(progress, AnalysisStage::kStrains, &setup);
   const auto ts = Clock::now();
   const SurfacePair surfaces(setup.mesh, und.parameters, def.fit.fit.parameters);
-  fill_point_results(res.points, grid, marks, und, def.fit, residuals, surfaces, options.fibre_angles);
+  fill_point_results(res.points, grid, marks, und, def.fit, residuals, surfaces, options);
   res.times.strain = seconds_since(ts);
+  res.noise_undeformed = undeformed_noise;
+  res.noise = def.noise;
+  res.element_multiplier = def.local.multiplier;
+  res.relaxed_elements = def.local.relaxed();
+  if (res.relaxed_elements > 0) {
+    const double least = *std::min_element(def.local.multiplier.begin(), def.local.multiplier.end());
+    Penalty relaxed = def.fit.penalty;
+    for (double* w : {&relaxed.alpha, &relaxed.beta, &relaxed.gamma, &relaxed.delta}) *w *= least;
+    res.local_gauge_length = gauge_length(relaxed, setup.mark_spacing);
+  }
+  res.noise_outliers_undeformed = outliers.noise_undeformed;
+  res.noise_outliers_deformed = outliers.noise_deformed;
   record_parameters(res, setup, und, problem, def, residuals, options);
+  // Every element relaxed alike is one lighter weight everywhere: reported as such.
+  if (!res.element_multiplier.empty() && res.relaxed_elements == static_cast<Index>(res.element_multiplier.size())) {
+    const auto [lo, hi] = std::minmax_element(res.element_multiplier.begin(), res.element_multiplier.end());
+    if (*hi - *lo <= 1e-12 * *hi) {
+      for (double* w : {&res.penalty_deformed.alpha, &res.penalty_deformed.beta, &res.penalty_deformed.gamma,
+                        &res.penalty_deformed.delta})
+        *w *= *lo;
+      res.gauge_length = gauge_length(res.penalty_deformed, res.mark_spacing);
+      res.gcv_log10_delta += std::log10(*lo);
+      std::fill(res.element_multiplier.begin(), res.element_multiplier.end(), 1.0);
+      res.relaxed_elements = 0;
+      res.local_gauge_length = 0.0;
+    }
+  }
   return res;
 }
 
@@ -153,7 +212,8 @@ void AnalyseOptions::validate() const {
   for (const auto& [field, value] : weights)
     if (*value && !(**value >= 0.0)) throw OptionError(field, "a smoothing weight must be >= 0" + found(**value));
   if (!(smoothing.scale > 0.0)) throw OptionError("smoothing.scale", "must be > 0" + found(smoothing.scale));
-  if (!(outliers.sigma > 0.0)) throw OptionError("outliers.sigma", "must be > 0" + found(outliers.sigma));
+  if (!(outliers.sigma > 0.0) || !std::isfinite(outliers.sigma))
+    throw OptionError("outliers.sigma", "must be a number > 0" + found(outliers.sigma));
   if (!fibre_angles.empty() && fibre_angles.size() != 2)
     throw OptionError("fibre_angles", "expected two angles in degrees, e.g. 0,90; found " +
                                           std::to_string(fibre_angles.size()));

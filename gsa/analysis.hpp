@@ -9,8 +9,10 @@
 //   frame and mesh     fit_marks, build_frame_and_mesh  FrameAndMesh  gsa/frame_mesh.hpp
 //   undeformed fit     fit_undeformed               UndeformedFit     gsa/undeformed_fit.hpp
 //   deformed fit       fit_deformed, refit_deformed DeformedFit       gsa/deformed_fit.hpp
-//   smoothing choice   choose_smoothing_gcv         SmoothingChoice   gsa/smoothing.hpp
-//   outliers           detect_outliers, take_readmitted  OutlierFlag  gsa/outliers.hpp
+//   outliers           find_outliers, take_readmitted  MarkOutliers    gsa/outliers.hpp
+//   noise model        undeformed_noise, deformed_noise NoiseEstimate  gsa/noise_estimate.hpp
+//   smoothing choice   choose_smoothing_noise_model (or _gcv)  SmoothingChoice  gsa/smoothing.hpp
+//   local smoothing    relax_smoothing              LocalSmoothing    gsa/local_smoothing.hpp
 //   strains            strain_at (per mark)         MarkStrain        gsa/mark_strains.hpp
 //
 // analyse() runs them in that order and gathers an AnalysisResult. It never prints:
@@ -28,6 +30,7 @@
 #include "gsa/frame_mesh.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/mark_strains.hpp"
+#include "gsa/noise_model.hpp"
 #include "gsa/option_error.hpp"
 #include "gsa/outliers.hpp"
 #include "gsa/plane.hpp"
@@ -68,6 +71,7 @@ struct PointResult {
   double residual_undeformed = std::numeric_limits<double>::quiet_NaN();  // undeformed fit
   std::vector<FibreResult> fibres;  // one per fibre family
   double shear_angle_deg = std::numeric_limits<double>::quiet_NaN();  // first two families
+  std::optional<OutlierFlag> flag;  // why the point was flagged (outlier statuses), with its numbers
 };
 
 struct StageTimes {
@@ -92,15 +96,24 @@ struct AnalysisResult {
   double noise_estimate = 0.0;   // estimated digitisation noise (units), per coordinate
   double mark_spacing = 0.0;     // mean spacing of marks (units)
   double gauge_length = 0.0;     // effective smoothing length (units)
-  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // GCV optimum, log10(delta / spacing^6)
+  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
+  std::string smoothing_criterion;  // "GCV", "Cp" (noise model) or empty (explicit weights)
+  double smoothing_criterion_value = std::numeric_limits<double>::quiet_NaN();
   double rms_undeformed = 0, max_undeformed = 0, rms_deformed = 0, max_deformed = 0;
   int projection_iterations = 0;
   Index n_triangles = 0;  // triangles method
   StageTimes times;
   std::vector<std::string> warnings;
+  // Noise-model smoothing (gsa/noise_estimate.hpp): the undeformed estimate (correlation
+  // length) and the deformed data's; all zero with another rule.
+  NoiseEstimate noise_undeformed, noise;
+  std::vector<double> element_multiplier;  // local smoothing: penalty multiplier per element (1: global weight)
+  Index relaxed_elements = 0;              // elements with a multiplier below 1
+  double local_gauge_length = 0.0;         // gauge length in the relaxed elements (units; 0: none)
+  double noise_outliers_undeformed = 0.0, noise_outliers_deformed = 0.0;  // noise levels of the outlier checks (units)
 };
 
-enum class AnalysisStage { kFrameAndMesh, kUndeformedFit, kDeformedFit, kSmoothingChoice, kStrains };
+enum class AnalysisStage { kFrameAndMesh, kOutliers, kUndeformedFit, kDeformedFit, kSmoothingChoice, kStrains };
 
 // What the progress callback hears as each stage of the surface method starts.
 struct StageStart {

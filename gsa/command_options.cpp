@@ -57,6 +57,12 @@ PenaltyKind parse_penalty(const std::string& text) {
   throw UsageError("--penalty: expected 'third', 'jumps' or 'sobolev', found '" + text + "'");
 }
 
+SmoothingRule parse_smoothing_rule(const std::string& text) {
+  if (text == "noise-model") return SmoothingRule::kNoiseModel;
+  if (text == "gcv") return SmoothingRule::kGcv;
+  throw UsageError("--smoothing-rule: expected 'noise-model' or 'gcv', found '" + text + "'");
+}
+
 // Runs a library validate() and turns its field into the user's flag.
 template <class Options>
 void validate_for_the_command_line(const Options& options) {
@@ -86,6 +92,8 @@ AnalyseOptions analyse_options(const AnalyseFlags& a) {
   AnalyseOptions o;
   o.method = parse_method(a.method);
   o.smoothing.penalty = parse_penalty(a.penalty);
+  o.smoothing.rule = parse_smoothing_rule(a.smoothing_rule);
+  o.smoothing.local = !a.no_local_smoothing;
   if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
   o.mesh.file = a.mesh;
   if (!a.elements.empty()) parse_elements(a.elements, o.mesh);

@@ -19,10 +19,11 @@ namespace sf::gsa {
 // The flags of `gsa analyse` (docs/usage.md); NaN weights are "not given".
 struct AnalyseFlags {
   std::string grid, undeformed, deformed, out;
-  std::string method = "surface", penalty = "jumps", elements, mesh, columns, delimiter = ",", fibres, units = "mm";
+  std::string method = "surface", penalty = "jumps", smoothing_rule = "noise-model", elements, mesh, columns, delimiter = ",", fibres, units = "mm";
   double alpha = std::numeric_limits<double>::quiet_NaN(), beta = std::numeric_limits<double>::quiet_NaN(),
          gamma = std::numeric_limits<double>::quiet_NaN(), delta = std::numeric_limits<double>::quiet_NaN();
-  double outlier_sigma = 6.0, smoothing_scale = 1.0;
+  double outlier_sigma = 4.5, smoothing_scale = 1.0;
+  bool no_local_smoothing = false;
   int sample = 0;
   bool no_plots = false;
   std::string measure = "true", size = "1200x900", view = "auto", flc;  // pictures

@@ -51,7 +51,7 @@ Input read_input(const AnalyseFlags& a, bool quiet) {
   const GridReadOptions ro = grid_read_options(a);
   const auto t0 = std::chrono::steady_clock::now();
   Input in;
-  in.info.command_line = "gsa analyse";
+  in.info.command_line = cli::command_line().empty() ? "gsa analyse" : cli::command_line();
   if (!a.grid.empty()) {
     if (!a.undeformed.empty() || !a.deformed.empty())
       throw UsageError("give either GRID.csv or --undeformed U.csv --deformed D.csv, not both");
@@ -79,8 +79,9 @@ ProgressCallback stage_status_lines(bool quiet) {
         break;
       case AnalysisStage::kDeformedFit: cli::status(quiet, "gsa: fitting the deformed surface"); break;
       case AnalysisStage::kSmoothingChoice:
-        cli::status(quiet, "gsa: choosing the smoothing by cross-validation");
+        cli::status(quiet, "gsa: estimating the noise and choosing the smoothing");
         break;
+      case AnalysisStage::kOutliers: cli::status(quiet, "gsa: checking the marks against their neighbours"); break;
       case AnalysisStage::kFrameAndMesh:
       case AnalysisStage::kStrains: break;
     }
@@ -97,7 +98,16 @@ std::string closing_line(const AnalysisResult& result, Index n_points, const std
   if (result.method == Method::kSurface)
     msg << " (mesh " << result.mesh_layout << ", " << result.mesh.n_elements() << " elements; fit RMS residual "
         << result.rms_undeformed << " / " << result.rms_deformed << " " << units << "; gauge length "
-        << std::setprecision(3) << result.gauge_length << " " << units << ")";
+        << std::setprecision(3) << result.gauge_length << " " << units;
+  if (result.method == Method::kSurface && result.relaxed_elements > 0)
+    msg << ", " << result.local_gauge_length << " " << units << " in " << result.relaxed_elements
+        << " elements with a local feature";
+  if (result.method == Method::kSurface) msg << ")";
+  Index flagged = 0;
+  for (const auto& p : result.points) flagged += p.flag ? 1 : 0;
+  if (flagged > 0)
+    msg << "; " << flagged << " isolated mark" << (flagged == 1 ? "" : "s")
+        << " flagged as outliers, strains kept (see summary.json)";
   if (margins)
     msg << "; " << margins->n_beyond << " of " << margins->n_marks << " marks beyond the forming limit curve";
   return msg.str();
@@ -231,7 +241,9 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_option("--columns", args->columns, "Map column names, e.g. X=x0,Y=y0,Z=z0,u=u,v=v,w=w (u,v,w = displacements)");
         app.add_option("--delimiter", args->delimiter, "Field separator: one character, or tab/comma/semicolon/space");
         app.add_option("--smoothing-scale", args->smoothing_scale, "Multiply the automatic smoothing weights (default 1; >1 smoother)");
-        app.add_option("--outlier-sigma", args->outlier_sigma, "Flag marks whose fit residual exceeds this many robust noise sigmas (default 6)");
+        app.add_option("--outlier-sigma", args->outlier_sigma, "Flag a mark as an isolated blunder when it is this many noise levels off its neighbours' local fit and far more than they are (default 4.5); flagged marks still get a strain");
+        app.add_option("--smoothing-rule", args->smoothing_rule, "How the automatic smoothing is chosen: noise-model (default; Cp with the estimated noise, spatial correlation included) or gcv (cross-validation, assumes independent errors)");
+        app.add_flag("--no-local-smoothing", args->no_local_smoothing, "Keep one smoothing weight everywhere (by default it is relaxed where the fit cannot follow a localised feature such as a neck)");
         app.add_option("--sample", args->sample, "Also write samples.csv with fields on N x N points per element");
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);

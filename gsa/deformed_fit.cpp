@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -11,9 +12,6 @@
 namespace sf::gsa {
 
 namespace {
-
-// Outlier rounds of the deformed fit at most.
-constexpr int kMaxOutlierRounds = 8;
 
 // Rotation of the polar decomposition F = Q U, by Newton's iteration
 // Q <- (Q + Q^-T) / 2 (quadratic convergence; a handful of steps for the
@@ -102,11 +100,37 @@ void DeformedProblem::set_weight(Index k, double weight) {
 FitSystem& DeformedProblem::system() {
   // One system per set of weights: rebuilt only when marks are flagged or readmitted.
   if (rebuild_ || !system_) {
-    system_ = std::make_unique<FitSystem>(setup_.mesh, setup_.penalties, undeformed_.location, weight_);
+    system_ = std::make_unique<FitSystem>(setup_.mesh, relaxed_ ? *relaxed_ : setup_.penalties,
+                                          undeformed_.location, weight_);
     system_->set_values(data_);
+    if (probes_.size() > 0) system_->set_probes(probes_);
     rebuild_ = false;
   }
   return *system_;
+}
+
+MatX DeformedProblem::smooth(const MatX& values, const Penalty& penalty, int passes) {
+  FitSystem& s = system();
+  s.set_values(values);
+  const FitResult f = s.solve(penalty, MatX::Zero(setup_.mesh.n_dofs(), values.cols()), 0, passes);
+  s.set_values(data_);
+  if (!f.ok) throw InputError(marks_.source + ": " + f.message);
+  return f.fitted;
+}
+
+void DeformedProblem::set_probes(MatX probes) {
+  probes_ = std::move(probes);
+  if (system_) system_->set_probes(probes_);
+}
+
+void DeformedProblem::set_element_multipliers(std::vector<double> multipliers) {
+  multipliers_ = std::move(multipliers);
+  const bool uniform = std::all_of(multipliers_.begin(), multipliers_.end(), [](double v) { return v == 1.0; });
+  if (uniform)
+    relaxed_.reset();
+  else
+    relaxed_ = std::make_unique<PenaltyMatrices>(assemble_penalties(setup_.mesh, multipliers_));
+  rebuild_ = true;
 }
 
 FitResult DeformedProblem::fit(const Penalty& penalty, int passes) {
@@ -120,25 +144,16 @@ std::array<FitResult, 2> DeformedProblem::fit_pair(const std::array<Penalty, 2>&
   return system().solve_pair(penalties, reference_, trace_probes, passes);
 }
 
-DeformedFit fit_deformed(DeformedProblem& problem, const Penalty& penalty, const OutlierOptions& outliers,
-                         double mark_spacing) {
+DeformedFit fit_deformed(DeformedProblem& problem, const Penalty& penalty, std::vector<OutlierFlag> flags) {
   DeformedFit out;
   out.penalty = penalty;
   out.passes = 1;
+  out.flags = std::move(flags);
+  for (const OutlierFlag& f : out.flags) problem.set_weight(f.mark, 0.0);
   problem.carry_residuals(nullptr);
   out.fit = problem.fit(penalty, out.passes);
   problem.carry_residuals(&out.fit.parameters);
   out.fit = problem.fit(penalty, out.passes);
-  for (int round = 0; round < kMaxOutlierRounds; ++round) {
-    const std::vector<OutlierFlag> bad =
-        detect_outliers(out.fit.residual, problem.weight(), ResidualKind::kVector, outliers, mark_spacing);
-    if (bad.empty()) break;
-    for (const OutlierFlag& f : bad) {
-      problem.set_weight(f.mark, 0.0);
-      out.flags.push_back(f);
-    }
-    out.fit = problem.fit(penalty, out.passes);
-  }
   return out;
 }
 
@@ -150,11 +165,10 @@ void refit_deformed(DeformedProblem& problem, DeformedFit& fit, const SmoothingC
   fit.fit = problem.fit(fit.penalty, fit.passes);
 }
 
-void readmit_deformed(DeformedProblem& problem, DeformedFit& fit, const OutlierOptions& outliers,
-                      double mark_spacing) {
-  const double threshold =
-      outlier_threshold(fit.fit.residual, problem.weight(), ResidualKind::kVector, outliers, mark_spacing);
-  const std::vector<OutlierFlag> back = take_readmitted(fit.flags, fit.fit.residual, threshold);
+void readmit_deformed(DeformedProblem& problem, DeformedFit& fit) {
+  // Distance of each flagged mark as digitised from the surface at its material point.
+  const VecX residual = (fit.fit.fitted - MatX(problem.position())).rowwise().norm();
+  const std::vector<OutlierFlag> back = take_readmitted(fit.flags, residual);
   for (const OutlierFlag& f : back) problem.set_weight(f.mark, 1.0);
   if (!back.empty()) fit.fit = problem.fit(fit.penalty, fit.passes);
 }

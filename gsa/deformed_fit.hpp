@@ -4,10 +4,10 @@
 //
 //   DeformedMarks data = deformed_marks(grid, marks, undeformed);
 //   DeformedProblem problem(setup, marks, undeformed, data);
-//   DeformedFit fit = fit_deformed(problem, penalty, outliers, d);  // first fit, outlier rounds
+//   DeformedFit fit = fit_deformed(problem, penalty, flags);  // first fit, flagged marks left out
 //   SmoothingChoice c = choose_smoothing_gcv(problem, smoothing, d);  // optional (gsa/smoothing.hpp)
 //   refit_deformed(problem, fit, c);
-//   readmit_deformed(problem, fit, outliers, d);
+//   readmit_deformed(problem, fit);
 //   DeformedResiduals r = deformed_residuals(problem, fit);
 //
 // The smoothing acts on the deviation of x from the undeformed surface moved by the
@@ -64,7 +64,19 @@ class DeformedProblem {
   // degrees of freedom; failures are reported in the results, not thrown.
   std::array<FitResult, 2> fit_pair(const std::array<Penalty, 2>& penalties, int trace_probes, int passes);
 
+  // The smoother H of `penalty` applied to `values` (m x k, other data at the same marks
+  // with the same weights, e.g. noise probes): their fit with a zero reference, at the
+  // marks. The problem's own data stay as they are.
+  MatX smooth(const MatX& values, const Penalty& penalty, int passes);
+  // Probes for the trace estimates of later fit_pair() calls (FitSystem::set_probes),
+  // kept when the system is rebuilt; their column count is the trace_probes to pass.
+  void set_probes(MatX probes);
+  // A penalty multiplier per element (locally relaxed smoothing); empty: 1 everywhere.
+  void set_element_multipliers(std::vector<double> multipliers);
+  const std::vector<double>& element_multipliers() const { return multipliers_; }
+
   const VecX& weight() const { return weight_; }
+  const Points3& data() const { return data_; }  // x - Q r, what is fitted
   const Points3& position() const { return deformed_.position; }  // the marks as digitised
   const RigidMotion& rigid() const { return rigid_; }
   const MatX& reference() const { return reference_; }  // U_ref: the undeformed surface moved rigidly
@@ -84,6 +96,9 @@ class DeformedProblem {
   Points3 data_;                  // x - Q r
   std::unique_ptr<FitSystem> system_;
   bool rebuild_ = true;
+  MatX probes_;
+  std::vector<double> multipliers_;
+  std::unique_ptr<PenaltyMatrices> relaxed_;  // penalties with the multipliers, when any differs from 1
 };
 
 struct DeformedFit {
@@ -94,15 +109,13 @@ struct DeformedFit {
 };
 
 // The first fit with `penalty` (residuals carried with the rigid rotation, then with the
-// fitted one), then outliers flagged and removed in rounds.
-DeformedFit fit_deformed(DeformedProblem& problem, const Penalty& penalty, const OutlierOptions& outliers,
-                         double mark_spacing);
+// fitted one), the marks of `flags` (deformed outliers, gsa/outliers.hpp) left out.
+DeformedFit fit_deformed(DeformedProblem& problem, const Penalty& penalty, std::vector<OutlierFlag> flags);
 // Refits with a chosen smoothing, carrying the residuals once more with the new surface.
 void refit_deformed(DeformedProblem& problem, DeformedFit& fit, const SmoothingChoice& choice);
-// Takes flagged marks back that the final surface fits within the outlier threshold (good
-// neighbours of a bad mark can exceed it while the bad mark still pulls the fit), and refits.
-void readmit_deformed(DeformedProblem& problem, DeformedFit& fit, const OutlierOptions& outliers,
-                      double mark_spacing);
+// Takes flagged marks back that the final surface (fitted without them) passes within
+// their threshold, and refits.
+void readmit_deformed(DeformedProblem& problem, DeformedFit& fit);
 
 struct DeformedResiduals {
   VecX residual;                // m: distance of each mark as digitised from x at its material point

@@ -84,6 +84,10 @@ int position(const linalg::SparseMatrix& a, Index row, Index col) {
 }  // namespace
 
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
+  return assemble_penalties(mesh, std::vector<double>(static_cast<std::size_t>(mesh.n_elements()), 1.0));
+}
+
+PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vector<double>& element_multiplier) {
   const Index n = mesh.n_dofs();
   linalg::TripletAssembler k1(n, n), k2(n, n), k3(n, n), k4(n, n);
   const auto rule = quadrature::gauss_2d(4, 4);
@@ -117,9 +121,10 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
       }
     }
     const fe::ElementDofMap dm = fe::element_dof_map(mesh.element_map(e));
-    add_element_block(k1, dm, a1);
-    add_element_block(k2, dm, a2);
-    add_element_block(k3, dm, a3);
+    const double me = element_multiplier[static_cast<std::size_t>(e)];
+    add_element_block(k1, dm, me * a1);
+    add_element_block(k2, dm, me * a2);
+    add_element_block(k3, dm, me * a3);
   }
   // Jumps of the normal second derivative across interior edges (third-order term).
   const quadrature::Rule1D line = quadrature::gauss_legendre(4);
@@ -150,7 +155,10 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         return mesh.neighbour(el, opposite).element < 0 &&
                !mesh::SurfaceMesh::is_degenerate_edge(mesh.element(el), opposite);
       };
-      const double w4 = (boundary_behind(e, edge) || boundary_behind(nb.element, nb.edge)) ? kBoundaryEdgeWeight : 1.0;
+      const double m_edge = std::min(element_multiplier[static_cast<std::size_t>(e)],
+                                     element_multiplier[static_cast<std::size_t>(nb.element)]);
+      const double w4 =
+          m_edge * ((boundary_behind(e, edge) || boundary_behind(nb.element, nb.edge)) ? kBoundaryEdgeWeight : 1.0);
       Eigen::MatrixXd kj = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
       Eigen::MatrixXd k4j = Eigen::MatrixXd::Zero(dofs.size(), dofs.size());
       for (std::size_t g = 0; g < line.points.size(); ++g) {
@@ -174,7 +182,7 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
         const Eigen::VectorXd j3 = te.transpose() * we - tn.transpose() * wn;
         k4j.noalias() += (w4 * line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
       }
-      k3.add_block(dofs, dofs, kj);
+      k3.add_block(dofs, dofs, m_edge * kj);
       k4.add_block(dofs, dofs, k4j);
     }
   }
@@ -326,6 +334,15 @@ void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
     for (decltype(s.phi)::InnerIterator it(s.phi, d); it; ++it)
       s.data_rhs.row(it.col()) += (s.w[d] * it.value()) * values.row(d);
   }
+}
+
+void FitSystem::set_probes(const MatX& p) {
+  Impl& s = *impl_;
+  s.probes = p;
+  for (Index r = 0; r < p.rows(); ++r)
+    if (!(s.w[r] > 0.0)) s.probes.row(r).setZero();
+  s.probes_plain = s.phi.transpose() * s.probes;
+  s.probes_weighted = s.phi.transpose() * (s.w.asDiagonal() * s.probes);
 }
 
 void FitSystem::Impl::draw_probes(int count) {

@@ -74,6 +74,10 @@ struct PenaltyMatrices {
   std::vector<std::vector<int>> element_positions;
 };
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
+// The same with a multiplier per element (n_elements, > 0) on its interior terms; an
+// edge's terms take the smaller multiplier of its two elements (locally relaxed
+// smoothing where the field varies sharply, gsa/local_smoothing.hpp).
+PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vector<double>& element_multiplier);
 
 
 struct FitResult {
@@ -117,6 +121,10 @@ class FitSystem {
   // degrees of freedom are those of the iterated smoother.
   FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0,
                   int passes = 1);
+  // Probes of the trace estimate given by the caller (n_points x count) instead of
+  // Rademacher ones: with probes drawn from the noise N(0, Sigma) the estimate is
+  // tr(H Sigma) (gsa/noise_model.hpp). Later solves with trace_probes = count use them.
+  void set_probes(const MatX& probes);
   // Two penalties at once, on two threads where the machine has two cores (each
   // with its own factorisation; automatic smoothing compares pairs).
   std::array<FitResult, 2> solve_pair(const std::array<Penalty, 2>& penalties, const Eigen::Ref<const MatX>& reference,

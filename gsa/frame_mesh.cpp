@@ -30,6 +30,13 @@ void choose_element_counts(Index n_marks, double len1, double len2, int& n1, int
   const double total = std::max(1.0, n / (9.0 * std::pow(std::max(1.0, n / 441.0), 0.27)));
   n1 = std::max(1, static_cast<int>(std::lround(std::sqrt(total * len1 / len2))));
   n2 = std::max(1, static_cast<int>(std::lround(total / n1)));
+  // A narrow strip gets at least three elements across (the minor strain varies across
+  // a tensile specimen's width), as long as each keeps about four marks across.
+  const double spacing = std::sqrt(len1 * len2 / n);
+  for (auto [count, len] : {std::pair<int*, double>{&n1, len1}, std::pair<int*, double>{&n2, len2}}) {
+    const int across = static_cast<int>(std::floor((len / spacing + 1.0) / 4.0));
+    *count = std::max(*count, std::min(3, across));
+  }
   n1 = std::min(n1, 300);
   n2 = std::min(n2, 300);
 }

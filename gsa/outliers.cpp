@@ -1,58 +1,64 @@
 #include "gsa/outliers.hpp"
 
-#include <algorithm>
+#include <fmt/format.h>
+
+#include "gsa/blunders.hpp"
 
 namespace sf::gsa {
 
-namespace {
-
-// Residuals beyond this fraction of the mark spacing may be flagged, however small the
-// noise (a noise-free grid has a robust sigma of round-off).
-constexpr double kFloorPerSpacing = 0.02;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
-// Median of |r| over sigma for Gaussian residuals with `dims` components.
-double median_over_sigma(ResidualKind kind) { return kind == ResidualKind::kNormal ? 0.6745 : 1.5382; }
-
-}  // namespace
-
 const char* to_string(OutlierReason reason) {
   switch (reason) {
-    case OutlierReason::kResidual: return "residual";
+    case OutlierReason::kUndeformedOffNeighbours: return "undeformed position off its neighbours' surface";
+    case OutlierReason::kDeformedOffNeighbours: return "deformed position off its neighbours' deformation";
   }
-  return "residual";
+  return "";
 }
 
-double outlier_threshold(const VecX& residual, const VecX& weight, ResidualKind kind, const OutlierOptions& options,
-                         double mark_spacing) {
-  std::vector<double> r;
-  for (Index i = 0; i < residual.size(); ++i)
-    if (weight[i] > 0) r.push_back(residual[i]);
-  return std::max(options.sigma * median(r) / median_over_sigma(kind), kFloorPerSpacing * mark_spacing);
+const char* code(OutlierReason reason) {
+  switch (reason) {
+    case OutlierReason::kUndeformedOffNeighbours: return "undeformed_off_neighbours";
+    case OutlierReason::kDeformedOffNeighbours: return "deformed_off_neighbours";
+  }
+  return "";
 }
 
-std::vector<OutlierFlag> detect_outliers(const VecX& residual, const VecX& weight, ResidualKind kind,
-                                         const OutlierOptions& options, double mark_spacing) {
-  const double threshold = outlier_threshold(residual, weight, kind, options, mark_spacing);
-  double worst = 0.0;
-  for (Index i = 0; i < residual.size(); ++i)
-    if (weight[i] > 0 && residual[i] > threshold) worst = std::max(worst, residual[i]);
-  std::vector<OutlierFlag> out;
-  for (Index i = 0; i < residual.size(); ++i)
-    if (weight[i] > 0 && residual[i] > threshold && residual[i] >= 0.5 * worst)
-      out.push_back({i, OutlierReason::kResidual, residual[i], threshold});
+std::string describe(const OutlierFlag& f, double sigma, const std::string& units) {
+  return fmt::format("{} by {:.4g} {} (threshold {:.4g} {} = {:g} x noise {:.4g} {})", to_string(f.reason),
+                     f.deviation, units, f.threshold, units, sigma, f.noise, units);
+}
+
+MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
+                           const OutlierOptions& options) {
+  const Index m = marks.size();
+  BlunderOptions bo;
+  bo.threshold = options.sigma;
+  bo.isolation = options.isolation;
+  bo.neighbours = options.neighbours;
+  bo.floor = options.floor * mark_spacing;
+  MarkOutliers out;
+  const std::vector<bool> all(static_cast<std::size_t>(m), true);
+  const BlunderCheck u = find_blunders(marks.undeformed, marks.undeformed, all, true, bo);
+  out.noise_undeformed = u.noise;
+  std::vector<bool> usable(static_cast<std::size_t>(m));
+  for (Index k = 0; k < m; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (u.flagged[kk])
+      out.undeformed.push_back({k, OutlierReason::kUndeformedOffNeighbours, u.deviation[kk], u.threshold, u.noise});
+    usable[kk] = !u.flagged[kk] && deformed.row(k).allFinite();
+  }
+  const BlunderCheck d = find_blunders(marks.undeformed, deformed, usable, false, bo);
+  out.noise_deformed = d.noise;
+  for (Index k = 0; k < m; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (d.flagged[kk])
+      out.deformed.push_back({k, OutlierReason::kDeformedOffNeighbours, d.deviation[kk], d.threshold, d.noise});
+  }
   return out;
 }
 
-std::vector<OutlierFlag> take_readmitted(std::vector<OutlierFlag>& flags, const VecX& residual, double threshold) {
+std::vector<OutlierFlag> take_readmitted(std::vector<OutlierFlag>& flags, const VecX& residual) {
   std::vector<OutlierFlag> readmitted, kept;
-  for (const OutlierFlag& f : flags) (residual[f.mark] < threshold ? readmitted : kept).push_back(f);
+  for (const OutlierFlag& f : flags) (residual[f.mark] <= f.threshold ? readmitted : kept).push_back(f);
   flags = std::move(kept);
   return readmitted;
 }

@@ -1,49 +1,66 @@
 #pragma once
-// Outlier detection of `gsa analyse` (docs/theory/strain.md, "Outliers"): marks whose fit
-// residual is far beyond the noise are flagged, each with the reason, and left out of the
-// fit; flagged marks that a later surface fits well are readmitted. Both fits use it.
+// Outliers of `gsa analyse` (docs/theory/strain.md, "Outliers"): isolated blunders,
+// never real deformation.
 //
-// Threshold: max(k * robust sigma, floor) with robust sigma = median residual /
-// (median of |r| / sigma for Gaussian noise in `dims` components) and floor = 2 % of
-// the mark spacing. Each round flags only the worst marks beyond it (at least half the
-// largest such residual): one bad mark drags its neighbours' residuals up until it is
-// removed.
+// A large fit residual alone does not make a mark wrong: a neck narrower than the
+// smoothing, a wrinkle or a dimple leaves large residuals on every mark it covers, and
+// flagging them hides the highest strains of the part. A mark is flagged only when its
+// neighbours disagree with it (gsa/blunders.hpp): its position is far from the local
+// quadratic fit of its nearest neighbours (leaving it out), in noise levels, AND far
+// more than its neighbours are from theirs. Undeformed state: the normal component of
+// the undeformed position. Deformed state: the deformed position against the
+// undeformed in-plane coordinates (this also catches an undeformed position typed
+// wrong in the plane: its deformed position does not fit where it claims to be).
+//
+// A flagged mark takes no part in the fits that its state enters (an undeformed flag:
+// both fits; a deformed flag: the deformed fit), still gets the strain of the fitted
+// surfaces at its material point, and is readmitted when the final surface passes
+// within its threshold. Every flag carries its numbers (deviation, threshold, noise).
 
 #include <string>
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "gsa/frame_mesh.hpp"
 
 namespace sf::gsa {
 
 struct OutlierOptions {
-  double sigma = 6.0;  // flag residuals beyond this many robust noise sigmas (> 0)
+  double sigma = 4.5;      // deviation from the neighbours' local fit, in noise levels (> 0)
+  double isolation = 2.5;  // and over the second largest deviation of the 8 nearest neighbours (>= 1)
+  int neighbours = 16;     // of the local fit (>= 8)
+  double floor = 0.005;    // the threshold is at least this fraction of the mark spacing (noise-free data)
 };
 
-// Why a mark was left out.
+// Why a mark was flagged.
 enum class OutlierReason {
-  kResidual,  // its residual exceeded the threshold
+  kUndeformedOffNeighbours,  // its undeformed position is off its neighbours' surface
+  kDeformedOffNeighbours,    // its deformed position is off its neighbours' deformation
 };
 const char* to_string(OutlierReason reason);
+// One word for tables: "undeformed_off_neighbours", "deformed_off_neighbours".
+const char* code(OutlierReason reason);
 
 struct OutlierFlag {
   Index mark = -1;  // index into the fit's marks (FitMarks)
-  OutlierReason reason = OutlierReason::kResidual;
-  double residual = 0.0;   // its residual when flagged (units)
-  double threshold = 0.0;  // the threshold it exceeded (units)
+  OutlierReason reason = OutlierReason::kDeformedOffNeighbours;
+  double deviation = 0.0;  // from the neighbours' local fit (units)
+  double threshold = 0.0;  // the threshold it exceeded (units): sigma x noise, or the floor
+  double noise = 0.0;      // the robust noise level of the deviations (units)
 };
+// "deformed position 0.123 mm off its neighbours' local fit (threshold 0.061 mm = 4.5 x noise 0.0136 mm)"
+std::string describe(const OutlierFlag& flag, double sigma, const std::string& units);
 
-// Components of the residuals: the undeformed fit's are distances along the normal
-// (projection absorbs the in-plane noise into xi), the deformed fit's 3-D vectors.
-enum class ResidualKind { kNormal = 1, kVector = 3 };
+struct MarkOutliers {
+  std::vector<OutlierFlag> undeformed, deformed;
+  double noise_undeformed = 0.0, noise_deformed = 0.0;  // robust noise levels of the deviations (units)
+};
+// deformed: m x 3 deformed positions of the marks (NaN where not digitised).
+MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
+                           const OutlierOptions& options);
 
-// The threshold over the marks with weight > 0 (see above).
-double outlier_threshold(const VecX& residual, const VecX& weight, ResidualKind kind, const OutlierOptions& options,
-                         double mark_spacing);
-// One round: the worst marks with weight > 0 beyond the threshold, in mark order.
-std::vector<OutlierFlag> detect_outliers(const VecX& residual, const VecX& weight, ResidualKind kind,
-                                         const OutlierOptions& options, double mark_spacing);
-// Removes from `flags` the marks whose residual is now below `threshold` and returns them.
-std::vector<OutlierFlag> take_readmitted(std::vector<OutlierFlag>& flags, const VecX& residual, double threshold);
+// Removes from `flags` the marks whose residual (distance from the final surface, which
+// they took no part in) is within their threshold, and returns them.
+std::vector<OutlierFlag> take_readmitted(std::vector<OutlierFlag>& flags, const VecX& residual);
 
 }  // namespace sf::gsa

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "gsa/deformed_fit.hpp"
+#include "gsa/noise_model.hpp"
 
 namespace sf::gsa {
 
@@ -23,6 +24,8 @@ constexpr double kGcvStrainFactor = 2.0;
 // The automatic deformed fit is iterated once (two passes, iterated Tikhonov): the
 // second pass smooths towards the first one, which squares the smoothing bias.
 constexpr int kAutoFitPasses = 2;
+// Noise probes of the Cp trace tr(H Sigma): four random fields, three components each.
+constexpr int kNoiseProbes = 12;
 
 }  // namespace
 
@@ -61,35 +64,26 @@ double gauge_length(const Penalty& p, double mark_spacing) {
                    std::pow(std::max(p.delta, 0.0) / rho, 0.125)});
 }
 
-SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOptions& options, double mark_spacing) {
-  const double d = mark_spacing;
-  const VecX& w = problem.weight();
-  const double n_used = w.sum();
-  // Hutchinson probes: the trace estimate's relative error falls as 1/sqrt(probes * N),
-  // so large grids need fewer probes for the same GCV curve.
-  const int probes = n_used > 20000 ? 6 : 12;
-  const double tolerance = n_used > 20000 ? 0.3 : 0.2;
-  auto penalty_at = [&](double log_delta) {
-    Penalty p;
-    p.gamma = kJumpsGammaFloor * std::pow(d, 4);
-    p.delta = std::pow(10.0, log_delta) * std::pow(d, 6);
-    return p;
-  };
-  auto gcv = [&](const FitResult& f) {
-    if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
-    double rss = 0.0;
-    for (Index k = 0; k < w.size(); ++k)
-      if (w[k] > 0) rss += f.residual[k] * f.residual[k];
-    const double a = 1.0 - f.edf / n_used;
-    return rss / (3.0 * n_used) / (a * a);
-  };
-  auto gcv_pair = [&](double a, double b) {
-    const std::array<FitResult, 2> f = problem.fit_pair({penalty_at(a), penalty_at(b)}, probes, kAutoFitPasses);
-    return std::array<double, 2>{gcv(f[0]), gcv(f[1])};
-  };
-  // The bracket keeps the best point in its middle and halves each round.
+Penalty jumps_penalty(double log10_delta, double mark_spacing) {
+  Penalty p;
+  p.gamma = kJumpsGammaFloor * std::pow(mark_spacing, 4);
+  p.delta = std::pow(10.0, log10_delta) * std::pow(mark_spacing, 6);
+  return p;
+}
+
+namespace {
+
+// Minimises `score` over log10(delta / d^6) in [-6, 6], two candidates at a time (fitted
+// on two threads): the bracket keeps the best point in its middle and halves each round
+// until it is `tolerance` wide.
+struct BracketMinimum {
+  double at = 0.0, value = 0.0;
+};
+
+template <class PairScore>
+BracketMinimum bracket_search(const PairScore& score_pair, double tolerance) {
   double left = -6.0, right = 6.0, best = -2.0;
-  const std::array<double, 2> g0 = gcv_pair(-2.0, 2.0);
+  const std::array<double, 2> g0 = score_pair(-2.0, 2.0);
   double g_best = g0[0];
   if (g0[0] <= g0[1]) {
     right = 2.0;
@@ -98,7 +92,7 @@ SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOp
   }
   while (right - left > tolerance) {
     const double p1 = 0.5 * (left + best), p2 = 0.5 * (best + right);
-    const std::array<double, 2> g = gcv_pair(p1, p2);
+    const std::array<double, 2> g = score_pair(p1, p2);
     if (g[0] < g_best && g[0] <= g[1]) {
       right = best, best = p1, g_best = g[0];
     } else if (g[1] < g_best) {
@@ -107,12 +101,72 @@ SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOp
       left = p1, right = p2;
     }
   }
+  return {best, g_best};
+}
+
+double weighted_rss(const FitResult& f, const VecX& w) {
+  double rss = 0.0;
+  for (Index k = 0; k < w.size(); ++k)
+    if (w[k] > 0) rss += f.residual[k] * f.residual[k];
+  return rss;
+}
+
+SmoothingChoice strain_choice(const BracketMinimum& best, const char* criterion, const SmoothingOptions& options,
+                              double d) {
   SmoothingChoice choice;
-  choice.gcv_log10_delta = best;
-  choice.penalty.gamma = kJumpsGammaFloor * std::pow(d, 4);
-  choice.penalty.delta = options.scale * kGcvStrainFactor * std::pow(10.0, best) * std::pow(d, 6);
+  choice.gcv_log10_delta = best.at;
+  choice.criterion = criterion;
+  choice.criterion_value = best.value;
+  choice.penalty = jumps_penalty(best.at, d);
+  choice.penalty.delta *= options.scale * kGcvStrainFactor;
   choice.passes = kAutoFitPasses;
   return choice;
+}
+
+}  // namespace
+
+SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOptions& options, double mark_spacing) {
+  const double d = mark_spacing;
+  const VecX& w = problem.weight();
+  const double n_used = w.sum();
+  // Hutchinson probes: the trace estimate's relative error falls as 1/sqrt(probes * N),
+  // so large grids need fewer probes for the same GCV curve.
+  const int probes = n_used > 20000 ? 6 : 12;
+  const double tolerance = n_used > 20000 ? 0.3 : 0.2;
+  auto gcv = [&](const FitResult& f) {
+    if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
+    const double a = 1.0 - f.edf / n_used;
+    return weighted_rss(f, w) / (3.0 * n_used) / (a * a);
+  };
+  auto pair = [&](double a, double b) {
+    const std::array<FitResult, 2> f =
+        problem.fit_pair({jumps_penalty(a, d), jumps_penalty(b, d)}, probes, kAutoFitPasses);
+    return std::array<double, 2>{gcv(f[0]), gcv(f[1])};
+  };
+  return strain_choice(bracket_search(pair, tolerance), "GCV", options, d);
+}
+
+SmoothingChoice choose_smoothing_noise_model(DeformedProblem& problem, const SmoothingOptions& options,
+                                             const NoiseEstimate& noise, const Points3& positions,
+                                             double mark_spacing) {
+  const double d = mark_spacing;
+  const VecX& w = problem.weight();
+  const double n_used = w.sum();
+  const int probes = kNoiseProbes;
+  const double tolerance = n_used > 20000 ? 0.3 : 0.2;
+  problem.set_probes(noise_probes(noise, positions, probes));
+  // Cp with correlated noise: E|H z - f|^2 = |z - H z|^2 - tr(Sigma) + 2 tr(H Sigma) per
+  // component; the trace from probes drawn from the noise model.
+  auto cp = [&](const FitResult& f) {
+    if (!f.ok || !(f.edf < 0.95 * n_used)) return std::numeric_limits<double>::infinity();
+    return weighted_rss(f, w) + 6.0 * f.edf;
+  };
+  auto pair = [&](double a, double b) {
+    const std::array<FitResult, 2> f =
+        problem.fit_pair({jumps_penalty(a, d), jumps_penalty(b, d)}, probes, kAutoFitPasses);
+    return std::array<double, 2>{cp(f[0]), cp(f[1])};
+  };
+  return strain_choice(bracket_search(pair, tolerance), "Cp", options, d);
 }
 
 }  // namespace sf::gsa

@@ -10,11 +10,13 @@
 #include <limits>
 #include <optional>
 
+#include "common/core/types.hpp"
 #include "gsa/fit.hpp"
 
 namespace sf::gsa {
 
 class DeformedProblem;
+struct NoiseEstimate;
 
 enum class PenaltyKind {
   kThirdOrder,  // gamma: third derivatives with edge jumps of the second (--penalty third)
@@ -22,8 +24,16 @@ enum class PenaltyKind {
   kJumps,       // delta: fourth-order edge jumps, weight by GCV (--penalty jumps, the default)
 };
 
+// How the automatic deformed weight is chosen (jumps penalty).
+enum class SmoothingRule {
+  kNoiseModel,  // Cp with the estimated noise model, correlation included (--smoothing-rule noise-model, the default)
+  kGcv,         // generalised cross-validation, which assumes independent errors (--smoothing-rule gcv)
+};
+
 struct SmoothingOptions {
   PenaltyKind penalty = PenaltyKind::kJumps;
+  SmoothingRule rule = SmoothingRule::kNoiseModel;
+  bool local = true;  // relax the smoothing where the fit cannot follow a localised feature
   // Explicit weights: giving any switches the automatic choice off; these are used for
   // both fits and the unset ones are 0. Units: alpha 1, beta units^2, gamma units^4,
   // delta units^6 (each >= 0).
@@ -43,6 +53,9 @@ Penalty noise_rule_penalty(const SmoothingOptions& options, double sigma, double
 // Explicit weights, or the noise rule when automatic.
 Penalty penalty_for_noise(const SmoothingOptions& options, double sigma, double mark_spacing);
 
+// The jumps penalty with delta = 10^log10_delta d^6 (and the small third-order floor).
+Penalty jumps_penalty(double log10_delta, double mark_spacing);
+
 // Effective smoothing length (units) of a penalty: the largest of (gamma/rho)^(1/6),
 // (beta/rho)^(1/4), (delta/rho)^(1/8), rho = 1/d^2.
 double gauge_length(const Penalty& penalty, double mark_spacing);
@@ -50,7 +63,9 @@ double gauge_length(const Penalty& penalty, double mark_spacing);
 struct SmoothingChoice {
   Penalty penalty;
   int passes = 1;  // of the fit (iterated Tikhonov, gsa/fit.hpp)
-  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // GCV optimum, log10(delta / d^6)
+  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // the criterion's optimum, log10(delta / d^6)
+  const char* criterion = "";  // "GCV" or "Cp" (noise model); empty for explicit weights
+  double criterion_value = std::numeric_limits<double>::quiet_NaN();  // at the optimum (GCV: mm^2; Cp: mm^2 summed)
 };
 
 // Generalised cross-validation of the deformed positions over log10(delta / d^6) in
@@ -59,5 +74,17 @@ struct SmoothingChoice {
 // positions) times options.scale. Fits the problem's current data with its current
 // weights; leaves its data and weights as they are.
 SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOptions& options, double mark_spacing);
+
+// The same search minimising Mallows' Cp with correlated noise,
+//   Cp = |z - H z|^2 + 2 x 3 tr(H Sigma)   (3 components, Sigma per component),
+// an unbiased estimate of the position error |H z - f|^2 up to a constant, with
+// tr(H Sigma) estimated from probes drawn from `noise` at the marks' undeformed
+// `positions` (m x 3). Where the noise is independent this is close to GCV; where it is
+// correlated, GCV takes the correlated part for signal and under-smooths, Cp does not.
+// The weight used is 2 x the optimum (as for GCV) times options.scale. Leaves the
+// problem's probes set to the noise probes.
+SmoothingChoice choose_smoothing_noise_model(DeformedProblem& problem, const SmoothingOptions& options,
+                                             const NoiseEstimate& noise, const Points3& positions,
+                                             double mark_spacing);
 
 }  // namespace sf::gsa

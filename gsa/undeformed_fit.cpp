@@ -13,8 +13,6 @@ namespace {
 
 // The undeformed fit and projection alternate until no mark moves more than this (in xi).
 constexpr double kXiSettled = 1e-4;
-// Outer rounds (flag outliers, re-estimate the noise) at most.
-constexpr int kMaxRounds = 8;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -67,12 +65,15 @@ UndeformedFit fit_undeformed(const FrameAndMesh& setup, const FitMarks& marks, c
   UndeformedFit out;
   out.location = setup.start;
   out.weight = VecX::Ones(marks.size());
+  out.flags = options.outliers;
+  for (const OutlierFlag& f : out.flags) out.weight[f.mark] = 0.0;
   out.penalty = penalty_for_noise(options.smoothing, 0.0, d);
   FitResult fit;
   bool searched = false;  // a global projection has been done
-  for (int round = 0; round < kMaxRounds; ++round) {
-    // The first round only estimates the noise: one projection is enough there.
-    const int iterations = (automatic && round == 0) ? 1 : std::max(1, options.max_projection_iterations);
+  // Round 0 (automatic only): one projection, then the noise estimate sets the weights.
+  // Then fit-and-project until the xi settle; once more after readmitting outliers.
+  for (int round = automatic ? 0 : 1; round < 3; ++round) {
+    const int iterations = round == 0 ? 1 : std::max(1, options.max_projection_iterations);
     for (int it = 0; it < iterations; ++it) {
       const auto tf = Clock::now();
       FitSystem system(mesh, setup.penalties, out.location, out.weight);
@@ -86,21 +87,18 @@ UndeformedFit fit_undeformed(const FrameAndMesh& setup, const FitMarks& marks, c
       out.project_seconds += seconds_since(tp);
       if (max_dxi < kXiSettled) break;  // xi settled
     }
-    bool changed = false;
-    for (const OutlierFlag& f : detect_outliers(fit.residual, out.weight, ResidualKind::kNormal, options.outliers, d)) {
-      out.weight[f.mark] = 0.0;
-      out.flags.push_back(f);
-      changed = true;
-    }
-    if (automatic && round == 0) {
+    if (round == 0) {
       const double noise = estimate_noise(fit, out.weight, mesh.n_dofs());
       if (std::isfinite(noise)) {
         out.noise_estimate = noise;
         out.penalty = noise_rule_penalty(options.smoothing, noise, d);
-        changed = true;
       }
+      continue;
     }
-    if (!changed) break;
+    if (round == 2) break;
+    const std::vector<OutlierFlag> back = take_readmitted(out.flags, fit.residual);
+    for (const OutlierFlag& f : back) out.weight[f.mark] = 1.0;
+    if (back.empty()) break;
   }
   out.parameters = fit.parameters;
   out.residual = fit.residual;

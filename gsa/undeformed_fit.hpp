@@ -3,9 +3,11 @@
 // coordinates (docs/theory/strain.md, "Undeformed fit").
 //
 // The fit alternates with nearest-point projection of the marks onto the fitted surface
-// until their xi settle; each round then flags outliers (gsa/outliers.hpp) and, with
-// automatic smoothing, the first round estimates the digitisation noise from a light fit
-// and sets the weights by the noise rule. The result is what every deformed fit of the
+// until their xi settle; with automatic smoothing a first round estimates the
+// digitisation noise from a light fit and sets the weights by the noise rule. Marks
+// flagged as outliers beforehand (gsa/outliers.hpp) take no part, are projected all the
+// same (so they get a material coordinate), and are readmitted when the final surface
+// passes within their threshold. The result is what every deformed fit of the
 // same marks starts from: fit it once, and fit as many deformed states against it as
 // there are.
 
@@ -21,7 +23,7 @@ namespace sf::gsa {
 
 struct UndeformedFitOptions {
   SmoothingOptions smoothing;
-  OutlierOptions outliers;
+  std::vector<OutlierFlag> outliers;  // undeformed flags (find_outliers): left out unless readmitted
   int max_projection_iterations = 5;  // fit-and-project rounds per outer round (>= 1)
 };
 
@@ -30,7 +32,7 @@ struct UndeformedFit {
   std::vector<MeshLocation> location;  // m: each mark's material coordinate (element, xi)
   VecX residual;                       // m: distance of each mark from X at its location (units)
   VecX weight;                         // m: 1 where the mark took part, 0 where flagged
-  std::vector<OutlierFlag> flags;      // the marks left out, with reasons
+  std::vector<OutlierFlag> flags;      // the marks left out (not readmitted), with reasons
   double rms = 0.0, max = 0.0;         // residuals over the marks that took part
   Penalty penalty;                     // the weights of the final fit
   double noise_estimate = 0.0;         // digitisation noise per coordinate (automatic smoothing), units

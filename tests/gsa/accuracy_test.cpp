@@ -136,6 +136,18 @@ std::string describe(const StrainError& e) {
   return os.str();
 }
 
+// How the analysis chose its smoothing, for failure messages.
+std::string describe(const AnalysisResult& a) {
+  std::ostringstream os;
+  Index flagged = 0;
+  for (const PointResult& p : a.points) flagged += p.flag ? 1 : 0;
+  os << "noise und " << a.noise_undeformed.sigma_total() << " L " << a.noise_undeformed.effective_length()
+     << ", def sc " << a.noise.sigma_correlated << " sw " << a.noise.sigma_white << ", log10 delta "
+     << a.gcv_log10_delta << ", gauge " << a.gauge_length << ", relaxed " << a.relaxed_elements << ", flagged "
+     << flagged;
+  return os.str();
+}
+
 // The exact maps' rotation (gsa/synthetic.cpp: 0.7 rad about (1, 2, 3)).
 Mat3 synthetic_rotation() { return Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix(); }
 
@@ -243,7 +255,7 @@ TEST(GsaAccuracy, WavyNoiseFree) {
   const CaseRun r = run_case("wavy");
   const StrainError e = strain_error(r.grid, r.result, r.exact);
   EXPECT_EQ(e.n_missing, 0);
-  EXPECT_LT(e.rms(), tol::kWavyRms) << describe(e);
+  EXPECT_LT(e.rms(), tol::kWavyRms) << describe(e) << "; " << describe(r.result);
 }
 
 TEST(GsaAccuracy, TrellisShearAngleAndInextensibleFibres) {
@@ -506,22 +518,13 @@ TEST(GsaMissing, MissingUndeformedMarkIsFlaggedAndTakesNoPart) {
 // make_synthetic_grid moves marks (k * 7919 + n / 3) % n, k = 0, 1, by 2 mm in z.
 std::vector<Index> moved_marks(Index n) { return {(n / 3) % n, (7919 + n / 3) % n}; }
 
-// Moved marks at least one row inside the grid edge (those strain_error counts).
-Index interior_moved_marks(const GridData& g) {
-  long imax = 0, jmax = 0;
-  for (Index p = 0; p < g.n_points(); ++p) imax = std::max(imax, g.i[p]), jmax = std::max(jmax, g.j[p]);
-  Index k = 0;
-  for (Index p : moved_marks(g.n_points())) k += g.i[p] > 0 && g.j[p] > 0 && g.i[p] < imax && g.j[p] < jmax;
-  return k;
-}
-
 // Checks that exactly the moved marks are flagged outlier_deformed.
 void expect_only_moved_marks_flagged(const GridData& g, const AnalysisResult& res) {
   const std::vector<Index> moved = moved_marks(g.n_points());
   for (Index p = 0; p < g.n_points(); ++p) {
     if (std::find(moved.begin(), moved.end(), p) != moved.end()) {
       EXPECT_EQ(res.points[p].status, kStatusOutlierDeformed) << g.ids[p];
-      EXPECT_FALSE(res.points[p].strain) << g.ids[p];
+      EXPECT_TRUE(res.points[p].strain) << g.ids[p] << ": a flagged mark still gets the fitted surfaces' strain";
     } else {
       EXPECT_EQ(res.points[p].status, kStatusOk) << g.ids[p] << " is not an outlier";
     }
@@ -540,7 +543,7 @@ TEST_P(NoisyOutliers, AreFlaggedAndTheRestStayAsAccurate) {
   const AnalysisResult res = analyse(g, {});
   expect_only_moved_marks_flagged(g, res);
   const StrainError e = strain_error(g, res, exact), e0 = strain_error(clean, analyse(clean, {}), exact);
-  EXPECT_EQ(e.n_missing, interior_moved_marks(g));
+  EXPECT_EQ(e.n_missing, 0);
   EXPECT_LT(e.rms(), tol::kOutlierRemovedRel * e0.rms()) << "with outliers: " << describe(e)
                                                          << "; without: " << describe(e0);
 }
@@ -560,7 +563,7 @@ TEST(GsaMissing, NoiseFreeOutliersAreTheOnlyMarksFlagged) {
   const AnalysisResult res = analyse(g, {});
   expect_only_moved_marks_flagged(g, res);
   const StrainError e = strain_error(g, res, exact);
-  EXPECT_EQ(e.n_missing, interior_moved_marks(g));
+  EXPECT_EQ(e.n_missing, 0);
   EXPECT_LT(e.rms(), tol::kDomeDegradedRms) << describe(e);
 }
 

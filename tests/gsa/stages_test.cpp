@@ -52,17 +52,17 @@ TEST(GsaStages, ProgressHearsEachStageInOrderWithTheMesh) {
     }
   };
   const AnalysisResult r = analyse(grid, {}, progress);
-  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kUndeformedFit,
-                                 AnalysisStage::kDeformedFit, AnalysisStage::kSmoothingChoice,
-                                 AnalysisStage::kStrains));
+  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers,
+                                 AnalysisStage::kUndeformedFit, AnalysisStage::kDeformedFit,
+                                 AnalysisStage::kSmoothingChoice, AnalysisStage::kStrains));
   EXPECT_EQ(layout, r.mesh_layout);
   // Explicit weights: no smoothing is chosen.
   heard.clear();
   AnalyseOptions o;
   o.smoothing.gamma = 1.0;
   analyse(grid, o, progress);
-  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kUndeformedFit,
-                                 AnalysisStage::kDeformedFit, AnalysisStage::kStrains));
+  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers,
+                                 AnalysisStage::kUndeformedFit, AnalysisStage::kDeformedFit, AnalysisStage::kStrains));
 }
 
 // Stage series: the undeformed fit of the marks once, then two deformed states of the
@@ -86,7 +86,7 @@ TEST(GsaStages, OneUndeformedFitServesSeveralDeformedStates) {
       grid.deformed.row(p) = (states[s] * grid.undeformed.row(p).transpose() + Vec3(3, -2, 1)).transpose();
     const DeformedMarks data = deformed_marks(grid, marks, und);
     DeformedProblem problem(setup, marks, und, data);
-    const DeformedFit fit = fit_deformed(problem, explicit_penalty(uo.smoothing), {}, setup.mark_spacing);
+    const DeformedFit fit = fit_deformed(problem, explicit_penalty(uo.smoothing), {});
     EXPECT_TRUE(fit.flags.empty());
     const SurfacePair surfaces(setup.mesh, und.parameters, fit.fit.parameters);
     for (std::size_t k = 0; k < und.location.size(); ++k) {
@@ -98,10 +98,10 @@ TEST(GsaStages, OneUndeformedFitServesSeveralDeformedStates) {
   }
 }
 
-// Two marks digitised 2 mm off: the first deformed fit flags them (and, while they still
-// pull the surface, a neighbour or two), each flag with its reason, residual and the
-// threshold it exceeded; after the smoothing choice, readmission keeps exactly the two.
-TEST(GsaStages, OutlierFlagsCarryReasonResidualAndThreshold) {
+// Two marks digitised 2 mm off: the neighbour check flags exactly them, each flag with its
+// reason and numbers; they take no part in the deformed fit, are not readmitted (the
+// final surface passes far from them), and still get the fitted surfaces' strain.
+TEST(GsaStages, OutlierFlagsCarryReasonDeviationThresholdAndNoise) {
   const GridData grid = grid_of("dome", 21, 2), clean = grid_of("dome", 21, 0);
   std::vector<Index> offset;  // the marks moved 2 mm
   for (Index p = 0; p < grid.n_points(); ++p)
@@ -110,62 +110,52 @@ TEST(GsaStages, OutlierFlagsCarryReasonResidualAndThreshold) {
   const AnalyseOptions o;
   const FitMarks marks = fit_marks(grid);
   const FrameAndMesh setup = build_frame_and_mesh(grid, marks, o.mesh);
-  const UndeformedFit und = fit_undeformed(setup, marks, {o.smoothing, o.outliers, o.max_projection_iterations});
+  Points3 deformed(marks.size(), 3);
+  for (Index k = 0; k < marks.size(); ++k) deformed.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  MarkOutliers found = find_outliers(marks, deformed, setup.mark_spacing, o.outliers);
+  EXPECT_TRUE(found.undeformed.empty());
+  ASSERT_EQ(found.deformed.size(), 2u);
+  for (const OutlierFlag& f : found.deformed) {
+    EXPECT_EQ(f.reason, OutlierReason::kDeformedOffNeighbours);
+    EXPECT_GT(f.deviation, f.threshold);
+    EXPECT_NEAR(f.threshold, std::max(o.outliers.sigma * f.noise, o.outliers.floor * setup.mark_spacing), 1e-12);
+    EXPECT_GT(f.deviation, 1.0);  // about the 2 mm offset
+    EXPECT_NE(describe(f, o.outliers.sigma, "mm").find("threshold"), std::string::npos);
+  }
+  const UndeformedFit und = fit_undeformed(setup, marks, {o.smoothing, found.undeformed, o.max_projection_iterations});
   const DeformedMarks data = deformed_marks(grid, marks, und);
   DeformedProblem problem(setup, marks, und, data);
   const double d = setup.mark_spacing;
-  DeformedFit fit = fit_deformed(problem, penalty_for_noise(o.smoothing, und.noise_estimate, d), o.outliers, d);
-  ASSERT_GE(fit.flags.size(), 2u);
-  for (const OutlierFlag& f : fit.flags) {
-    EXPECT_EQ(f.reason, OutlierReason::kResidual);
-    EXPECT_STREQ(to_string(f.reason), "residual");
-    EXPECT_GT(f.residual, f.threshold);
-    EXPECT_EQ(problem.weight()[f.mark], 0.0);
-  }
+  DeformedFit fit = fit_deformed(problem, penalty_for_noise(o.smoothing, und.noise_estimate, d), found.deformed);
+  for (const OutlierFlag& f : fit.flags) EXPECT_EQ(problem.weight()[f.mark], 0.0);
   refit_deformed(problem, fit, choose_smoothing_gcv(problem, o.smoothing, d));
-  readmit_deformed(problem, fit, o.outliers, d);
+  readmit_deformed(problem, fit);
   std::vector<Index> kept;
   for (const OutlierFlag& f : fit.flags) kept.push_back(marks.point[static_cast<std::size_t>(f.mark)]);
   std::sort(kept.begin(), kept.end());
   EXPECT_EQ(kept, offset);
-  for (Index k = 0; k < marks.size(); ++k) {
-    const bool out = std::find(kept.begin(), kept.end(), marks.point[static_cast<std::size_t>(k)]) != kept.end();
-    EXPECT_EQ(problem.weight()[k], out ? 0.0 : 1.0) << "mark " << k;
-  }
-  // The whole analysis reports the same two marks.
+  // The whole analysis reports the same two marks, and gives them strains.
   const AnalysisResult r = analyse(grid, o);
   std::vector<Index> flagged;
   for (Index p = 0; p < grid.n_points(); ++p)
-    if (r.points[p].status == kStatusOutlierDeformed) flagged.push_back(p);
+    if (r.points[p].status == kStatusOutlierDeformed) {
+      flagged.push_back(p);
+      EXPECT_TRUE(r.points[p].strain.has_value());
+      ASSERT_TRUE(r.points[p].flag.has_value());
+    }
   EXPECT_EQ(flagged, offset);
 }
 
-TEST(GsaStages, OutlierDetectionTakesTheWorstRoundAndReadmitsTheFitOnes) {
-  // Residuals of ten marks with unit noise (median 1 in 3-D) and two large ones.
-  VecX r(12), w = VecX::Ones(12);
-  r << 1, 1.1, 0.9, 1, 1.2, 0.8, 1, 1.05, 0.95, 1, 30, 12;
-  const OutlierOptions o;  // 6 sigmas
-  const double threshold = outlier_threshold(r, w, ResidualKind::kVector, o, 1.0);
-  EXPECT_NEAR(threshold, 6.0 * 1.0 / 1.5382, 1e-12);
-  // Only the worst round: 30 is flagged, 12 (beyond the threshold but under half of 30) waits.
-  std::vector<OutlierFlag> flags = detect_outliers(r, w, ResidualKind::kVector, o, 1.0);
-  ASSERT_EQ(flags.size(), 1u);
-  EXPECT_EQ(flags[0].mark, 10);
-  EXPECT_DOUBLE_EQ(flags[0].residual, 30.0);
-  EXPECT_DOUBLE_EQ(flags[0].threshold, threshold);
-  // Marks with weight 0 are not judged; the floor is 2 % of the spacing.
-  w[10] = 0;
-  flags = detect_outliers(r, w, ResidualKind::kVector, o, 1.0);
-  ASSERT_EQ(flags.size(), 1u);
-  EXPECT_EQ(flags[0].mark, 11);
-  EXPECT_TRUE(detect_outliers(r, w, ResidualKind::kVector, o, 1000.0).empty());  // floor 20 > 12
-  // Readmission: a flagged mark the surface now fits is taken back, the other kept.
-  std::vector<OutlierFlag> out = {{3, OutlierReason::kResidual, 9, 4}, {10, OutlierReason::kResidual, 30, 4}};
-  const std::vector<OutlierFlag> back = take_readmitted(out, r, threshold);
+TEST(GsaStages, ReadmissionTakesBackTheMarksTheSurfacePassesWithinTheirThreshold) {
+  VecX residual(4);
+  residual << 0.1, 5.0, 0.3, 0.9;
+  std::vector<OutlierFlag> flags = {{1, OutlierReason::kDeformedOffNeighbours, 5.2, 1.0, 0.2},
+                                    {3, OutlierReason::kDeformedOffNeighbours, 1.5, 1.0, 0.2}};
+  const std::vector<OutlierFlag> back = take_readmitted(flags, residual);
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].mark, 3);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].mark, 10);
+  ASSERT_EQ(flags.size(), 1u);
+  EXPECT_EQ(flags[0].mark, 1);
 }
 
 // Every bad value the library can meet names its field; the command line names the flag

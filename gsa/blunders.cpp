@@ -1,0 +1,158 @@
+#include "gsa/blunders.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "common/core/error.hpp"
+#include "common/mesh/neighbours.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Median of a chi distribution with k degrees of freedom (|e| of k unit normals).
+double chi_median(int k) { return k == 1 ? 0.674490 : 1.538172; }
+
+// Leave-one-out deviation of point p from the local quadratic of its neighbours.
+double deviation(const Points3& X, const Points3& v, Index p, const std::vector<Index>& nb, bool normal_only) {
+  const Index k = static_cast<Index>(nb.size());
+  if (k < 4) return std::numeric_limits<double>::quiet_NaN();
+  Vec3 centre = Vec3::Zero();
+  for (Index q : nb) centre += X.row(q).transpose();
+  centre /= static_cast<double>(k);
+  Mat3 cov = Mat3::Zero();
+  double scale = 0.0;
+  for (Index q : nb) {
+    const Vec3 d = X.row(q).transpose() - centre;
+    cov += d * d.transpose();
+    scale += (X.row(q) - X.row(p)).norm();
+  }
+  scale = std::max(scale / static_cast<double>(k), 1e-300);
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  const Vec3 n = es.eigenvectors().col(0), t1 = es.eigenvectors().col(2), t2 = es.eigenvectors().col(1);
+  // Quadratic with >= 10 neighbours, else linear; coordinates scaled to O(1).
+  const int terms = k >= 10 ? 6 : 3;
+  MatX A(k, terms);
+  MatX b(k, normal_only ? 1 : 3);
+  for (Index i = 0; i < k; ++i) {
+    const Index q = nb[static_cast<std::size_t>(i)];
+    const Vec3 d = X.row(q).transpose() - X.row(p).transpose();
+    const double s = d.dot(t1) / scale, t = d.dot(t2) / scale;
+    A(i, 0) = 1.0;
+    A(i, 1) = s;
+    A(i, 2) = t;
+    if (terms == 6) {
+      A(i, 3) = s * s;
+      A(i, 4) = s * t;
+      A(i, 5) = t * t;
+    }
+    if (normal_only)
+      b(i, 0) = d.dot(n);
+    else
+      b.row(i) = v.row(q) - v.row(p);  // relative to the point: the prediction is then -deviation
+  }
+  const MatX ata = A.transpose() * A;
+  const Eigen::LDLT<MatX> ldlt(ata);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-10)) return std::numeric_limits<double>::quiet_NaN();
+  const MatX c = ldlt.solve(A.transpose() * b);
+  // Standardised: the prediction c0 carries noise of variance v0 sigma^2 on top of
+  // the point's own (v0 = (A^T A)^-1_00: larger at gaps and at the outline).
+  const VecX e0 = ldlt.solve(VecX::Unit(terms, 0));
+  return c.row(0).norm() / std::sqrt(1.0 + e0[0]);
+}
+
+}  // namespace
+
+void BlunderOptions::validate() const {
+  if (neighbours < 8) throw UsageError("blunder check: at least 8 neighbours are needed, found " + std::to_string(neighbours));
+  if (!(threshold > 0.0) || !std::isfinite(threshold)) throw UsageError("blunder check: the threshold must be a positive number");
+  if (!(isolation >= 1.0) || !std::isfinite(isolation)) throw UsageError("blunder check: the isolation factor must be >= 1");
+  if (passes < 1) throw UsageError("blunder check: at least one pass");
+}
+
+Index BlunderCheck::n_flagged() const { return static_cast<Index>(std::count(flagged.begin(), flagged.end(), true)); }
+
+BlunderCheck find_blunders(const Points3& positions, const Points3& values, const std::vector<bool>& usable,
+                           bool normal_only, const BlunderOptions& o) {
+  o.validate();
+  const Index n = positions.rows();
+  BlunderCheck out;
+  out.deviation.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  out.flagged.assign(static_cast<std::size_t>(n), false);
+  Points3 X = positions;
+  for (Index p = 0; p < n; ++p)
+    if (!usable[static_cast<std::size_t>(p)] || !values.row(p).allFinite())
+      X.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
+  // Candidates once; each pass takes the nearest ones not flagged.
+  const std::vector<std::vector<Index>> candidates = mesh::nearest_neighbours(X, o.neighbours + 16);
+  const int comps = normal_only ? 1 : 3;
+  for (int pass = 0; pass < o.passes; ++pass) {
+    std::vector<std::vector<Index>> nb(static_cast<std::size_t>(n));
+    for (Index p = 0; p < n; ++p) {
+      for (Index q : candidates[static_cast<std::size_t>(p)])
+        if (!out.flagged[static_cast<std::size_t>(q)] && static_cast<int>(nb[static_cast<std::size_t>(p)].size()) < o.neighbours)
+          nb[static_cast<std::size_t>(p)].push_back(q);
+    }
+    std::vector<double> clean;
+    for (Index p = 0; p < n; ++p)
+      if (!out.flagged[static_cast<std::size_t>(p)]) out.deviation[static_cast<std::size_t>(p)] = std::numeric_limits<double>::quiet_NaN();
+    for (Index p = 0; p < n; ++p) {
+      // A flagged point keeps the deviation it was flagged with.
+      if (!X.row(p).allFinite() || out.flagged[static_cast<std::size_t>(p)]) continue;
+      const double e = deviation(X, values, p, nb[static_cast<std::size_t>(p)], normal_only);
+      out.deviation[static_cast<std::size_t>(p)] = e;
+      if (std::isfinite(e) && !out.flagged[static_cast<std::size_t>(p)]) clean.push_back(e);
+    }
+    out.noise = median_of(clean) / chi_median(comps);
+    out.threshold = std::max(o.threshold * out.noise, o.floor);
+    // Only the largest deviation of its neighbourhood is judged in a pass: a blunder
+    // spoils its neighbours' fits too, and they are judged again without it.
+    auto local_max = [&](Index p, double e) {
+      int seen = 0;
+      for (Index q : nb[static_cast<std::size_t>(p)]) {
+        if (seen++ == 8) break;
+        if (out.deviation[static_cast<std::size_t>(q)] > e) return false;
+      }
+      return true;
+    };
+    std::vector<Index> newly;
+    for (Index p = 0; p < n; ++p) {
+      const double e = out.deviation[static_cast<std::size_t>(p)];
+      if (!std::isfinite(e) || out.flagged[static_cast<std::size_t>(p)] || !(e > out.threshold)) continue;
+      if (!local_max(p, e)) continue;
+      // The neighbours' deviations without the candidate (a blunder pulls its
+      // neighbours' local fits towards itself).
+      std::vector<double> around;
+      for (Index q : nb[static_cast<std::size_t>(p)]) {
+        std::vector<Index> others;
+        for (Index r : candidates[static_cast<std::size_t>(q)])
+          if (r != p && !out.flagged[static_cast<std::size_t>(r)] && static_cast<int>(others.size()) < o.neighbours)
+            others.push_back(r);
+        const double eq = deviation(X, values, q, others, normal_only);
+        if (std::isfinite(eq)) around.push_back(eq);
+        if (around.size() == 8) break;
+      }
+      // A feature along a line (a neck) has at least two neighbours as far off as the
+      // point; a blunder has none: compare with the second largest of the eight.
+      std::sort(around.begin(), around.end(), std::greater<double>());
+      const double second = around.size() >= 2 ? around[1] : 0.0;
+      if (e > o.isolation * second) newly.push_back(p);
+    }
+    for (Index p : newly) out.flagged[static_cast<std::size_t>(p)] = true;
+    if (newly.empty()) break;
+  }
+  return out;
+}
+
+}  // namespace sf::gsa

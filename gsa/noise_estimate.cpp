@@ -1,0 +1,147 @@
+#include "gsa/noise_estimate.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/fe/surface_field.hpp"
+#include "common/mesh/neighbours.hpp"
+#include "gsa/deformed_fit.hpp"
+#include "gsa/smoothing.hpp"
+
+namespace sf::gsa {
+
+namespace {
+
+// Variogram lags: up to 15 spacings for the correlation length (the range is 1-5
+// spacings: the variogram must reach its sill), 8 for the amplitudes.
+constexpr double kUndeformedMaxLag = 15.0;
+constexpr double kDeformedMaxLag = 8.0;
+// A pilot's estimate is confirmed by the next lighter one when the total sigma agrees
+// within this fraction and the effective length within kLengthAgreement of the longer
+// one plus half a spacing.
+constexpr double kSigmaAgreement = 0.15;
+constexpr double kLengthAgreement = 0.35;
+// A pilot shows no smooth bias when b r_max^2 < this fraction of the noise variance.
+constexpr double kBiasFraction = 0.25;
+// Points whose neighbourhood (3 spacings) mean square residual exceeds this multiple of
+// the median are misfit, not noise, for the amplitude estimate.
+constexpr double kMisfitFactor = 6.0;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+bool confirms(const NoiseEstimate& heavier, const NoiseEstimate& lighter, double d) {
+  const double sh = heavier.sigma_total(), sl = lighter.sigma_total();
+  const double lh = heavier.effective_length(), ll = lighter.effective_length();
+  return std::abs(sh - sl) <= kSigmaAgreement * sl &&
+         std::abs(lh - ll) <= kLengthAgreement * std::max(lh, ll) + 0.5 * d;
+}
+
+}  // namespace
+
+NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks, const UndeformedFit& und) {
+  const Index m = marks.size();
+  const double d = setup.mark_spacing;
+  const mesh::SurfaceMesh& mesh = setup.mesh;
+  // Normals of the fitted undeformed surface at the marks.
+  const fe::SurfaceField surface(mesh, und.parameters);
+  Points3 normal(m, 3);
+  for (Index k = 0; k < m; ++k) {
+    const MeshLocation& loc = und.location[static_cast<std::size_t>(k)];
+    const Mat32 t = surface.evaluate3(loc.element, loc.xi, basis::kFirst).dx;
+    normal.row(k) = t.col(0).cross(t.col(1)).normalized().transpose();
+  }
+  FitSystem system(mesh, setup.penalties, und.location, und.weight);
+  std::vector<bool> usable(static_cast<std::size_t>(m));
+  for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = und.weight[k] > 0;
+  VariogramOptions vo;
+  vo.max_lag = kUndeformedMaxLag * d;
+  const VariogramPairs pairs(marks.undeformed, usable, d, vo);
+  std::vector<NoiseEstimate> ladder;
+  MatX residual(m, 1);
+  for (int k = 8; k >= 1; --k) {
+    const Penalty pilot = jumps_penalty(k, d);
+    system.set_values(marks.undeformed);
+    const FitResult f = system.solve(pilot, mesh.geometry(), 0, 1);
+    if (!f.ok) break;
+    for (Index i = 0; i < m; ++i) residual(i, 0) = (marks.undeformed.row(i) - f.fitted.row(i)).dot(normal.row(i));
+    auto shrink = [&](const MatX& probes) {
+      system.set_values(probes);
+      const FitResult g = system.solve(pilot, MatX::Zero(mesh.n_dofs(), probes.cols()), 0, 1);
+      return MatX(probes - g.fitted);
+    };
+    ladder.push_back(fit_noise_model(pairs, pairs.gamma(residual, 1), marks.undeformed, shrink));
+  }
+  if (ladder.empty()) return {};
+  for (std::size_t i = 0; i + 1 < ladder.size(); ++i) {
+    const NoiseEstimate& e = ladder[i];
+    const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
+    if (unbiased && confirms(e, ladder[i + 1], d)) return e;
+  }
+  return ladder.back();
+}
+
+NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
+                             const NoiseEstimate& undeformed) {
+  const Index m = marks.size();
+  const double d = setup.mark_spacing;
+  const double length = undeformed.effective_length();
+  const VecX& w = problem.weight();
+  const std::vector<std::vector<Index>> around = mesh::neighbours_within(marks.undeformed, 3.0 * d);
+  VariogramOptions vo;
+  vo.max_lag = kDeformedMaxLag * d;
+  // The same ladder as the undeformed estimate, lighter: the heaviest pilot without
+  // smooth bias whose estimate the next lighter one confirms. A deformation the pilot
+  // cannot follow leaves bias that looks like noise; lighter pilots leave less of it,
+  // while true noise gives the same estimate at every pilot (the shrinkage correction).
+  std::vector<NoiseEstimate> ladder;
+  for (int k = 4; k >= -1; --k) {
+    const Penalty pilot = jumps_penalty(k, d);
+    const FitResult f = problem.fit(pilot, 1);
+    if (!f.ok) break;
+    const MatX residual = MatX(problem.data()) - f.fitted;
+    // Misfit exclusion: neighbourhood mean square residual far above the median.
+    std::vector<double> ms(static_cast<std::size_t>(m), 0.0), all;
+    for (Index i = 0; i < m; ++i) {
+      if (!(w[i] > 0)) continue;
+      double sum = residual.row(i).squaredNorm();
+      int count = 1;
+      for (Index q : around[static_cast<std::size_t>(i)])
+        if (w[q] > 0) sum += residual.row(q).squaredNorm(), ++count;
+      ms[static_cast<std::size_t>(i)] = sum / count;
+      all.push_back(sum / count);
+    }
+    const double typical = median(all);
+    std::vector<bool> usable(static_cast<std::size_t>(m));
+    for (Index i = 0; i < m; ++i)
+      usable[static_cast<std::size_t>(i)] = w[i] > 0 && ms[static_cast<std::size_t>(i)] <= kMisfitFactor * typical;
+    const VariogramPairs pairs(marks.undeformed, usable, d, vo);
+    auto shrink = [&](const MatX& probes) { return MatX(probes - problem.smooth(probes, pilot, 1)); };
+    // Independent noise is a correlated one with a length far below the spacing.
+    NoiseEstimate e = fit_noise_model(pairs, pairs.gamma(residual, 3), marks.undeformed, shrink,
+                                      length > 0 ? length : 0.01 * d);
+    if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
+    e.correlation_length = length;
+    ladder.push_back(e);
+  }
+  if (ladder.empty()) return {};
+  NoiseEstimate out = ladder.back();
+  for (std::size_t i = 0; i + 1 < ladder.size(); ++i) {
+    const NoiseEstimate& e = ladder[i];
+    const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
+    const double sh = e.sigma_total(), sl = ladder[i + 1].sigma_total();
+    if (unbiased && std::abs(sh - sl) <= kSigmaAgreement * sl) {
+      out = e;
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace sf::gsa

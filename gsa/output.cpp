@@ -48,6 +48,8 @@ Fields fields_of(const std::optional<SurfaceStrain>& s) {
   return f;
 }
 
+nlohmann::json json_number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
 nlohmann::json range_of(const std::vector<double>& v) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (double x : v)
@@ -66,7 +68,8 @@ std::vector<std::string> strain_columns(const AnalysisResult& result) {
                                 "E1",      "E2",      "eng1",    "eng2",   "true1",  "true2",
                                 "thickness_change_pct", "dir1_x", "dir1_y", "dir1_z", "dir2_x", "dir2_y",
                                 "dir2_z",  "dir1u_x", "dir1u_y", "dir1u_z", "residual", "residual_undeformed",
-                                "X_fit",   "Y_fit",   "Z_fit"};
+                                "X_fit",   "Y_fit",   "Z_fit",   "flag_reason", "flag_deviation", "flag_threshold",
+                                "flag_noise"};
   if (result.fibre_angles.size() == 2) {
     for (const char* f : {"fibre1", "fibre2"})
       for (const char* s : {"_x", "_y", "_z", "_stretch"}) c.push_back(std::string(f) + s);
@@ -82,7 +85,9 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
   out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
       << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
       << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
-      << options.units << "); thickness by incompressibility; method " << method_name(result.method) << "\n";
+      << options.units << "); flag_* = why a point was flagged (its deviation from its neighbours' local fit, the threshold "
+      << "it exceeded, the noise level; " << options.units << "), flagged points keep the fitted surfaces' strain"
+      << "; thickness by incompressibility; method " << method_name(result.method) << "\n";
   if (margins) out << flc_margin_comment(*margins) << "\n";
   std::vector<std::string> columns = strain_columns(result);
   if (margins) columns.push_back("flc_margin");
@@ -105,6 +110,8 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
       Vec3 xf = Vec3::Constant(kNaN);
       if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
       w.add(xf[0]).add(xf[1]).add(xf[2]);
+      if (pr.flag) w.add(std::string(code(pr.flag->reason))).add(pr.flag->deviation).add(pr.flag->threshold).add(pr.flag->noise);
+      else w.add(std::string()).add(kNaN).add(kNaN).add(kNaN);
       if (result.fibre_angles.size() == 2) {
         for (int k = 0; k < 2; ++k) {
           if (pr.fibres.size() == 2 && pr.strain)
@@ -136,7 +143,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   j["units"] = {{"length", options.units}, {"strain", "dimensionless"}, {"thickness_change", "percent"},
                 {"angles", "degrees"}};
   std::map<std::string, Index> counts;
-  std::vector<double> e1, e2, th, eng1, eng2, shear;
+  std::vector<double> e1, e2, th, eng1, eng2, true1, true2, shear;
   for (const PointResult& p : r.points) {
     ++counts[p.status];
     if (!p.strain) continue;
@@ -144,6 +151,8 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     e2.push_back(p.strain->green(1));
     eng1.push_back(p.strain->engineering(0));
     eng2.push_back(p.strain->engineering(1));
+    true1.push_back(p.strain->true_strain(0));
+    true2.push_back(p.strain->true_strain(1));
     th.push_back(p.strain->thickness_change_pct());
     shear.push_back(p.shear_angle_deg);
   }
@@ -177,6 +186,48 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     params["gauge_length"] = r.gauge_length;
     params["projection_iterations"] = r.projection_iterations;
     params["outlier_sigma"] = r.outlier_sigma;
+    nlohmann::json smoothing = {{"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
+                                {"log10_delta_optimum", json_number(r.gcv_log10_delta)},
+                                {"criterion_value", json_number(r.smoothing_criterion_value)},
+                                {"gauge_length", r.gauge_length},
+                                {"relaxed_elements", r.relaxed_elements},
+                                {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
+    params["smoothing"] = smoothing;
+    if (r.noise.sigma_total() > 0 || r.noise_undeformed.sigma_total() > 0) {
+      auto model = [](const NoiseEstimate& e) {
+        return nlohmann::json{{"sigma_correlated", e.sigma_correlated},
+                              {"correlation_length", e.correlation_length},
+                              {"sigma_white", e.sigma_white},
+                              {"sigma_total", e.sigma_total()}};
+      };
+      params["noise_model"] = {{"undeformed", model(r.noise_undeformed)},
+                               {"deformed", model(r.noise)},
+                               {"meaning", "per coordinate; covariance sigma_correlated^2 exp(-r^2 / (2 L^2)) + "
+                                           "sigma_white^2 [same point], L = correlation_length; deformed: of the "
+                                           "displacement noise, both states together"}};
+    }
+    nlohmann::json flagged = nlohmann::json::array();
+    for (std::size_t p = 0; p < r.points.size(); ++p) {
+      const PointResult& pr = r.points[p];
+      if (!pr.flag) continue;
+      nlohmann::json f = {{"id", grid.ids[p]},
+                          {"status", pr.status},
+                          {"reason", code(pr.flag->reason)},
+                          {"deviation", pr.flag->deviation},
+                          {"threshold", pr.flag->threshold},
+                          {"noise", pr.flag->noise}};
+      const Eigen::RowVector3d at = grid.has_deformed(static_cast<Index>(p)) ? grid.deformed.row(p) : grid.undeformed.row(p);
+      if (at.allFinite()) f["position"] = {at[0], at[1], at[2]};
+      f["position_state"] = grid.has_deformed(static_cast<Index>(p)) ? "deformed" : "undeformed";
+      flagged.push_back(std::move(f));
+    }
+    j["outliers"] = {{"sigma", r.outlier_sigma},
+                     {"noise_undeformed", r.noise_outliers_undeformed},
+                     {"noise_deformed", r.noise_outliers_deformed},
+                     {"rule", "isolated points only: deviation from the local quadratic of the 16 nearest neighbours "
+                              "above sigma x noise and 2.5 x the second largest among the 8 nearest; flagged points "
+                              "keep a strain"},
+                     {"flagged", flagged}};
     j["fit"] = {{"undeformed", {{"rms_residual", r.rms_undeformed}, {"max_residual", r.max_undeformed}}},
                 {"deformed", {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}}}};
   } else {
@@ -185,7 +236,8 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   if (!r.fibre_angles.empty()) params["fibre_angles_deg"] = r.fibre_angles;
   j["parameters"] = params;
   j["strain_ranges"] = {{"E1", range_of(e1)}, {"E2", range_of(e2)}, {"eng1", range_of(eng1)},
-                        {"eng2", range_of(eng2)}, {"thickness_change_pct", range_of(th)}};
+                        {"eng2", range_of(eng2)}, {"true1", range_of(true1)}, {"true2", range_of(true2)},
+                        {"thickness_change_pct", range_of(th)}};
   if (r.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
   j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh}, {"project", r.times.project},
                     {"fit", r.times.fit}, {"strain", r.times.strain}, {"write", r.times.write}};

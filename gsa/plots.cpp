@@ -344,6 +344,37 @@ render::Scene contour_scene(const Results& r, const std::vector<double>& values,
   return scene;
 }
 
+// The marks flagged as outliers (summary.json "outliers") as black asterisks on the
+// formed part, where they were measured; the footnote says how many.
+void draw_flagged_marks(const Results& r, render::Scene& scene) {
+  const auto out = r.summary.find("outliers");
+  if (out == r.summary.end() || !out->contains("flagged")) return;
+  double size = 0.0;
+  if (const auto p = r.summary.find("parameters"); p != r.summary.end() && p->contains("mark_spacing") &&
+                                                   (*p)["mark_spacing"].is_number())
+    size = 0.45 * (*p)["mark_spacing"].get<double>();
+  if (!(size > 0.0) && r.deformed.n_points() > 0)
+    size = 0.005 * (r.deformed.points.colwise().maxCoeff() - r.deformed.points.colwise().minCoeff()).norm();
+  render::GlyphSet g;
+  g.kind = render::GlyphSet::Kind::kSegment;
+  g.colour = {0.0, 0.0, 0.0};
+  g.width = 0.18 * size;
+  Index n = 0;
+  for (const auto& f : (*out)["flagged"]) {
+    if (!f.contains("position") || !f["position"].is_array() || f["position"].size() != 3) continue;
+    const Vec3 x(f["position"][0].get<double>(), f["position"][1].get<double>(), f["position"][2].get<double>());
+    for (const Vec3& d : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}) {
+      g.tails.push_back(x - size * d);
+      g.heads.push_back(x + size * d);
+    }
+    ++n;
+  }
+  if (n == 0) return;
+  scene.glyphs.push_back(std::move(g));
+  scene.footnote += " Black asterisks: " + std::to_string(n) + " flagged mark" + (n == 1 ? "" : "s") +
+                    " (summary.json, strains.csv flag_*).";
+}
+
 render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions& o) {
   const std::string file = r.source + "/deformed.vtp";
   const auto& f1 = require_field(r.deformed, "fibre1", 3, file);
@@ -547,9 +578,10 @@ void draw_surface_pictures(const Results& r, const std::function<void(const std:
   const std::string w = measure_word(r.measure);
   const auto e1 = scalar_values(r.deformed, names[0], file);
   const auto e2 = scalar_values(r.deformed, names[1], file);
-  draw("major_strain.png",
-       contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
-                     measure_name(r.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o));
+  render::Scene major = contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
+                                      measure_name(r.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o);
+  draw_flagged_marks(r, major);
+  draw("major_strain.png", major);
   draw("minor_strain.png",
        contour_scene(r, e2, "Minor strain", "Minor " + w + " strain", "-", 0.01,
                      measure_name(r.measure) + " strain, " + range_text(e2, decimals_for(e2), "", 0.01), o));

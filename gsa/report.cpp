@@ -145,6 +145,22 @@ void parameter_tables(std::ostream& h, const nlohmann::json& s) {
       t.row("rigid motion, undeformed to deformed (best fit)",
             "rotation " + text_of(at(p, {"rigid_motion", "rotation_deg"})) + "&deg;, translation " +
                 text_of(at(p, {"rigid_motion", "translation"})) + unit);
+    if (at(p, {"smoothing", "criterion"}).is_string())
+      t.row("smoothing chosen by", text_of(at(p, {"smoothing", "criterion"})) + " = " +
+                                       text_of(at(p, {"smoothing", "criterion_value"})) + " at log10(&delta;/d<sup>6</sup>) " +
+                                       text_of(at(p, {"smoothing", "log10_delta_optimum"})));
+    if (at(p, {"smoothing", "local_gauge_length"}).is_number())
+      t.row("locally relaxed smoothing", text_of(at(p, {"smoothing", "relaxed_elements"})) +
+                                             " elements, gauge length there " +
+                                             text_of(at(p, {"smoothing", "local_gauge_length"})) + unit);
+    for (const char* which : {"undeformed", "deformed"}) {
+      const auto& n = at(p, {"noise_model", which});
+      if (n.is_object())
+        t.row(std::string("noise model, ") + which,
+              "correlated " + text_of(at(n, {"sigma_correlated"})) + unit + " over " +
+                  text_of(at(n, {"correlation_length"})) + unit + ", independent " + text_of(at(n, {"sigma_white"})) +
+                  unit);
+    }
     t.row("outlier threshold (sigmas)", text_of(at(p, {"outlier_sigma"})));
     t.row("fibre angles (deg)", text_of(at(p, {"fibre_angles_deg"})));
     t.row("triangles", text_of(at(p, {"triangles"})));
@@ -173,7 +189,9 @@ void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& p
   {
     const auto& r = at(s, {"strain_ranges"});
     if (r.is_object()) {
-      h << "<h2>Strain ranges at the marks</h2>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
+      h << "<h2>Strain ranges at the marks</h2>\n<p>E: Green-Lagrange, eng: engineering, true: logarithmic "
+           "strain; the pictures show "
+        << io::xml_escape(measure_name(page.measure)) << " strain.</p>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
       for (auto it = r.begin(); it != r.end(); ++it)
         h << "<tr><th>" << io::xml_escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
           << text_of(at(it.value(), {"max"})) << "</td></tr>\n";
@@ -187,6 +205,24 @@ void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& p
     t.row("smallest margin (" + measure_name(page.measure) + " strain)", number(page.flc->min_margin));
     t.row("per mark", "column <code>flc_margin</code> of strains.csv");
     h << t.str();
+  }
+  {
+    const auto& f = at(s, {"outliers", "flagged"});
+    if (f.is_array() && !f.empty()) {
+      const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
+      h << "<h2>Flagged marks (" << f.size() << ")</h2>\n<p>Isolated points their neighbours disagree with; "
+           "each keeps the fitted surfaces' strain and took no part in the fit. Drawn as crosses on the "
+           "major strain picture.</p>\n<table>\n<tr><th>id</th><td><b>reason</b></td><td><b>off by / threshold"
+        << unit << "</b></td></tr>\n";
+      std::size_t shown = 0;
+      for (const auto& x : f) {
+        if (++shown > 50) break;
+        h << "<tr><th>" << text_of(at(x, {"id"})) << "</th><td>" << text_of(at(x, {"reason"})) << "</td><td>"
+          << text_of(at(x, {"deviation"})) << " / " << text_of(at(x, {"threshold"})) << "</td></tr>\n";
+      }
+      h << "</table>\n";
+      if (f.size() > 50) h << "<p>" << f.size() - 50 << " more in summary.json and strains.csv.</p>\n";
+    }
   }
   {
     const auto& w = at(s, {"warnings"});

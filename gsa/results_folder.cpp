@@ -48,11 +48,17 @@ std::vector<double> fibre_angles_of(const nlohmann::json& summary) {
 }
 
 std::string case_name_of(const nlohmann::json& summary, const std::string& dir) {
-  if (summary.contains("inputs") && summary["inputs"].is_array() && !summary["inputs"].empty() &&
-      summary["inputs"][0].is_string()) {
-    const fs::path p = summary["inputs"][0].get<std::string>();
-    const std::string parent = p.parent_path().filename().string();
-    return parent.empty() ? p.filename().string() : parent + "/" + p.filename().string();
+  if (summary.contains("inputs") && summary["inputs"].is_array() && !summary["inputs"].empty()) {
+    // One grid file, or the undeformed and deformed files of a two-file run.
+    std::string name;
+    for (const auto& input : summary["inputs"]) {
+      if (!input.is_string()) continue;
+      const fs::path p = input.get<std::string>();
+      const std::string parent = p.parent_path().filename().string();
+      const std::string one = parent.empty() ? p.filename().string() : parent + "/" + p.filename().string();
+      name += (name.empty() ? "" : " \xE2\x86\x92 ") + one;
+    }
+    if (!name.empty()) return name;
   }
   return fs::path(dir).filename().string();
 }

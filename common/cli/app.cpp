@@ -11,6 +11,22 @@
 
 namespace sf::cli {
 
+namespace {
+std::string& recorded_command_line() {
+  static std::string line;
+  return line;
+}
+
+std::string quoted_argument(const std::string& a) {
+  if (!a.empty() && a.find_first_of(" \t'\"\\$`") == std::string::npos) return a;
+  std::string q = "'";
+  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+}  // namespace
+
+const std::string& command_line() { return recorded_command_line(); }
+
 struct Program::Command {
   CLI::App* app = nullptr;
   std::function<int()> run;
@@ -37,6 +53,9 @@ void Program::add_command(const std::string& name, const std::string& descriptio
 }
 
 int Program::main(int argc, char** argv) {
+  std::string line = name_;
+  for (int i = 1; i < argc; ++i) line += " " + quoted_argument(argv[i]);
+  recorded_command_line() = line;
   try {
     app_->parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -20,6 +20,10 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
 
+// The command line of this run as typed (arguments with spaces or quotes quoted), for
+// the record in output files; empty before Program::main.
+const std::string& command_line();
+
 // Options every subcommand understands.
 struct CommonOptions {
   bool quiet = false;  // --quiet: no progress on stderr

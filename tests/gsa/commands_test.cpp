@@ -206,6 +206,36 @@ TEST_F(GsaCli, SummaryJsonHasUnitsCountsResidualsAndTimings) {
   EXPECT_LE(j.at("strain_ranges").at("E2").at("max").get<double>(), j.at("strain_ranges").at("E1").at("max").get<double>());
 }
 
+// Flagged marks: why, in strains.csv and summary.json, with the full command line and
+// the smoothing criterion; both flagged marks keep a strain.
+TEST_F(GsaCli, FlaggedMarksAreExplainedInStrainsAndSummary) {
+  const std::string grid = synth("dome", "--outliers 2 --noise 0.01 --seed 3");
+  const std::string out = analyse_ok(quoted(grid));
+  const Strains s = read_strains(out);
+  std::vector<std::string> flagged;
+  for (const auto& [id, row] : s.row) {
+    const std::string reason(s.t.cell(row, s.t.column_index("flag_reason")));
+    if (reason.empty()) continue;
+    flagged.push_back(id);
+    EXPECT_EQ(reason, "deformed_off_neighbours") << id;
+    EXPECT_EQ(s.status(id), "outlier_deformed") << id;
+    EXPECT_GT(s.num(id, "flag_deviation"), s.num(id, "flag_threshold")) << id;
+    EXPECT_GT(s.num(id, "flag_noise"), 0.0) << id;
+    EXPECT_TRUE(std::isfinite(s.num(id, "E1"))) << id << " keeps a strain";
+  }
+  EXPECT_EQ(flagged.size(), 2u);
+  const nlohmann::json j = nlohmann::json::parse(read_text(out + "/summary.json"));
+  ASSERT_EQ(j.at("outliers").at("flagged").size(), flagged.size());
+  for (const auto& f : j.at("outliers").at("flagged")) {
+    EXPECT_NE(std::find(flagged.begin(), flagged.end(), f.at("id").get<std::string>()), flagged.end());
+    EXPECT_EQ(f.at("position").size(), 3u);
+  }
+  EXPECT_NE(j.at("command_line").get<std::string>().find("--out"), std::string::npos) << j.at("command_line");
+  EXPECT_EQ(j.at("parameters").at("smoothing").at("criterion"), "Cp");
+  EXPECT_TRUE(j.at("parameters").at("smoothing").at("criterion_value").is_number());
+  EXPECT_GT(j.at("parameters").at("noise_model").at("deformed").at("sigma_total").get<double>(), 0.0);
+}
+
 TEST_F(GsaCli, FittedSurfacesReadBackWithStrainFields) {
   const std::string out = analyse_ok(quoted(synth("dome")));
   for (const char* name : {"undeformed.vtp", "deformed.vtp"}) {

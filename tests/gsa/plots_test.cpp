@@ -322,5 +322,14 @@ TEST(GsaPlots, PlotCommandRedrawsAResultsFolder) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+// A two-file run's pictures name both files, not only the undeformed one.
+TEST(GsaPlots, TwoFileRunsAreNamedByBothFiles) {
+  nlohmann::json summary;
+  summary["inputs"] = {"trial/blank.csv", "trial/formed.csv"};
+  EXPECT_EQ(case_name_of(summary, "out"), "trial/blank.csv \xE2\x86\x92 trial/formed.csv");
+  summary["inputs"] = {"dome/grid.csv"};
+  EXPECT_EQ(case_name_of(summary, "out"), "dome/grid.csv");
+}
+
 }  // namespace
 }  // namespace sf::gsa

@@ -23,6 +23,8 @@ namespace sf::io {
 namespace {
 
 constexpr std::size_t kMaxLineBytes = (std::size_t{1} << 30) - 1;
+// The header test looks at this many non-blank lines at most (preambles are short).
+constexpr int kHeaderSearchLines = 1000;
 
 bool is_blank(char c, char delimiter) { return (c == ' ' || c == '\t') && c != delimiter; }
 
@@ -399,8 +401,10 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
     return {l.next, line_no + 1};
   }
 
-  std::optional<std::pair<LineSpan, std::int64_t>> fallback;
-  while (pos < size) {
+  // The non-comment lines looked at, for the fallback when no line passes the test.
+  std::vector<std::pair<LineSpan, std::int64_t>> kept;
+  int searched = 0;
+  while (pos < size && searched < kHeaderSearchLines) {
     const LineSpan l = line_at(text_, pos);
     const std::int64_t number = ++line_no;
     pos = l.next;
@@ -416,6 +420,7 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
       preamble_.emplace_back(static_cast<int>(number), std::string(line));
       continue;
     }
+    ++searched;
     const std::string_view content = comment ? without_comment_mark(line, options.comment) : line;
     if (const char d = passing_delimiter(content)) {
       bool take = !comment;
@@ -436,12 +441,34 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
         return {l.next, number};
       }
     }
-    if (!comment && !fallback) fallback = std::make_pair(l, number);
+    if (!comment) kept.emplace_back(l, number);
     preamble_.emplace_back(static_cast<int>(number), std::string(line));
   }
-  if (!fallback)
+  if (kept.empty())
     throw InputError(located_message(file_name_, 0, 0, "no header line (the file is empty or only comments)"));
-  const auto& [l, number] = *fallback;
+  // No line passed: take the line that looks most like the header of a table (not all
+  // numbers, as many fields as the next line, the most fields), so that the caller's
+  // column lookup names what is missing from it; else the first kept line.
+  std::size_t best = 0;
+  std::size_t best_fields = 0;
+  std::vector<std::string> fields, next_fields;
+  for (std::size_t k = 0; k + 1 < kept.size(); ++k) {
+    const std::string_view line = text.substr(kept[k].first.begin, kept[k].first.end - kept[k].first.begin);
+    const std::string_view next = text.substr(kept[k + 1].first.begin, kept[k + 1].first.end - kept[k + 1].first.begin);
+    const char d = delimiter_of(line);
+    if (!split_names(line, d, options.brackets_in_header, fields, bad_field, problem) ||
+        !split_names(next, d, options.brackets_in_header, next_fields, bad_field, problem))
+      continue;
+    const bool numbers = std::all_of(fields.begin(), fields.end(), [](const std::string& f) {
+      double ignored = 0.0;
+      return parse_double(f, ignored);
+    });
+    if (fields.size() > 1 && fields.size() == next_fields.size() && !numbers && fields.size() > best_fields) {
+      best = k;
+      best_fields = fields.size();
+    }
+  }
+  const auto& [l, number] = kept[best];
   const std::string_view line = text.substr(l.begin, l.end - l.begin);
   accept(line, number, delimiter_of(line));
   return {l.next, number};

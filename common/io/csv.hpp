@@ -62,8 +62,10 @@ struct CsvOptions {
   // after skip_lines whose names pass the test. A comment line is tried too, without its
   // comment character, and is taken when the next non-blank line is neither a comment nor
   // a header that passes (a commented header over the data). Lines before the header are a
-  // preamble and not read. When no line passes, the first kept line is the header, so
-  // that the caller's column lookup reports what was found.
+  // preamble and not read. The search looks at the first 1000 non-blank lines. When no
+  // line passes, the header is the line that looks most like a table's (not all numbers,
+  // as many fields as the next line, the most fields; else the first kept line), so that
+  // the caller's column lookup reports what it found there.
   std::function<bool(const std::vector<std::string>& names)> header_test;
   // In the header only: a delimiter inside [...] does not split ("eps [%, technical]").
   bool brackets_in_header = false;

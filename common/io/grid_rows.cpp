@@ -281,11 +281,18 @@ std::string candidate_text(const Candidate& c) {
 }
 
 [[noreturn]] void throw_missing(const std::string& path, int line, const Plan& best, const FormatSpec& spec,
-                                const Header& h) {
+                                const Header& h, const std::vector<Candidate>& layouts) {
   std::string detail;
   if (!best.missing_why.empty()) detail = best.missing_why + "; ";
-  if (spec.format != MeasurementFormat::kPlain)
-    detail += format_label(spec) + " reads " + candidate_text(best.candidate) + "; ";
+  if (spec.format != MeasurementFormat::kPlain) {
+    // The layout that came closest first, then the others the format also reads.
+    std::vector<std::string> others;
+    for (const Candidate& c : layouts)
+      if (c.triples != best.candidate.triples) others.push_back(candidate_text(c));
+    detail += format_label(spec) + " reads " + candidate_text(best.candidate);
+    if (!others.empty()) detail += " (or " + join(others, "; or ") + ")";
+    detail += "; ";
+  }
   throw InputError(located_message(path, line, 0,
                                    fmt::format("missing required column '{}' ({}found: {})", best.missing, detail,
                                                join(h.names()))));
@@ -310,14 +317,22 @@ std::string file_unit(const CsvTable& t) {
 // The factor from column `col`'s unit to the options' unit; nothing for a column in
 // pixels without a pixel size when `soft` (the caller then does without it).
 std::optional<double> scale_of(const CsvTable& t, const Header& h, std::size_t col, bool pixels, const std::string& unit_of_file,
-                               const GridReadOptions& o, bool soft) {
+                               const GridReadOptions& o, bool soft, const std::string& lengths_of = "") {
   const NameAndUnit& nu = h.unit(col);
   std::string unit = nu.has_unit ? nu.unit : pixels ? "px" : unit_of_file;
-  if (!nu.has_unit && unit.empty()) return 1.0;  // taken to be in the options' unit
   auto fail = [&](const std::string& what) -> double {
     throw InputError(located_message(t.file_name(), t.header_line(), static_cast<int>(col + 1),
                                      fmt::format("column '{}' {}", h.name(col), what)));
   };
+  if (!nu.has_unit && unit.empty()) {
+    // Taken to be in the options' unit, unless the format says it holds lengths (metric
+    // coordinates of a calibrated system) and pixels are asked for.
+    if (!lengths_of.empty() && is_pixel_unit(o.units))
+      return fail(fmt::format("holds lengths ({} writes calibrated coordinates), which cannot be read in pixels "
+                              "(--units {}); give the length unit of the calibration, e.g. --units mm",
+                              lengths_of, o.units));
+    return 1.0;
+  }
   if (is_pixel_unit(unit)) {
     if (is_pixel_unit(o.units)) return 1.0;
     if (std::isfinite(o.pixel_size)) return o.pixel_size;
@@ -375,7 +390,7 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileR
     }
     if (p.score() > best.score()) best = std::move(p);
   }
-  if (!plan) throw_missing(t.file_name(), t.header_line(), best, spec, h);
+  if (!plan) throw_missing(t.file_name(), t.header_line(), best, spec, h, layouts);
 
   GridRows out;
   out.path = path;
@@ -388,7 +403,8 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileR
     for (int k = 0; k < 3; ++k) {
       scale[tr][k] = 1.0;
       if (const auto col = (*plan->triples[tr])[k]) {
-        scale[tr][k] = *scale_of(t, h, *col, plan->pixels, unit_of_file, o, false);
+        scale[tr][k] = *scale_of(t, h, *col, plan->pixels, unit_of_file, o, false,
+                                 spec.format == MeasurementFormat::kPlain ? "" : format_label(spec));
         if (scale[tr][k] != 1.0) converted.push_back(h.name(*col));
       }
     }

@@ -46,6 +46,9 @@ constexpr double kTrellisShearDegAllMarks = 0.05;
 // the same strains: exactly, up to x = X + u rounding in the displacement form.
 // Also the bound on the triangles method's exact homogeneous stretch.
 constexpr double kSameData = 1e-9;
+// Strains of the example exports of measuring systems against the exact ones: their
+// positions are written with 6 digits (measured worst 1.2e-6, MatchID).
+constexpr double kExactFromExport = 1e-5;
 // Positions on the tessellated fitted surfaces (mm): the flat blank's z, the dome's
 // apex height 80 (the tessellation passes through the apex). Measured < 1e-4.
 constexpr double kSurfacePosition = 1e-3;
@@ -327,6 +330,59 @@ TEST_F(GsaCli, UnitsAreWrittenIntoTheOutputs) {
   const std::string out = analyse_ok(quoted(synth("rigid")) + " --units in");
   EXPECT_EQ(nlohmann::json::parse(read_text(out + "/summary.json")).at("units").at("length"), "in");
   EXPECT_THAT(read_text(out + "/strains.csv"), HasSubstr("lengths in in"));
+}
+
+// Every preset's example export (tests/data/formats/, made-up numbers from one stretch
+// 1.10 x 0.95 plus a rigid motion) analysed as a user would: the marks the system
+// marked invalid get no strain, all others the exact strains.
+TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
+  struct Case {
+    std::string args;
+    std::size_t rows, ok;
+  };
+  const std::string d = std::string(SF_SOURCE_DIR) + "/tests/data/formats/";
+  const std::vector<Case> cases = {
+      {quoted(d + "gom_stage.csv") + " --format gom", 47, 45},
+      {quoted(d + "matchid_image.csv") + " --format matchid", 47, 46},
+      {quoted(d + "vic3d_frame.csv") + " --format vic3d --pixel-size 0.02", 49, 46},
+      {quoted(d + "dice_solution_10.txt") + " --format dice", 49, 46},
+      {quoted(d + "plain_no_id_metres.csv") + " --columns X=X0,Y=Y0,Z=Z0,u=ux,v=uy,w=uz", 49, 49},
+      {quoted(d + "grid_indices.csv") + " --pitch 5", 49, 49},
+  };
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const Strains s = read_strains(analyse_ok(cases[k].args + " --no-plots", "format" + std::to_string(k)));
+    EXPECT_EQ(s.t.n_rows(), cases[k].rows) << cases[k].args;
+    std::size_t ok = 0;
+    double worst = 0;
+    for (const auto& [id, r] : s.row) {
+      if (s.status(id) != "ok") {
+        EXPECT_TRUE(std::isnan(s.num(id, "E1"))) << cases[k].args << " " << id;
+        continue;
+      }
+      ++ok;
+      worst = std::max({worst, std::abs(s.num(id, "E1") - 0.105), std::abs(s.num(id, "E2") + 0.04875)});
+    }
+    EXPECT_EQ(ok, cases[k].ok) << cases[k].args;
+    EXPECT_LT(worst, kExactFromExport) << cases[k].args;
+  }
+}
+
+TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
+  const std::string d = std::string(SF_SOURCE_DIR) + "/tests/data/formats/";
+  const std::string out = " --no-plots --out " + quoted(dir_.file("out"));
+  const CommandResult preset = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic" + "x" + out);
+  EXPECT_EQ(preset.exit_code, 2);
+  EXPECT_THAT(preset.err, HasSubstr("--format: unknown format 'vicx'"));
+  const CommandResult column = run_gsa(dir_, "analyse " + quoted(d + "gom_stage.csv") + " --format matchid" + out);
+  EXPECT_EQ(column.exit_code, 1);
+  // The 2023 layout (x, y, z, u, v, w) comes closest to GOM's x, y, z; the message names
+  // it first and the 2024 names after it.
+  EXPECT_THAT(column.err, AllOf(HasSubstr("gom_stage.csv:6: missing required column 'u'"),
+                                HasSubstr("--format matchid reads x, y, z, u, v, w (or coor.X, coor.Y")));
+  const CommandResult pixels = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic3d --units px" + out);
+  EXPECT_EQ(pixels.exit_code, 1);
+  EXPECT_THAT(pixels.err, HasSubstr("vic3d_frame.csv:1:1: column 'X' holds lengths"));
+  EXPECT_FALSE(fs::exists(dir_.file("out")));
 }
 
 // ---------------------------------------------------------------- failures

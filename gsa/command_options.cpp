@@ -146,9 +146,10 @@ GridReadOptions grid_read_options(const AnalyseFlags& a) {
   if (o.positions != io::Positions::kAsFormat && o.format == io::MeasurementFormat::kPlain)
     throw UsageError("--positions: applies to --format gom, matchid, vic3d or dice; with a plain file, name the "
                      "position columns X,Y,Z (reference) or x,y,z (current) in --columns");
-  if (a.decimal == "point" || a.decimal == ".") o.decimal = '.';
+  if (a.decimal == "auto") o.decimal = io::kDetectDecimal;
+  else if (a.decimal == "point" || a.decimal == ".") o.decimal = '.';
   else if (a.decimal == "comma" || a.decimal == ",") o.decimal = ',';
-  else throw UsageError("--decimal: expected 'point' or 'comma', found '" + a.decimal + "'");
+  else throw UsageError("--decimal: expected 'auto', 'point' or 'comma', found '" + a.decimal + "'");
   if (o.decimal == ',' && o.delimiter == ',')
     throw UsageError("--decimal comma: the delimiter cannot be a comma too (give --delimiter semicolon, or leave it auto)");
   if (a.skip_lines < 0) throw UsageError("--skip-lines: must be >= 0, found " + std::to_string(a.skip_lines));

@@ -22,7 +22,7 @@ struct AnalyseFlags {
   std::string grid, undeformed, deformed, out;
   std::string method = "surface", penalty = "jumps", elements, mesh, columns, delimiter = "auto", fibres, units = "mm";
   // Reading (docs/usage.md "Input formats"); NaN: not given.
-  std::string format = "plain", id, positions, decimal = "point";
+  std::string format = "auto", id, positions, decimal = "auto";
   int skip_lines = 0, header_line = 0;
   double pitch = std::numeric_limits<double>::quiet_NaN(), pixel_size = std::numeric_limits<double>::quiet_NaN();
   double alpha = std::numeric_limits<double>::quiet_NaN(), beta = std::numeric_limits<double>::quiet_NaN(),
@@ -47,7 +47,7 @@ StrainMeasure parse_measure(const std::string& text, const std::string& option =
 // --format, --columns, --id, --positions, --delimiter, --decimal, --skip-lines,
 // --header-line, --units, --pixel-size, --pitch; validated, errors naming the flag.
 GridReadOptions grid_read_options(const AnalyseFlags& flags);
-// "--format": plain, gom (also aramis, correlate, zeiss), matchid, vic3d (also vic), dice.
+// "--format": auto, plain, gom (also aramis, correlate, zeiss), matchid, vic3d (also vic), dice.
 io::MeasurementFormat parse_format(const std::string& text);
 // "--id": column names separated by commas (the id joins their cells with '_'), or "row".
 std::vector<std::string> parse_id_columns(const std::string& text);

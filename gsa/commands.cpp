@@ -232,8 +232,9 @@ void add_analyse_command(sf::cli::Program& program) {
                        "Length unit to read the coordinates in and to write into every output (default mm); columns "
                        "in other units ([m], [in], '# units: m') are converted");
         app.add_option("--format", args->format,
-                       "Layout of the input: plain (default, the grid file), gom (GOM/ZEISS ARAMIS, Correlate), "
-                       "matchid, vic3d or dice (see docs/usage.md, Input formats)");
+                       "Layout of the input: auto (default: a preset when the header holds its columns and key, "
+                       "else plain), plain (the grid file), gom (GOM/ZEISS ARAMIS, Correlate), matchid, vic3d or "
+                       "dice (see docs/usage.md, Input formats)");
         app.add_option("--columns", args->columns,
                        "Map column names, e.g. X=x0,Y=y0,Z=z0,u=ux,v=uy,w=uz: X,Y,Z reference and x,y,z current "
                        "positions, u,v,w displacements (any two of the three), id, i, j, sigma");
@@ -244,7 +245,7 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_option("--delimiter", args->delimiter,
                        "Field separator: auto (default, found from the header), one character, or "
                        "tab/comma/semicolon/space (runs of blanks)");
-        app.add_option("--decimal", args->decimal, "Decimal separator of the numbers: point (default) or comma");
+        app.add_option("--decimal", args->decimal, "Decimal separator of the numbers: auto (default: comma when the numbers are written so and the delimiter is not a comma), point or comma");
         app.add_option("--skip-lines", args->skip_lines, "Skip the first N lines of each file, then look for the header");
         app.add_option("--header-line", args->header_line, "The header is line N of each file (1-based)");
         app.add_option("--pixel-size", args->pixel_size,

@@ -479,7 +479,7 @@ void CsvTable::parse(const CsvOptions& options) {
   const std::size_t size = text_.size();
   std::size_t pos = 0;
   if (size >= 3 && std::memcmp(text, "\xEF\xBB\xBF", 3) == 0) pos = 3;
-  decimal_ = options.decimal;
+  decimal_ = options.decimal == kDetectDecimal ? '.' : options.decimal;
 
   std::int64_t line_no = 0;
   std::tie(pos, line_no) = find_header(pos, options);
@@ -628,12 +628,34 @@ void CsvTable::parse(const CsvOptions& options) {
     }
     rows_.push_back(Row{line_begin, line_no});
   }
+  if (options.decimal == kDetectDecimal) decimal_ = detect_decimal();
+}
+
+char CsvTable::detect_decimal() const {
+  if (delimiter_ == ',') return '.';
+  bool comma = false;
+  const std::size_t n = std::min<std::size_t>(rows_.size(), 200);
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = 0; c < n_columns_; ++c) {
+      const std::string_view s = cell(r, c);
+      double ignored = 0.0;
+      const auto at = s.find(',');
+      if (at == std::string_view::npos) {
+        if (s.find('.') != std::string_view::npos && parse_double(s, ignored)) return '.';
+      } else if (!comma && s.find(',', at + 1) == std::string_view::npos && s.find('.') == std::string_view::npos) {
+        std::string dotted(s);
+        dotted[at] = '.';
+        comma = parse_double(dotted, ignored);
+      }
+    }
+  }
+  return comma ? ',' : '.';
 }
 
 CsvTable read_csv_string(std::string text, const std::string& name, const CsvOptions& options) {
   if (options.delimiter == '"' || options.delimiter == '\n' || options.delimiter == '\r' ||
       (options.comment != '\0' && options.comment == options.delimiter) ||
-      (options.decimal != '.' && options.decimal != ',') || (options.decimal == ',' && options.delimiter == ',') ||
+      (options.decimal != '.' && options.decimal != ',' && options.decimal != kDetectDecimal) || (options.decimal == ',' && options.delimiter == ',') ||
       options.skip_lines < 0 || options.header_line < 0 ||
       (options.header_line > 0 && options.header_line <= options.skip_lines)) {
     throw std::logic_error("read_csv: invalid delimiter/comment/decimal/skip_lines/header_line options");

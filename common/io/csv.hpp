@@ -43,6 +43,8 @@ namespace sf::io {
 
 // CsvOptions::delimiter value: find the delimiter from the header line.
 inline constexpr char kDetectDelimiter = '\0';
+// CsvOptions::decimal value: find the decimal separator from the data rows.
+inline constexpr char kDetectDecimal = '\0';
 
 struct CsvOptions {
   // The field separator. ' ' means runs of blanks (spaces and tabs; a line's leading and
@@ -70,6 +72,9 @@ struct CsvOptions {
   // In the header only: a delimiter inside [...] does not split ("eps [%, technical]").
   bool brackets_in_header = false;
   // The decimal separator of numbers: '.' or ',' (then the delimiter cannot be ',').
+  // kDetectDecimal: ',' when the delimiter is not ',' and the first 200 data rows hold a
+  // number that reads only with a decimal comma ("1,25") and none written with a point
+  // ("1.25"); else '.'. CsvTable::decimal() says which.
   char decimal = '.';
 };
 
@@ -89,6 +94,8 @@ class CsvTable {
   int header_line() const { return header_line_; }
   // The delimiter used (the one found, with kDetectDelimiter).
   char delimiter() const { return delimiter_; }
+  // The decimal separator used (the one found, with kDetectDecimal).
+  char decimal() const { return decimal_; }
   // The non-blank lines before the header (comments and preamble), as written, with
   // their 1-based line numbers; lines dropped by skip_lines are not kept.
   const std::vector<std::pair<int, std::string>>& preamble() const { return preamble_; }
@@ -151,6 +158,8 @@ class CsvTable {
   // header_line_, delimiter_ and preamble_; returns the byte offset after the header line
   // and its line number, or (text size, lines) without a header.
   std::pair<std::size_t, std::int64_t> find_header(std::size_t pos, const CsvOptions& options);
+  // The decimal separator of the data rows (CsvOptions::decimal == kDetectDecimal).
+  char detect_decimal() const;
   [[noreturn]] void throw_bad_cell(std::size_t row, std::size_t col, const char* what) const;
 
   std::string file_name_;

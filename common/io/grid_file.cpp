@@ -60,7 +60,8 @@ void GridReadOptions::validate() const {
     bad_option("id_from_row", "the id is either the row number or taken from columns");
   for (const std::string& c : id_columns)
     if (c.empty()) bad_option("id_columns", "an empty column name");
-  if (decimal != '.' && decimal != ',') bad_option("decimal", std::string("must be '.' or ',', found '") + decimal + "'");
+  if (decimal != '.' && decimal != ',' && decimal != kDetectDecimal)
+    bad_option("decimal", std::string("must be '.', ',' or kDetectDecimal, found '") + decimal + "'");
   if (decimal == ',' && delimiter == ',') bad_option("decimal", "',' needs a delimiter other than ','");
   if (skip_lines < 0) bad_option("skip_lines", "must be >= 0, found " + std::to_string(skip_lines));
   if (header_line < 0) bad_option("header_line", "must be >= 1, found " + std::to_string(header_line));

@@ -69,7 +69,9 @@ bool is_grid_column_key(std::string_view key);
 inline constexpr long kNoGridIndex = std::numeric_limits<long>::min();
 
 struct GridReadOptions {
-  // The column layout (measurement_formats.hpp); plain is the grid file above.
+  // The column layout (measurement_formats.hpp); plain is the grid file above. kAuto:
+  // the preset whose columns and key the header holds (a note says which), else plain;
+  // with `columns` given, plain.
   MeasurementFormat format = MeasurementFormat::kPlain;
   // Field separator; kDetectDelimiter: found with the header (',', ';', tab or blanks).
   char delimiter = kDetectDelimiter;
@@ -87,7 +89,7 @@ struct GridReadOptions {
   Positions positions = Positions::kAsFormat;
   int skip_lines = 0;   // lines 1..N are not read (then the header is searched)
   int header_line = 0;  // > 0: the header is this line (1-based)
-  char decimal = '.';   // decimal separator: '.' or ','
+  char decimal = '.';   // decimal separator: '.', ',' or kDetectDecimal (csv.hpp; a note says when ',')'
   // The length unit of the positions read; columns in other units are converted
   // (length_units.hpp). Text that is no known length unit only names the unit.
   std::string units = "mm";

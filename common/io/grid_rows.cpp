@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <fstream>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -281,8 +282,11 @@ std::string candidate_text(const Candidate& c) {
 }
 
 [[noreturn]] void throw_missing(const std::string& path, int line, const Plan& best, const FormatSpec& spec,
-                                const Header& h, const std::vector<Candidate>& layouts) {
+                                const Header& h, const std::vector<Candidate>& layouts, bool auto_plain = false) {
   std::string detail;
+  if (auto_plain) detail = "nor does the header hold the columns and key of --format gom, matchid, vic3d or dice; ";
+  if (best.missing == "X" && h.find("i") && h.find("j"))
+    detail += "with grid indices i, j, a pitch (--pitch) places the undeformed marks; ";
   if (!best.missing_why.empty()) detail = best.missing_why + "; ";
   if (spec.format != MeasurementFormat::kPlain) {
     // The layout that came closest first, then the others the format also reads.
@@ -357,10 +361,101 @@ std::optional<double> scale_of(const CsvTable& t, const Header& h, std::size_t c
   return *mm / *target;
 }
 
+CsvOptions csv_options(const FormatSpec& spec, const GridReadOptions& o) {
+  CsvOptions co;
+  co.delimiter = o.delimiter;
+  co.skip_lines = o.skip_lines;
+  co.header_line = o.header_line;
+  co.decimal = o.decimal;
+  co.brackets_in_header = spec.brackets || spec.format == MeasurementFormat::kPlain;
+  return co;
+}
+
+// True when one of the format's key column sets is all in the header.
+bool has_key(const FormatSpec& spec, const Header& h) {
+  return std::any_of(spec.ids.begin(), spec.ids.end(), [&](const std::vector<std::string>& set) {
+    return std::all_of(set.begin(), set.end(), [&](const std::string& name) { return h.find(name).has_value(); });
+  });
+}
+
+// --format auto: the formats whose header test passes on the first lines of the file (a
+// preset only with its key columns: "x, y, z, u, v, w" alone would fit both the plain
+// file and MatchID 2023, which read x differently). One preset: that preset; none: plain;
+// several presets: an error asking for --format.
+struct Detected {
+  MeasurementFormat format = MeasurementFormat::kPlain;
+  bool found = false;  // a preset was found (else plain)
+};
+
+Detected detect_format(const std::string& path, const GridReadOptions& o, const std::string& stage_column) {
+  std::string head;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    for (int n = 0; n < 300 && std::getline(in, line); ++n) head += line + '\n';
+  }
+  std::vector<const FormatSpec*> presets;
+  int header_line = 0;
+  for (const FormatSpec& spec : format_specs()) {
+    if (spec.format == MeasurementFormat::kPlain) continue;
+    // The preset's own layouts, as for a file holding both states and without the
+    // pitch: its layouts cut down to current positions would take any "id, x, y, z".
+    GridReadOptions oo = o;
+    oo.format = spec.format;
+    oo.pitch = std::numeric_limits<double>::quiet_NaN();
+    const FileRole full = FileRole::kBothStates;
+    const std::vector<Candidate> layouts = candidates(spec, oo, full);
+    bool hit = false;
+    CsvOptions co = csv_options(spec, oo);
+    co.header_test = [&](const std::vector<std::string>& names) {
+      const Header h(names);
+      const bool ok = has_key(spec, h) && std::any_of(layouts.begin(), layouts.end(), [&](const Candidate& c) {
+                        return resolve(c, h, spec, oo, full, stage_column).ok();
+                      });
+      hit = hit || ok;
+      return ok;
+    };
+    try {
+      const CsvTable t = read_csv_string(head, path, co);
+      if (hit) header_line = t.header_line();
+    } catch (const InputError&) {
+      // A row cut short at the end of the first lines; `hit` says what matters.
+    }
+    if (hit) presets.push_back(&spec);
+  }
+  Detected d;
+  if (presets.empty()) return d;
+  if (presets.size() > 1) {
+    std::vector<std::string> names;
+    for (const FormatSpec* p : presets) names.push_back(p->name);
+    throw InputError(located_message(path, header_line, 0,
+                                     fmt::format("the header fits more than one measuring system's format ({}); "
+                                                 "choose one with --format",
+                                                 join(names))));
+  }
+  d.format = presets.front()->format;
+  d.found = true;
+  return d;
+}
+
 }  // namespace
 
-GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileRole role, const std::string& stage_column) {
-  o.validate();
+GridRows read_grid_rows(const std::string& path, const GridReadOptions& options, FileRole role,
+                        const std::string& stage_column) {
+  options.validate();
+  GridReadOptions o = options;
+  bool detected = false, auto_plain = false;
+  if (o.format == MeasurementFormat::kAuto) {
+    // With --columns the user names the columns: the plain layout they extend.
+    const Detected d = o.columns.empty() ? detect_format(path, o, stage_column) : Detected{};
+    o.format = d.format;
+    detected = d.found;
+    auto_plain = !d.found && o.columns.empty();
+    if (o.format == MeasurementFormat::kPlain && o.positions != Positions::kAsFormat)
+      throw InputError(located_message(
+          path, 0, 0,
+          "--positions applies to a measuring system's format, and the header fits none of them; give --format"));
+  }
   const FormatSpec& spec = format_spec(o.format);
   const std::vector<Candidate> layouts = candidates(spec, o, role);
   auto passes = [&](const std::vector<std::string>& names) {
@@ -368,12 +463,7 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileR
     return std::any_of(layouts.begin(), layouts.end(),
                        [&](const Candidate& c) { return resolve(c, h, spec, o, role, stage_column).ok(); });
   };
-  CsvOptions co;
-  co.delimiter = o.delimiter;
-  co.skip_lines = o.skip_lines;
-  co.header_line = o.header_line;
-  co.decimal = o.decimal;
-  co.brackets_in_header = spec.brackets || spec.format == MeasurementFormat::kPlain;
+  CsvOptions co = csv_options(spec, o);
   co.header_test = passes;
   const CsvTable t = read_csv(path, co);
   const Header h(t.names());
@@ -390,10 +480,12 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileR
     }
     if (p.score() > best.score()) best = std::move(p);
   }
-  if (!plan) throw_missing(t.file_name(), t.header_line(), best, spec, h, layouts);
+  if (!plan) throw_missing(t.file_name(), t.header_line(), best, spec, h, layouts, auto_plain);
 
   GridRows out;
   out.path = path;
+  if (options.decimal == kDetectDecimal && t.decimal() == ',')
+    out.notes.push_back(path + ": numbers with a decimal comma (found in the data; --decimal point reads them otherwise)");
   const std::string unit_of_file = file_unit(t);
   // Scale of each position and displacement column.
   std::array<std::array<double, 3>, 3> scale{};
@@ -433,8 +525,11 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& o, FileR
       if (tri[tr]) parts.push_back(triple_text(*plan->candidate.triples[tr]) + " = " + kTripleWords[tr]);
     std::string key = plan->id.empty() ? "row number" : "";
     for (const std::size_t c : plan->id) key += (key.empty() ? "" : ", ") + h.name(c);
-    out.notes.push_back(fmt::format("{}: {} ({}): {}; key {}{}", path, format_label(spec), spec.title, join(parts, "; "),
-                                    key, std::isfinite(o.pitch) ? "; reference positions from i, j and the pitch" : ""));
+    out.notes.push_back(fmt::format("{}: {} ({}): {}; key {}{}{}", path,
+                                    detected ? "format found from the header: " + spec.name : format_label(spec),
+                                    spec.title, join(parts, "; "), key,
+                                    std::isfinite(o.pitch) ? "; reference positions from i, j and the pitch" : "",
+                                    detected ? " (--format chooses another)" : ""));
   }
   if (!converted.empty())
     out.notes.push_back(fmt::format("{}: converted to {}: {}", path, o.units, join(converted)));

@@ -100,23 +100,24 @@ std::vector<FormatSpec> make_specs() {
   return specs;
 }
 
-const std::vector<FormatSpec>& specs() {
+}  // namespace
+
+const std::vector<FormatSpec>& format_specs() {
   static const std::vector<FormatSpec> all = make_specs();
   return all;
 }
 
-}  // namespace
-
 const FormatSpec& format_spec(MeasurementFormat format) {
-  for (const FormatSpec& s : specs())
+  for (const FormatSpec& s : format_specs())
     if (s.format == format) return s;
-  return specs().front();
+  return format_specs().front();
 }
 
 std::optional<MeasurementFormat> format_by_name(std::string_view name) {
   std::string n(name);
   std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  static const std::array<std::pair<std::string_view, MeasurementFormat>, 10> kNames = {{
+  static const std::array<std::pair<std::string_view, MeasurementFormat>, 11> kNames = {{
+      {"auto", MeasurementFormat::kAuto},
       {"plain", MeasurementFormat::kPlain},
       {"grid", MeasurementFormat::kPlain},
       {"gom", MeasurementFormat::kGom},
@@ -134,8 +135,8 @@ std::optional<MeasurementFormat> format_by_name(std::string_view name) {
 }
 
 std::string format_names() {
-  std::string out;
-  for (const FormatSpec& s : specs()) out += (out.empty() ? "" : ", ") + s.name;
+  std::string out = "auto";
+  for (const FormatSpec& s : format_specs()) out += ", " + s.name;
   return out;
 }
 

@@ -25,7 +25,9 @@
 
 namespace sf::io {
 
-enum class MeasurementFormat { kPlain, kGom, kMatchId, kVic3d, kDice };
+// kAuto: found from the header by the reader (grid_rows.hpp): the one preset whose
+// columns and key are all there, else plain.
+enum class MeasurementFormat { kPlain, kGom, kMatchId, kVic3d, kDice, kAuto };
 
 // What the position columns of a layout with displacements hold (GridReadOptions::positions).
 enum class Positions {
@@ -68,11 +70,14 @@ struct FormatSpec {
   bool brackets = false;     // names carry units in brackets ("coor.X [mm]")
 };
 
+// The preset of a format; plain's for kAuto (which the reader resolves first).
 const FormatSpec& format_spec(MeasurementFormat format);
-// The format of a --format value: plain, gom (also aramis, correlate, zeiss), matchid,
-// vic3d (also vic), dice; letter case ignored. Nothing for other text.
+// The presets, plain first.
+const std::vector<FormatSpec>& format_specs();
+// The format of a --format value: auto, plain, gom (also aramis, correlate, zeiss),
+// matchid, vic3d (also vic), dice; letter case ignored. Nothing for other text.
 std::optional<MeasurementFormat> format_by_name(std::string_view name);
-// "plain, gom, matchid, vic3d, dice", for messages.
+// "auto, plain, gom, matchid, vic3d, dice", for messages.
 std::string format_names();
 
 }  // namespace sf::io

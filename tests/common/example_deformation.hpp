@@ -1,5 +1,5 @@
 #pragma once
-// The analytic deformation behind the example exports in tests/data/formats/
+// The analytic deformation behind the example exports in data/formats/
 // (make_examples.py there): a 7 x 7 grid 5 mm apart, stretched 1.10 x 0.95 and moved
 // rigidly; the stage series scales it with the stage time t (s, 0 to 10).
 
@@ -10,7 +10,7 @@
 
 namespace sf::test {
 
-inline std::string formats_dir() { return std::string(SF_SOURCE_DIR) + "/tests/data/formats/"; }
+inline std::string formats_dir() { return std::string(SF_SOURCE_DIR) + "/data/formats/"; }
 
 // Reference position of grid row i (along Y), column j (along X).
 inline Vec3 example_reference(int i, int j) { return Vec3((j - 3) * 5.0, (i - 3) * 5.0, 0.0); }

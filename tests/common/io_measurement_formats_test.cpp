@@ -1,5 +1,5 @@
 // Reading measuring-system exports (common/io/measurement_formats.hpp through
-// read_grid_file): each preset reads its example file in tests/data/formats/ (made-up
+// read_grid_file): each preset reads its example file in data/formats/ (made-up
 // numbers from one analytic deformation, tests/common/example_deformation.hpp) with its
 // ids, positions, invalid points, units and uncertainties; and the general reading
 // options (units in brackets, composite ids, current positions with displacements,
@@ -59,7 +59,8 @@ TEST(IoFormats, PresetNames) {
   EXPECT_EQ(format_by_name("dice"), MeasurementFormat::kDice);
   EXPECT_EQ(format_by_name("plain"), MeasurementFormat::kPlain);
   EXPECT_FALSE(format_by_name("ncorr").has_value());
-  EXPECT_EQ(format_names(), "plain, gom, matchid, vic3d, dice");
+  EXPECT_EQ(format_by_name("Auto"), MeasurementFormat::kAuto);
+  EXPECT_EQ(format_names(), "auto, plain, gom, matchid, vic3d, dice");
 }
 
 // GOM: a comment and a second table before the header, ';', current positions with
@@ -377,6 +378,156 @@ TEST(IoFormats, BadOptionsNameTheField) {
   o.decimal = ',';
   o.delimiter = ',';
   EXPECT_THAT(message_of<UsageError>([&] { o.validate(); }), HasSubstr("decimal"));
+}
+
+}  // namespace
+}  // namespace sf::io
+
+namespace sf::io {
+namespace {
+
+// --format auto: each example export is recognised by its columns and key, and a note
+// says so; the plain grid file stays plain without a note.
+TEST(IoFormats, AutoFindsEachPresetFromItsHeader) {
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"gom_stage.csv", "gom"}, {"matchid_image.csv", "matchid"}, {"vic3d_frame.csv", "vic3d"},
+      {"dice_solution_10.txt", "dice"}, {"gom_stage_decimal_comma.csv", "gom"}};
+  GridReadOptions o = preset(MeasurementFormat::kAuto);
+  o.decimal = kDetectDecimal;
+  for (const auto& [file, name] : files) {
+    const GridData g = read_grid_file(formats_dir() + file, o);
+    EXPECT_TRUE(any_note(g, "format found from the header: " + name + " (")) << file;
+    // The same points as with the preset named.
+    GridReadOptions named = o;
+    named.format = *format_by_name(name);
+    const GridData h = read_grid_file(formats_dir() + file, named);
+    EXPECT_EQ(g.ids, h.ids) << file;
+    EXPECT_EQ(g.not_measured, h.not_measured) << file;
+  }
+  ScratchDir dir;
+  write_text(dir.file("plain.csv"), "id,X,Y,Z,x,y,z\np,0,0,0,1,0,0\n");
+  const GridData plain = read_grid_file(dir.file("plain.csv"), o);
+  EXPECT_FALSE(any_note(plain, "format found"));
+  EXPECT_EQ(plain.n_points(), 1);
+}
+
+// Without a preset's key the header does not say which system wrote it: x, y, z, u, v, w
+// fits both the plain file (x current) and MatchID 2023 (x reference); auto reads it as
+// plain. With MatchID's key x_pic, y_pic it is MatchID.
+TEST(IoFormats, AutoNeedsThePresetsKey) {
+  ScratchDir dir;
+  write_text(dir.file("a.csv"), "x,y,z,u,v,w\n1,2,3,0.5,0,0\n");
+  const GridData a = read_grid_file(dir.file("a.csv"), preset(MeasurementFormat::kAuto));
+  EXPECT_FALSE(any_note(a, "format found"));
+  EXPECT_LT((row(a.undeformed, 0) - Vec3(0.5, 2, 3)).norm(), 1e-12);  // X = x - u
+  write_text(dir.file("b.csv"), "x_pic,y_pic,x,y,z,u,v,w\n10,20,1,2,3,0.5,0,0\n");
+  const GridData b = read_grid_file(dir.file("b.csv"), preset(MeasurementFormat::kAuto));
+  EXPECT_TRUE(any_note(b, "format found from the header: matchid"));
+  EXPECT_EQ(b.ids[0], "10_20");
+  EXPECT_LT((row(b.undeformed, 0) - Vec3(1, 2, 3)).norm(), 1e-12);  // x is the reference
+  // With --columns the user names the columns: plain.
+  GridReadOptions o = preset(MeasurementFormat::kAuto);
+  o.columns = {{"id", "x_pic"}};
+  EXPECT_FALSE(any_note(read_grid_file(dir.file("b.csv"), o), "format found"));
+}
+
+TEST(IoFormats, AutoWithAHeaderOfTwoPresetsAsksForOne) {
+  ScratchDir dir;
+  const std::string path = dir.file("both.csv");
+  write_text(path, "# two systems' columns\nid,x,y,z,displacement_x,displacement_y,displacement_z,X,Y,Z,U,V,W,sigma\n"
+                   "1,1,2,3,0,0,0,1,2,3,0,0,0,0.1\n");
+  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(MeasurementFormat::kAuto)); }),
+              AllOf(HasSubstr(path + ":2: the header fits more than one measuring system's format (gom, vic3d)"),
+                    HasSubstr("--format")));
+  // A plain file that fits no preset keeps plain's message, and says no preset fits.
+  write_text(path, "i,j,x,y,z\n0,0,1,2,3\n");
+  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(MeasurementFormat::kAuto)); }),
+              AllOf(HasSubstr(path + ":1: missing required column 'X'"),
+                    HasSubstr("nor does the header hold the columns and key of --format gom")));
+}
+
+TEST(IoFormats, DecimalSeparatorFoundFromTheData) {
+  ScratchDir dir;
+  GridReadOptions o = preset(MeasurementFormat::kGom);
+  o.decimal = kDetectDecimal;
+  const GridData g = read_grid_file(formats_dir() + "gom_stage_decimal_comma.csv", o);
+  EXPECT_TRUE(any_note(g, "decimal comma"));
+  o.decimal = '.';
+  const GridData h = read_grid_file(formats_dir() + "gom_stage.csv", o);
+  ASSERT_EQ(g.ids, h.ids);
+  for (Index p = 0; p < g.n_points(); ++p) {
+    if (!g.has_deformed(p)) continue;
+    EXPECT_LT((row(g.deformed, p) - row(h.deformed, p)).norm(), 1e-12) << g.ids[p];
+  }
+  // A point anywhere in the first rows means a decimal point; a comma-separated file
+  // always has one.
+  o.decimal = kDetectDecimal;
+  write_text(dir.file("p.csv"), "id;x;y;z;displacement_x;displacement_y;displacement_z\na;1;2;3;0;0;0\nb;1.5;2;3;0;0;0\n");
+  EXPECT_FALSE(any_note(read_grid_file(dir.file("p.csv"), o), "decimal comma"));
+  write_text(dir.file("c.csv"), "id,x,y,z,displacement_x,displacement_y,displacement_z\na,1,2,3,0,0,0\n");
+  EXPECT_FALSE(any_note(read_grid_file(dir.file("c.csv"), o), "decimal comma"));
+}
+
+// Every preset: a bad cell is named by file, line, field number, column and what was
+// expected; a key cell (empty, repeated) by file, line and character column, as the
+// grid file's id always was.
+TEST(IoFormats, BadCellsOfEachPresetNameFileLineColumn) {
+  struct Case {
+    MeasurementFormat format;
+    std::string text, expected;
+  };
+  const std::vector<Case> cases = {
+      {MeasurementFormat::kPlain, "id,X,Y,Z,x,y,z\np,0,0,0,1,zwei,0\n",
+       ":2:6: expected a number in column 'y', found 'zwei'"},
+      {MeasurementFormat::kGom, "Project;p\n\nid;x [mm];y [mm];z [mm];displacement_x [mm];displacement_y [mm];"
+                                "displacement_z [mm]\n7;1;2;3;0,5;0;0\n",
+       ":4:5: expected a number in column 'displacement_x [mm]', found '0,5' (a decimal comma?"},
+      {MeasurementFormat::kMatchId,
+       "Coordinates.Image X [Pixel],Coordinates.Image Y [Pixel],coor.X [mm],coor.Y [mm],coor.Z [mm],"
+       "disp.Horizontal Displacement U [mm],disp.Vertical Displacement V [mm],disp.Out-Of-Plane: W [mm]\n"
+       "10,,1,2,3,0,0,0\n",
+       ":2:4: empty id cell in column 'Coordinates.Image Y [Pixel]'"},
+      {MeasurementFormat::kVic3d, " \"X\",  \"Y\",  \"Z\",  \"U\",  \"V\",  \"W\",  \"sigma\",  \"x\",  \"y\"\n"
+                                  "1,2,3,0.1,0.2,0.3,0.004,100,200\n1,2,3,0.1,0.2,0.3,0.004,100,200\n",
+       ":3:25: duplicate id '100_200' (from columns x, y) (first at line 2)"},
+      {MeasurementFormat::kDice, "*** DICe-style\n***\nSUBSET_ID,MODEL_COORDINATES_X,MODEL_COORDINATES_Y,"
+                                 "MODEL_COORDINATES_Z,MODEL_DISPLACEMENT_X,MODEL_DISPLACEMENT_Y,"
+                                 "MODEL_DISPLACEMENT_Z,SIGMA,MATCH\n0,1,2,3,0.1,0.2,0.3,0.004,0\n"
+                                 "1,1,2,3,0.1,0.2,0.3,0.004,-1x\n",
+       ":5:9: expected a number in column 'MATCH', found '-1x'"},
+  };
+  ScratchDir dir;
+  const std::string path = dir.file("bad.csv");
+  for (const Case& c : cases) {
+    write_text(path, c.text);
+    EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(c.format)); }), HasSubstr(path + c.expected))
+        << format_spec(c.format).name;
+  }
+}
+
+// Every preset: a file that lacks one of the columns it reads is named by file and
+// header line, with the column, what the preset reads and what the header holds.
+TEST(IoFormats, MissingColumnsOfEachPreset) {
+  struct Case {
+    MeasurementFormat format;
+    std::string text, expected;
+  };
+  const std::vector<Case> cases = {
+      {MeasurementFormat::kGom, "# export\nid;x;y;z;displacement_x;displacement_y\n1;1;2;3;0;0\n",
+       ":2: missing required column 'displacement_z' (the other out-of-plane columns are there; --format gom reads"},
+      {MeasurementFormat::kMatchId, "coor.X [mm],coor.Y [mm],coor.Z [mm],disp.Horizontal Displacement U [mm]\n1,2,3,4\n",
+       ":1: missing required column 'disp.Vertical Displacement V' (--format matchid reads coor.X"},
+      {MeasurementFormat::kDice, "***\nSUBSET_ID,COORDINATE_X,COORDINATE_Y,DISPLACEMENT_X\n0,1,2,3\n",
+       ":2: missing required column 'DISPLACEMENT_Y' (--format dice reads COORDINATE_X, COORDINATE_Y, DISPLACEMENT_X, "
+       "DISPLACEMENT_Y (or MODEL_COORDINATES_X"},
+  };
+  ScratchDir dir;
+  const std::string path = dir.file("short.csv");
+  for (const Case& c : cases) {
+    write_text(path, c.text);
+    EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(c.format)); }), HasSubstr(path + c.expected))
+        << format_spec(c.format).name;
+  }
 }
 
 }  // namespace

@@ -332,7 +332,7 @@ TEST_F(GsaCli, UnitsAreWrittenIntoTheOutputs) {
   EXPECT_THAT(read_text(out + "/strains.csv"), HasSubstr("lengths in in"));
 }
 
-// Every preset's example export (tests/data/formats/, made-up numbers from one stretch
+// Every preset's example export (data/formats/, made-up numbers from one stretch
 // 1.10 x 0.95 plus a rigid motion) analysed as a user would: the marks the system
 // marked invalid get no strain, all others the exact strains.
 TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
@@ -340,7 +340,7 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
     std::string args;
     std::size_t rows, ok;
   };
-  const std::string d = std::string(SF_SOURCE_DIR) + "/tests/data/formats/";
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
   const std::vector<Case> cases = {
       {quoted(d + "gom_stage.csv") + " --format gom", 47, 45},
       {quoted(d + "matchid_image.csv") + " --format matchid", 47, 46},
@@ -368,7 +368,7 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
 }
 
 TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
-  const std::string d = std::string(SF_SOURCE_DIR) + "/tests/data/formats/";
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
   const std::string out = " --no-plots --out " + quoted(dir_.file("out"));
   const CommandResult preset = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic" + "x" + out);
   EXPECT_EQ(preset.exit_code, 2);

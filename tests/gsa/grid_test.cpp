@@ -78,7 +78,7 @@ TEST(GsaGrid, FormatIdAndQuotedColumnNames) {
   EXPECT_EQ(parse_format("vic3d"), io::MeasurementFormat::kVic3d);
   EXPECT_EQ(parse_format("GOM"), io::MeasurementFormat::kGom);
   EXPECT_EQ(message_of<UsageError>([] { parse_format("ncorr"); }),
-            "--format: unknown format 'ncorr' (expected one of plain, gom, matchid, vic3d, dice)");
+            "--format: unknown format 'ncorr' (expected one of auto, plain, gom, matchid, vic3d, dice)");
   EXPECT_THAT(parse_id_columns("x_pic,y_pic"), ElementsAre("x_pic", "y_pic"));
   EXPECT_THAT(message_of<UsageError>([] { parse_id_columns("a,,b"); }), HasSubstr("--id"));
   // A column name that holds a comma is quoted.
@@ -121,14 +121,18 @@ TEST(GsaGrid, ReadingFlagsAndTheirErrors) {
     return message_of<UsageError>([&] { grid_read_options(f); });
   };
   EXPECT_THAT(error([](AnalyseFlags& f) { f.format = "excel"; }), HasSubstr("--format: unknown format 'excel'"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.positions = "current"; }), HasSubstr("--positions: applies to --format"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.format = "plain";
+                f.positions = "current";
+              }),
+              HasSubstr("--positions: applies to --format"));
   EXPECT_THAT(error([](AnalyseFlags& f) {
                 f.format = "gom";
                 f.positions = "later";
               }),
               HasSubstr("--positions: expected 'reference' or 'current'"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "comma"; f.delimiter = ","; }), HasSubstr("--decimal comma"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "dot"; }), HasSubstr("--decimal"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "dot"; }), HasSubstr("--decimal: expected 'auto'"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.pitch = 0; }), HasSubstr("--pitch: must be > 0"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.pixel_size = -1; }), HasSubstr("--pixel-size"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.skip_lines = 2; f.header_line = 4; }), HasSubstr("--skip-lines or --header-line"));

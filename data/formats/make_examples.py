@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the example exports in this folder (run from anywhere: python3 make_examples.py).
+"""Writes the example exports in this folder, data/formats/ (run from anywhere: python3 make_examples.py).
 
 Every number is made up here, from one analytic deformation of a flat 7 x 7 grid of
 points 5 mm apart (X, Y in [-15, 15] mm, Z = 0):
@@ -112,6 +112,13 @@ def main():
     # plus displacements, percent strains with a comma inside the unit brackets. Points 9
     # and 33 are left out of the stage (lost by the system), 17 and 41 have empty cells.
     write("gom_stage.csv", gom_file(10.0, skip=(9, 33), empty=(17, 41)))
+    # The same stage as a German-locale export might write it: decimal commas (the ';'
+    # delimiter leaves the comma free). Whether GOM software does so is not confirmed.
+    text = gom_file(10.0, skip=(9, 33), empty=(17, 41))
+    lines = text.split("\n")
+    head_at = lines.index(GOM_HEADER)
+    lines = [line.replace(".", ",") if k > head_at or 0 < k < head_at - 1 else line for k, line in enumerate(lines)]
+    write("gom_stage_decimal_comma.csv", "\n".join(lines))
     # The same as a series: the reference stage and two stages, one file each.
     write("gom_series/surface-1_0.000s.csv", gom_file(0.0))
     write("gom_series/surface-1_2.000s.csv", gom_file(2.0, empty=(17,)))

@@ -348,6 +348,9 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
       {quoted(d + "dice_solution_10.txt") + " --format dice", 49, 46},
       {quoted(d + "plain_no_id_metres.csv") + " --columns X=X0,Y=Y0,Z=Z0,u=ux,v=uy,w=uz", 49, 49},
       {quoted(d + "grid_indices.csv") + " --pitch 5", 49, 49},
+      // Found from the header (--format auto), the decimal comma from the numbers.
+      {quoted(d + "gom_stage_decimal_comma.csv"), 47, 45},
+      {quoted(d + "dice_solution_10.txt"), 49, 46},
   };
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const Strains s = read_strains(analyse_ok(cases[k].args + " --no-plots", "format" + std::to_string(k)));
@@ -367,6 +370,18 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
   }
 }
 
+// Without --format the status lines say which preset the header was taken for, and
+// how the columns were read.
+TEST_F(GsaCli, FormatFoundFromTheHeaderIsStated) {
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
+  const CommandResult r = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --no-plots --out " +
+                                            quoted(dir_.file("out")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("format found from the header: vic3d (Correlated Solutions VIC-3D"),
+                           HasSubstr("X, Y, Z = reference positions; U, V, W = displacements; key x, y"),
+                           HasSubstr("sigma' (uncertainty) is in image pixels and no pixel size was given")));
+}
+
 TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
   const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
   const std::string out = " --no-plots --out " + quoted(dir_.file("out"));
@@ -382,6 +397,17 @@ TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
   const CommandResult pixels = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic3d --units px" + out);
   EXPECT_EQ(pixels.exit_code, 1);
   EXPECT_THAT(pixels.err, HasSubstr("vic3d_frame.csv:1:1: column 'X' holds lengths"));
+  // A unit gsa does not convert, named by file, header line and field.
+  write_text(dir_.file("deg.csv"), "id,X [mm],Y [mm],Z [mm],x [deg],y [mm],z [mm]\na,0,0,0,1,0,0\n");
+  const CommandResult unit = run_gsa(dir_, "analyse " + quoted(dir_.file("deg.csv")) + out);
+  EXPECT_EQ(unit.exit_code, 1);
+  EXPECT_THAT(unit.err, HasSubstr("deg.csv:1:5: column 'x [deg]' is in 'deg', which is not a length unit"));
+  // --positions needs a preset; auto found none.
+  const CommandResult positions =
+      run_gsa(dir_, "analyse " + quoted(d + "grid_indices.csv") + " --pitch 5 --positions current" + out);
+  EXPECT_EQ(positions.exit_code, 1);
+  EXPECT_THAT(positions.err, AllOf(HasSubstr("grid_indices.csv: --positions applies to a measuring system's format"),
+                                   HasSubstr("give --format")));
   EXPECT_FALSE(fs::exists(dir_.file("out")));
 }
 

@@ -98,6 +98,22 @@ TEST(IoGridSeries, OneFilePerStageJoinedOnTheId) {
   EXPECT_EQ(g.where[0], dir + "surface-1_0.000s.csv:7");
 }
 
+// --format auto on a series: every file is recognised, and the series is the one the
+// preset reads.
+TEST(IoGridSeries, AutoFindsThePresetOfEveryStageFile) {
+  const std::string dir = formats_dir() + "gom_series/";
+  GridReadOptions o;
+  o.format = MeasurementFormat::kAuto;
+  const GridSeries a = read_grid_series(dir + "surface-1_0.000s.csv", {dir}, o);
+  const GridSeries b = read_grid_series(dir + "surface-1_0.000s.csv", {dir}, gom());
+  ASSERT_EQ(a.ids, b.ids);
+  ASSERT_EQ(a.n_stages(), b.n_stages());
+  for (std::size_t k = 0; k < a.n_stages(); ++k) EXPECT_EQ(a.stages[k].not_measured, b.stages[k].not_measured);
+  std::size_t found = 0;
+  for (const std::string& n : a.notes) found += n.find("format found from the header: gom") != std::string::npos;
+  EXPECT_EQ(found, 3u);  // the reference and two stage files
+}
+
 // Without a reference file the undeformed positions are the stages' reference positions
 // (GOM: x - displacement), taken from the first stage that has the mark.
 TEST(IoGridSeries, WithoutAReferenceFileTheStagesGiveTheUndeformedPositions) {

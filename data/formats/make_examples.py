@@ -144,6 +144,23 @@ def main():
         rows.append(",".join(cells))
     write("matchid_image.csv", "\n".join(rows) + "\n")
 
+    # MatchID 2023 names: no units in the header (mm and dimensionless), key x_pic, y_pic
+    # on a 10 px step, rows in the order of the seed growth (not raster order). Points 1
+    # and 37 are left out.
+    rows = ["x_pic,y_pic,x,y,z,u,v,w,exx,eyy,exy,e1,e2,gamma,evm"]
+    grid = list(points())
+    order = sorted(grid, key=lambda p: (abs(p[0] - 3) + abs(p[1] - 3), p[0], p[1]))
+    for i, j, X in order:
+        pid = i * N + j + 1
+        if pid in (1, 37):
+            continue
+        x = deform(X)
+        u = [x[k] - X[k] for k in range(3)]
+        cells = [str(610 + 10 * j), str(700 - 10 * i)] + [e_matchid(v) for v in X + u]
+        cells += [e_matchid(v) for v in (0.105, -0.04875, 0.0, 0.105, -0.04875, 0.0, 0.11)]
+        rows.append(",".join(cells))
+    write("matchid_2023_image.csv", "\n".join(rows) + "\n")
+
     # VIC-3D: quoted names padded with spaces; X, Y, Z reference positions, U, V, W
     # displacements, sigma in pixels; x, y the subset in the reference image (the key).
     # Points 5, 23 and 44 failed: a row of zeros with sigma = -1, x and y kept.
@@ -191,6 +208,31 @@ def main():
                     [f"{sigma:.4E}", "2.1000E-05", "0", "0"]
         rows.append(",".join(cells))
     write("dice_solution_10.txt", "\n".join(rows) + "\n")
+
+    # DICe 2-D: subset centres and displacements in image pixels (0.02 mm per pixel), no
+    # z, ' ' as the delimiter (DICe's default output_delimiter). The deformation is the
+    # in-plane part only: x = Rz(20 deg) (1.10 X, 0.95 Y) + (2, -1). Subsets 0 and 24
+    # failed: SIGMA = -1, MATCH = -1, stale displacements.
+    pre = ["***",
+           "*** DICe-style 2-D solution file, written by hand for gsa's tests (made-up numbers)",
+           "*** Subset size: 25",
+           "*** Step size: x 250 y 250 (-1 implies not regular grid)",
+           "***"]
+    head = ["SUBSET_ID", "COORDINATE_X", "COORDINATE_Y", "DISPLACEMENT_X", "DISPLACEMENT_Y", "SIGMA", "MATCH"]
+    rows = pre + [" ".join(head)]
+    px = 0.02
+    c, sn = math.cos(math.radians(20.0)), math.sin(math.radians(20.0))
+    for i, j, X in points():
+        sid = i * N + j
+        xc = [c * 1.10 * X[0] - sn * 0.95 * X[1] + 2.0, sn * 1.10 * X[0] + c * 0.95 * X[1] - 1.0]
+        cx, cy = 1000 + X[0] / px, 1000 + X[1] / px
+        if sid in (0, 24):
+            cells = [str(sid), f"{cx:.7E}", f"{cy:.7E}", "1.2500000E+01", "-3.0000000E+00", "-1", "-1"]
+        else:
+            cells = [str(sid), f"{cx:.7E}", f"{cy:.7E}", f"{(xc[0] - X[0]) / px:.7E}", f"{(xc[1] - X[1]) / px:.7E}",
+                     "3.0000E-03", "0"]
+        rows.append(" ".join(cells))
+    write("dice_2d_pixels.txt", "\n".join(rows) + "\n")
 
     # A plain table without an id column, in metres, with reference positions and
     # displacements under other names (the --columns example of docs/usage.md).

@@ -351,6 +351,8 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
       // Found from the header (--format auto), the decimal comma from the numbers.
       {quoted(d + "gom_stage_decimal_comma.csv"), 47, 45},
       {quoted(d + "dice_solution_10.txt"), 49, 46},
+      {quoted(d + "matchid_2023_image.csv"), 47, 47},
+      {quoted(d + "dice_2d_pixels.txt") + " --pixel-size 0.02", 49, 47},
   };
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const Strains s = read_strains(analyse_ok(cases[k].args + " --no-plots", "format" + std::to_string(k)));

@@ -509,7 +509,7 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       out.has_sigma = true;
     } else {
       out.notes.push_back(fmt::format("{}: column '{}' (uncertainty) is in image pixels and no pixel size was given: "
-                                      "it is not used as fit weights",
+                                      "not read (--pixel-size converts it)",
                                       path, h.name(*plan->sigma)));
     }
   }

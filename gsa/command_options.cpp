@@ -8,6 +8,7 @@
 
 #include "common/core/error.hpp"
 #include "common/io/grid_file.hpp"
+#include "common/io/measurement_formats.hpp"
 #include "common/render/scene.hpp"
 #include "gsa/flc.hpp"
 
@@ -136,37 +137,110 @@ StrainMeasure parse_measure(const std::string& text, const std::string& option) 
 
 GridReadOptions grid_read_options(const AnalyseFlags& a) {
   GridReadOptions o;
+  o.format = parse_format(a.format);
   o.delimiter = parse_delimiter(a.delimiter);
   if (!a.columns.empty()) o.columns = parse_column_map(a.columns);
+  if (a.id == "row") {
+    o.id_from_row = true;
+  } else if (!a.id.empty()) {
+    o.id_columns = parse_id_columns(a.id);
+  }
+  if (!a.id.empty() && o.columns.count("id"))
+    throw UsageError("--id: the id is given twice, also as --columns id=" + o.columns.at("id") + "; give one");
+  if (a.positions == "reference") o.positions = io::Positions::kReference;
+  else if (a.positions == "current") o.positions = io::Positions::kCurrent;
+  else if (!a.positions.empty())
+    throw UsageError("--positions: expected 'reference' or 'current', found '" + a.positions + "'");
+  if (o.positions != io::Positions::kAsFormat && o.format == io::MeasurementFormat::kPlain)
+    throw UsageError("--positions: applies to --format gom, matchid, vic3d or dice; with a plain file, name the "
+                     "position columns X,Y,Z (reference) or x,y,z (current) in --columns");
+  if (a.decimal == "auto") o.decimal = io::kDetectDecimal;
+  else if (a.decimal == "point" || a.decimal == ".") o.decimal = '.';
+  else if (a.decimal == "comma" || a.decimal == ",") o.decimal = ',';
+  else throw UsageError("--decimal: expected 'auto', 'point' or 'comma', found '" + a.decimal + "'");
+  if (o.decimal == ',' && o.delimiter == ',')
+    throw UsageError("--decimal comma: the delimiter cannot be a comma too (give --delimiter semicolon, or leave it auto)");
+  if (a.skip_lines < 0) throw UsageError("--skip-lines: must be >= 0, found " + std::to_string(a.skip_lines));
+  if (a.header_line < 0) throw UsageError("--header-line: must be >= 1, found " + std::to_string(a.header_line));
+  if (a.header_line > 0 && a.skip_lines > 0) throw UsageError("give either --skip-lines or --header-line, not both");
+  o.skip_lines = a.skip_lines;
+  o.header_line = a.header_line;
+  if (a.units.empty()) throw UsageError("--units: empty");
+  o.units = a.units;
+  if (!std::isnan(a.pixel_size) && !(a.pixel_size > 0 && std::isfinite(a.pixel_size)))
+    throw UsageError("--pixel-size: must be > 0 (length units per pixel), found " + std::to_string(a.pixel_size));
+  o.pixel_size = a.pixel_size;
+  if (!std::isnan(a.pitch) && !(a.pitch > 0 && std::isfinite(a.pitch)))
+    throw UsageError("--pitch: must be > 0, found " + std::to_string(a.pitch));
+  o.pitch = a.pitch;
+  if (!std::isnan(a.pitch) && (o.columns.count("X") || o.columns.count("Y") || o.columns.count("Z")))
+    throw UsageError("--pitch: gives the undeformed positions X, Y, Z; do not map them in --columns too");
+  if (!std::isnan(a.pitch) && !a.undeformed.empty())
+    throw UsageError("--pitch: gives the undeformed positions; give no --undeformed file with it");
+  try {
+    o.validate();  // what is left: contradictions inside --columns
+  } catch (const UsageError& e) {
+    std::string m = e.what();
+    const std::string prefix = "GridReadOptions::columns: ";
+    if (m.rfind(prefix, 0) == 0) m = "--columns: " + m.substr(prefix.size());
+    throw UsageError(m);
+  }
   return o;
+}
+
+io::MeasurementFormat parse_format(const std::string& text) {
+  if (const auto f = io::format_by_name(text)) return *f;
+  throw UsageError("--format: unknown format '" + text + "' (expected one of " + io::format_names() + ")");
+}
+
+namespace {
+
+// Splits  a,b,"c, d"  at the commas outside double quotes; the quotes are removed.
+std::vector<std::string> split_outside_quotes(const std::string& text) {
+  std::vector<std::string> items(1);
+  bool quoted = false;
+  for (const char c : text) {
+    if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) items.emplace_back();
+    else items.back() += c;
+  }
+  return items;
+}
+
+}  // namespace
+
+std::vector<std::string> parse_id_columns(const std::string& text) {
+  std::vector<std::string> out = split_outside_quotes(text);
+  for (const std::string& name : out)
+    if (name.empty())
+      throw UsageError("--id: expected column names separated by commas (e.g. x_pic,y_pic) or 'row', found '" + text + "'");
+  return out;
 }
 
 std::map<std::string, std::string> parse_column_map(const std::string& text) {
   std::map<std::string, std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, end - start);
+  for (const std::string& item : split_outside_quotes(text)) {
     const std::size_t eq = item.find('=');
     if (item.empty() || eq == std::string::npos || eq == 0 || eq + 1 == item.size())
       throw UsageError("--columns: expected NAME=COLUMN pairs separated by commas (e.g. X=x0,u=disp_x), found '" +
                        item + "'");
     const std::string key = item.substr(0, eq);
     if (!io::is_grid_column_key(key))
-      throw UsageError("--columns: unknown name '" + key + "' (expected one of id X Y Z x y z u v w i j)");
+      throw UsageError("--columns: unknown name '" + key + "' (expected one of id X Y Z x y z u v w i j sigma)");
     out[key] = item.substr(eq + 1);
-    start = end + 1;
   }
   return out;
 }
 
 char parse_delimiter(const std::string& text) {
+  if (text == "auto") return io::kDetectDelimiter;
   if (text == "tab" || text == "\\t") return '\t';
   if (text == "comma") return ',';
   if (text == "semicolon") return ';';
   if (text == "space") return ' ';
-  if (text.size() == 1) return text[0];
-  throw UsageError("--delimiter: expected one character or tab/comma/semicolon/space, found '" + text + "'");
+  if (text.size() == 1 && text[0] != '"' && text[0] != '#') return text[0];
+  throw UsageError("--delimiter: expected one character (not '\"' or '#') or auto/tab/comma/semicolon/space, found '" +
+                   text + "'");
 }
 
 }  // namespace sf::gsa

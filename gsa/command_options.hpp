@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "gsa/analysis.hpp"
 #include "gsa/grid.hpp"
@@ -19,7 +20,12 @@ namespace sf::gsa {
 // The flags of `gsa analyse` (docs/usage.md); NaN weights are "not given".
 struct AnalyseFlags {
   std::string grid, undeformed, deformed, out;
-  std::string method = "surface", penalty = "jumps", smoothing_rule = "noise-model", elements, mesh, columns, delimiter = ",", fibres, units = "mm";
+  std::string method = "surface", penalty = "jumps", smoothing_rule = "noise-model", elements, mesh, columns,
+      delimiter = "auto", fibres, units = "mm";
+  // Reading (docs/usage.md "Input formats"); NaN: not given.
+  std::string format = "auto", id, positions, decimal = "auto";
+  int skip_lines = 0, header_line = 0;
+  double pitch = std::numeric_limits<double>::quiet_NaN(), pixel_size = std::numeric_limits<double>::quiet_NaN();
   double alpha = std::numeric_limits<double>::quiet_NaN(), beta = std::numeric_limits<double>::quiet_NaN(),
          gamma = std::numeric_limits<double>::quiet_NaN(), delta = std::numeric_limits<double>::quiet_NaN();
   double outlier_sigma = 4.5, smoothing_scale = 1.0;
@@ -40,16 +46,23 @@ PlotOptions plot_options(const std::string& size, const std::string& view);
 // "true" (also "logarithmic", "natural"), "engineering" or "lagrangian" (also "green"), any
 // letter case; errors name `option`.
 StrainMeasure parse_measure(const std::string& text, const std::string& option = "--measure");
-// --columns, --delimiter.
+// --format, --columns, --id, --positions, --delimiter, --decimal, --skip-lines,
+// --header-line, --units, --pixel-size, --pitch; validated, errors naming the flag.
 GridReadOptions grid_read_options(const AnalyseFlags& flags);
+// "--format": auto, plain, gom (also aramis, correlate, zeiss), matchid, vic3d (also vic), dice.
+io::MeasurementFormat parse_format(const std::string& text);
+// "--id": column names separated by commas (the id joins their cells with '_'), or "row".
+std::vector<std::string> parse_id_columns(const std::string& text);
 
 // The flag that sets a field of AnalyseOptions or OutputOptions ("smoothing.scale" ->
 // "--smoothing-scale"); the field itself when no flag sets it.
 std::string flag_of_field(const std::string& field);
 
 // "--columns" text "X=x0,Y=y0,u=disp_x" -> key -> column name (keys: io::kGridColumnKeys).
+// A name holding a comma is double-quoted: x="eps [%, technical]".
 std::map<std::string, std::string> parse_column_map(const std::string& text);
-// "--delimiter": one character, or "tab", "comma", "semicolon", "space".
+// "--delimiter": one character, or "auto" (io::kDetectDelimiter), "tab", "comma",
+// "semicolon", "space" (runs of blanks).
 char parse_delimiter(const std::string& text);
 
 }  // namespace sf::gsa

@@ -66,6 +66,7 @@ Input read_input(const AnalyseFlags& a, bool quiet) {
     in.info.inputs = {a.undeformed, a.deformed};
   }
   in.read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const std::string& note : in.grid.notes) cli::status(quiet, "gsa: note: " + note);
   return in;
 }
 
@@ -224,7 +225,7 @@ void add_analyse_command(sf::cli::Program& program) {
   program.add_command(
       "analyse", "Grid strain analysis of a digitised part (surface fit or classical triangles)",
       [args](CLI::App& app) {
-        app.add_option("grid", args->grid, "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j])");
+        app.add_option("grid", args->grid, "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j]), or a measuring system's export with --format");
         app.add_option("--undeformed", args->undeformed, "Undeformed grid file (id,x,y,z), with --deformed");
         app.add_option("--deformed", args->deformed, "Deformed grid file (id,x,y,z), with --undeformed");
         app.add_option("-o,--out", args->out, "Output folder (created; files replaced only on success)")->required();
@@ -237,9 +238,30 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_option("--gamma", args->gamma, "Third-derivative smoothing weight, units^4 (default: automatic)");
         app.add_option("--delta", args->delta, "Fourth-order (edge-jump) smoothing weight, units^6, with --penalty jumps");
         app.add_option("--fibres", args->fibres, "Fibre mode: two fibre angles in degrees from the X axis on the undeformed sheet, e.g. 0,90");
-        app.add_option("--units", args->units, "Length unit of the coordinates, written into every output (default mm)");
-        app.add_option("--columns", args->columns, "Map column names, e.g. X=x0,Y=y0,Z=z0,u=u,v=v,w=w (u,v,w = displacements)");
-        app.add_option("--delimiter", args->delimiter, "Field separator: one character, or tab/comma/semicolon/space");
+        app.add_option("--units", args->units,
+                       "Length unit to read the coordinates in and to write into every output (default mm); columns "
+                       "in other units ([m], [in], '# units: m') are converted");
+        app.add_option("--format", args->format,
+                       "Layout of the input: auto (default: a preset when the header holds its columns and key, "
+                       "else plain), plain (the grid file), gom (GOM/ZEISS ARAMIS, Correlate), matchid, vic3d or "
+                       "dice (see docs/usage.md, Input formats)");
+        app.add_option("--columns", args->columns,
+                       "Map column names, e.g. X=x0,Y=y0,Z=z0,u=ux,v=uy,w=uz: X,Y,Z reference and x,y,z current "
+                       "positions, u,v,w displacements (any two of the three), id, i, j, sigma");
+        app.add_option("--id", args->id, "Columns whose cells together make the id, e.g. x_pic,y_pic; or 'row' (the row number)");
+        app.add_option("--positions", args->positions,
+                       "reference or current: what the position columns of a --format with displacements hold "
+                       "(x = X + u, or X = x - u)");
+        app.add_option("--delimiter", args->delimiter,
+                       "Field separator: auto (default, found from the header), one character, or "
+                       "tab/comma/semicolon/space (runs of blanks)");
+        app.add_option("--decimal", args->decimal, "Decimal separator of the numbers: auto (default: comma when the numbers are written so and the delimiter is not a comma), point or comma");
+        app.add_option("--skip-lines", args->skip_lines, "Skip the first N lines of each file, then look for the header");
+        app.add_option("--header-line", args->header_line, "The header is line N of each file (1-based)");
+        app.add_option("--pixel-size", args->pixel_size,
+                       "Length units per image pixel, for columns in pixels (DICe 2-D positions, VIC-3D/DICe sigma)");
+        app.add_option("--pitch", args->pitch,
+                       "Grid pitch: undeformed positions from the grid indices, X = j * pitch, Y = i * pitch, Z = 0");
         app.add_option("--smoothing-scale", args->smoothing_scale, "Multiply the automatic smoothing weights (default 1; >1 smoother)");
         app.add_option("--outlier-sigma", args->outlier_sigma, "Flag a mark as an isolated blunder when it is this many noise levels off its neighbours' local fit and far more than they are (default 4.5); flagged marks still get a strain");
         app.add_option("--smoothing-rule", args->smoothing_rule, "How the automatic smoothing is chosen: noise-model (default; Cp with the estimated noise, spatial correlation included) or gcv (cross-validation, assumes independent errors)");

@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 #include <system_error>
+#include <tuple>
 
 #include "common/core/error.hpp"
 
@@ -22,6 +23,8 @@ namespace sf::io {
 namespace {
 
 constexpr std::size_t kMaxLineBytes = (std::size_t{1} << 30) - 1;
+// The header test looks at this many non-blank lines at most (preambles are short).
+constexpr int kHeaderSearchLines = 1000;
 
 bool is_blank(char c, char delimiter) { return (c == ' ' || c == '\t') && c != delimiter; }
 
@@ -135,16 +138,32 @@ bool CsvTable::is_missing(std::size_t row, std::size_t col) const {
 }
 
 void CsvTable::throw_bad_cell(std::size_t row, std::size_t col, const char* what) const {
+  const std::string_view s = cell(row, col);
+  // "1,25" in a file whose decimal separator is taken to be '.': say so.
+  std::string hint;
+  const auto comma = s.find(',');
+  if (decimal_ == '.' && comma != std::string_view::npos && s.find(',', comma + 1) == std::string_view::npos) {
+    std::string dotted(s);
+    dotted[comma] = '.';
+    double ignored = 0.0;
+    if (parse_double(dotted, ignored)) hint = " (a decimal comma? read the file with ',' as the decimal separator)";
+  }
   throw InputError(
       located_message(file_name_, line(row), static_cast<int>(col + 1),
-                      fmt::format("expected {} in column {}, found {}", what, column_label(col),
-                                  quote_for_message(cell(row, col)))));
+                      fmt::format("expected {} in column {}, found {}{}", what, column_label(col),
+                                  quote_for_message(s), hint)));
 }
 
 double CsvTable::number(std::size_t row, std::size_t col, bool allow_missing) const {
   const std::string_view s = cell(row, col);
   double value = 0.0;
-  if (parse_double(s, value)) return value;
+  if (decimal_ == ',') {
+    std::string copy(s);
+    std::replace(copy.begin(), copy.end(), ',', '.');
+    if (copy.find(',') == std::string::npos && parse_double(copy, value)) return value;
+  } else if (parse_double(s, value)) {
+    return value;
+  }
   if (allow_missing && (s.empty() || equals_nan(s))) {
     return std::numeric_limits<double>::quiet_NaN();
   }
@@ -165,20 +184,318 @@ Eigen::VectorXd CsvTable::numbers(std::size_t col, bool allow_missing) const {
   return out;
 }
 
+namespace {
+
+// One line of the text: content [begin, end) without the line end; next = start of the
+// following line.
+struct LineSpan {
+  std::size_t begin = 0, end = 0, next = 0;
+};
+
+LineSpan line_at(const std::string& text, std::size_t pos) {
+  const char* nl = static_cast<const char*>(std::memchr(text.data() + pos, '\n', text.size() - pos));
+  LineSpan l;
+  l.begin = pos;
+  l.next = nl ? static_cast<std::size_t>(nl - text.data()) + 1 : text.size();
+  l.end = nl ? l.next - 1 : text.size();
+  if (l.end > l.begin && text[l.end - 1] == '\r') --l.end;
+  return l;
+}
+
+bool is_space_or_tab(char c) { return c == ' ' || c == '\t'; }
+
+// Offset of the ']' closing the '[' at `open`, or npos when the line has none.
+std::size_t closing_bracket(std::string_view line, std::size_t open) { return line.find(']', open + 1); }
+
+// Splits a header line into trimmed, unquoted names (the same field rules as the data
+// rows; with `brackets`, a delimiter inside [...] does not split). On a malformed quote,
+// returns false with the 1-based field number and the problem.
+bool split_names(std::string_view line, char delim, bool brackets, std::vector<std::string>& names, int& bad_field,
+                 std::string& problem) {
+  names.clear();
+  const bool whitespace = delim == ' ';
+  auto blank = [&](char c) { return whitespace ? is_space_or_tab(c) : is_blank(c, delim); };
+  auto separator = [&](char c) { return whitespace ? is_space_or_tab(c) : c == delim; };
+  std::size_t p = 0;
+  const std::size_t n = line.size();
+  while (p < n && blank(line[p])) ++p;
+  for (;;) {
+    while (!whitespace && p < n && blank(line[p])) ++p;
+    std::string name;
+    if (p < n && line[p] == '"') {
+      std::size_t q = p + 1;
+      for (;;) {
+        if (q >= n) {
+          bad_field = static_cast<int>(names.size() + 1);
+          problem = "unterminated quoted field (a quoted field must end with '\"' on the same line)";
+          return false;
+        }
+        if (line[q] == '"') {
+          if (q + 1 < n && line[q + 1] == '"') {
+            name += '"';
+            q += 2;
+            continue;
+          }
+          break;
+        }
+        name += line[q++];
+      }
+      p = q + 1;
+      if (!whitespace)
+        while (p < n && blank(line[p])) ++p;
+      if (p < n && !separator(line[p])) {
+        bad_field = static_cast<int>(names.size() + 1);
+        problem = fmt::format("unexpected character '{}' after the closing quote", line[p]);
+        return false;
+      }
+    } else {
+      const std::size_t start = p;
+      while (p < n && !separator(line[p])) {
+        if (brackets && line[p] == '[') {
+          const std::size_t close = closing_bracket(line, p);
+          if (close != std::string_view::npos) {
+            p = close + 1;
+            continue;
+          }
+        }
+        ++p;
+      }
+      std::size_t end = p;
+      while (end > start && blank(line[end - 1])) --end;
+      name.assign(line.substr(start, end - start));
+    }
+    names.push_back(std::move(name));
+    if (whitespace) {
+      while (p < n && is_space_or_tab(line[p])) ++p;
+      if (p >= n) break;
+    } else {
+      if (p >= n) break;
+      ++p;  // the delimiter; a field follows (possibly empty)
+    }
+  }
+  return true;
+}
+
+// The delimiter of a header line by counting: the most frequent of ',', ';', tab outside
+// quotes (and brackets); else ' ' when blanks split the line; else ','.
+char count_delimiter(std::string_view line, bool brackets, char decimal) {
+  std::size_t counts[3] = {0, 0, 0};
+  constexpr char kCandidates[3] = {',', ';', '\t'};
+  bool quoted = false;
+  for (std::size_t p = 0; p < line.size(); ++p) {
+    const char c = line[p];
+    if (c == '"') quoted = !quoted;
+    if (quoted) continue;
+    if (brackets && c == '[') {
+      const std::size_t close = closing_bracket(line, p);
+      if (close != std::string_view::npos) {
+        p = close;
+        continue;
+      }
+    }
+    for (int k = 0; k < 3; ++k)
+      if (c == kCandidates[k] && !(c == ',' && decimal == ',')) ++counts[k];
+  }
+  int best = -1;
+  for (int k = 0; k < 3; ++k)
+    if (counts[k] > 0 && (best < 0 || counts[k] > counts[best])) best = k;
+  if (best >= 0) return kCandidates[best];
+  const auto first = line.find_first_not_of(" \t");
+  const auto last = line.find_last_not_of(" \t");
+  if (first != std::string_view::npos && line.substr(first, last - first + 1).find_first_of(" \t") != std::string_view::npos)
+    return ' ';
+  return ',';
+}
+
+// True for a line of nothing but blanks and delimiters (",,,", as spreadsheets leave them).
+bool only_blanks_and_delimiters(std::string_view line, char delim) {
+  for (const char c : line) {
+    if (is_space_or_tab(c)) continue;
+    if (delim == kDetectDelimiter ? (c == ',' || c == ';') : c == delim) continue;
+    return false;
+  }
+  return true;
+}
+
+// The line without its leading blanks and, when it starts with it, the comment character.
+std::string_view without_comment_mark(std::string_view line, char comment) {
+  std::size_t p = 0;
+  while (p < line.size() && is_space_or_tab(line[p])) ++p;
+  if (comment != '\0' && p < line.size() && line[p] == comment) ++p;
+  return line.substr(p);
+}
+
+bool is_comment_line(std::string_view line, char comment) {
+  std::size_t p = 0;
+  while (p < line.size() && is_space_or_tab(line[p])) ++p;
+  return comment != '\0' && p < line.size() && line[p] == comment;
+}
+
+}  // namespace
+
+std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, const CsvOptions& options) {
+  const std::size_t size = text_.size();
+  const std::string_view text(text_);
+  std::int64_t line_no = 0;
+  while (line_no < options.skip_lines && pos < size) {
+    pos = line_at(text_, pos).next;
+    ++line_no;
+  }
+  delimiter_ = options.delimiter == kDetectDelimiter ? ',' : options.delimiter;
+  if (!options.has_header) return {pos, line_no};
+
+  std::vector<std::string> names;
+  int bad_field = 0;
+  std::string problem;
+  // Takes `content` (line `number`) as the header with delimiter `delim`.
+  auto accept = [&](std::string_view content, std::int64_t number, char delim) {
+    if (!split_names(content, delim, options.brackets_in_header, names, bad_field, problem))
+      throw InputError(located_message(file_name_, static_cast<int>(number), bad_field, problem));
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      if (!names[f].empty() && std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(f), names[f]) !=
+                                   names.begin() + static_cast<std::ptrdiff_t>(f))
+        throw InputError(located_message(file_name_, static_cast<int>(number), static_cast<int>(f + 1),
+                                         fmt::format("duplicate column name '{}'", names[f])));
+    }
+    names_ = names;
+    n_columns_ = names_.size();
+    header_line_ = static_cast<int>(number);
+    delimiter_ = delim;
+    while (!preamble_.empty() && preamble_.back().first >= header_line_) preamble_.pop_back();
+  };
+  auto delimiter_of = [&](std::string_view content) {
+    return options.delimiter != kDetectDelimiter ? options.delimiter
+                                                 : count_delimiter(content, options.brackets_in_header, options.decimal);
+  };
+  // The delimiter for which `content` passes the header test, or '\0'.
+  auto passing_delimiter = [&](std::string_view content) -> char {
+    std::vector<std::string> trial;
+    int f = 0;
+    std::string why;
+    const std::vector<char> candidates = options.delimiter != kDetectDelimiter
+                                             ? std::vector<char>{options.delimiter}
+                                             : std::vector<char>{',', ';', '\t', ' '};
+    for (const char d : candidates) {
+      if (d == ',' && options.decimal == ',') continue;
+      if (split_names(content, d, options.brackets_in_header, trial, f, why) && options.header_test(trial)) return d;
+    }
+    return '\0';
+  };
+
+  if (options.header_line > 0) {
+    while (line_no + 1 < options.header_line && pos < size) {
+      const LineSpan l = line_at(text_, pos);
+      const std::string_view content = text.substr(l.begin, l.end - l.begin);
+      if (content.find_first_not_of(" \t") != std::string_view::npos)
+        preamble_.emplace_back(static_cast<int>(line_no + 1), std::string(content));
+      pos = l.next;
+      ++line_no;
+    }
+    if (pos >= size)
+      throw InputError(located_message(file_name_, 0, 0,
+                                       fmt::format("the header line {} is past the end of the file ({} lines)",
+                                                   options.header_line, line_no)));
+    const LineSpan l = line_at(text_, pos);
+    const std::string_view content = without_comment_mark(text.substr(l.begin, l.end - l.begin), options.comment);
+    accept(content, line_no + 1, delimiter_of(content));
+    return {l.next, line_no + 1};
+  }
+
+  // The non-comment lines looked at, for the fallback when no line passes the test.
+  std::vector<std::pair<LineSpan, std::int64_t>> kept;
+  int searched = 0;
+  while (pos < size && searched < kHeaderSearchLines) {
+    const LineSpan l = line_at(text_, pos);
+    const std::int64_t number = ++line_no;
+    pos = l.next;
+    const std::string_view line = text.substr(l.begin, l.end - l.begin);
+    if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
+    const bool comment = is_comment_line(line, options.comment);
+    if (!comment && only_blanks_and_delimiters(line, options.delimiter)) continue;
+    if (!options.header_test) {
+      if (!comment) {
+        accept(line, number, delimiter_of(line));
+        return {l.next, number};
+      }
+      preamble_.emplace_back(static_cast<int>(number), std::string(line));
+      continue;
+    }
+    ++searched;
+    const std::string_view content = comment ? without_comment_mark(line, options.comment) : line;
+    if (const char d = passing_delimiter(content)) {
+      bool take = !comment;
+      if (comment) {
+        // A commented header counts only when data follows it, not another comment or header.
+        take = true;
+        for (std::size_t q = l.next; q < size;) {
+          const LineSpan m = line_at(text_, q);
+          q = m.next;
+          const std::string_view next = text.substr(m.begin, m.end - m.begin);
+          if (next.find_first_not_of(" \t") == std::string_view::npos) continue;
+          take = !is_comment_line(next, options.comment) && passing_delimiter(next) == '\0';
+          break;
+        }
+      }
+      if (take) {
+        accept(content, number, d);
+        return {l.next, number};
+      }
+    }
+    if (!comment) kept.emplace_back(l, number);
+    preamble_.emplace_back(static_cast<int>(number), std::string(line));
+  }
+  if (kept.empty())
+    throw InputError(located_message(file_name_, 0, 0, "no header line (the file is empty or only comments)"));
+  // No line passed: take the line that looks most like the header of a table (not all
+  // numbers, as many fields as the next line, the most fields), so that the caller's
+  // column lookup names what is missing from it; else the first kept line.
+  std::size_t best = 0;
+  std::size_t best_fields = 0;
+  std::vector<std::string> fields, next_fields;
+  for (std::size_t k = 0; k + 1 < kept.size(); ++k) {
+    const std::string_view line = text.substr(kept[k].first.begin, kept[k].first.end - kept[k].first.begin);
+    const std::string_view next = text.substr(kept[k + 1].first.begin, kept[k + 1].first.end - kept[k + 1].first.begin);
+    const char d = delimiter_of(line);
+    if (!split_names(line, d, options.brackets_in_header, fields, bad_field, problem) ||
+        !split_names(next, d, options.brackets_in_header, next_fields, bad_field, problem))
+      continue;
+    const bool numbers = std::all_of(fields.begin(), fields.end(), [](const std::string& f) {
+      double ignored = 0.0;
+      return parse_double(f, ignored);
+    });
+    if (fields.size() > 1 && fields.size() == next_fields.size() && !numbers && fields.size() > best_fields) {
+      best = k;
+      best_fields = fields.size();
+    }
+  }
+  const auto& [l, number] = kept[best];
+  const std::string_view line = text.substr(l.begin, l.end - l.begin);
+  accept(line, number, delimiter_of(line));
+  return {l.next, number};
+}
+
 void CsvTable::parse(const CsvOptions& options) {
-  const char delim = options.delimiter;
   const char* const text = text_.data();
   const std::size_t size = text_.size();
   std::size_t pos = 0;
   if (size >= 3 && std::memcmp(text, "\xEF\xBB\xBF", 3) == 0) pos = 3;
+  decimal_ = options.decimal == kDetectDecimal ? '.' : options.decimal;
+
+  std::int64_t line_no = 0;
+  std::tie(pos, line_no) = find_header(pos, options);
+  const char delim = delimiter_;
+  const bool whitespace = delim == ' ';
+  auto separator = [&](char c) { return whitespace ? is_space_or_tab(c) : c == delim; };
+  auto blank = [&](char c) { return whitespace ? is_space_or_tab(c) : is_blank(c, delim); };
 
   // Reserve for the data rows from the number of line ends.
   const std::size_t n_lines_estimate =
       static_cast<std::size_t>(std::count(text + pos, text + size, '\n')) + 1;
-
-  bool need_header = options.has_header;
-  bool width_known = false;
-  std::int64_t line_no = 0;
+  bool width_known = options.has_header;
+  if (width_known) {
+    cells_.reserve(n_lines_estimate * n_columns_);
+    rows_.reserve(n_lines_estimate);
+  }
   std::string unescaped;  // scratch for a quoted field with doubled quotes
   std::vector<std::pair<std::size_t, std::string>> row_escaped;  // (field, text) of this row
 
@@ -197,21 +514,19 @@ void CsvTable::parse(const CsvOptions& options) {
     }
 
     // Comment line: first non-blank character is the comment character.
-    {
-      std::size_t p = line_begin;
-      while (p < line_end && (text[p] == ' ' || text[p] == '\t')) ++p;
-      if (p == line_end) continue;  // blank line
-      if (options.comment != '\0' && text[p] == options.comment) continue;
-    }
+    std::size_t p = line_begin;
+    while (p < line_end && is_space_or_tab(text[p])) ++p;
+    if (p == line_end) continue;  // blank line
+    if (options.comment != '\0' && text[p] == options.comment) continue;
+    if (!whitespace) p = line_begin;
 
     // Split the line into fields, appended to cells_.
     const std::size_t first_cell = cells_.size();
     row_escaped.clear();
     bool all_empty = true;
-    std::size_t p = line_begin;
     std::size_t field = 0;
     for (;; ++field) {
-      while (p < line_end && is_blank(text[p], delim)) ++p;
+      while (p < line_end && blank(text[p])) ++p;
       const std::size_t field_start = p;
       Cell cell{static_cast<std::uint32_t>(field_start - line_begin), 0};
       if (p < line_end && text[p] == '"') {
@@ -250,19 +565,29 @@ void CsvTable::parse(const CsvOptions& options) {
         }
         all_empty = false;
         p = close + 1;
-        while (p < line_end && is_blank(text[p], delim)) ++p;
-        if (p < line_end && text[p] != delim) {
+        if (!whitespace) {
+          while (p < line_end && blank(text[p])) ++p;
+          if (p < line_end && text[p] != delim) {
+            throw InputError(located_message(
+                file_name_, line_int, static_cast<int>(field + 1),
+                fmt::format("unexpected character '{}' after the closing quote", text[p])));
+          }
+        } else if (p < line_end && !separator(text[p])) {
           throw InputError(located_message(
               file_name_, line_int, static_cast<int>(field + 1),
               fmt::format("unexpected character '{}' after the closing quote", text[p])));
         }
       } else {
-        const char* d = p < line_end
-                            ? static_cast<const char*>(std::memchr(text + p, delim, line_end - p))
-                            : nullptr;
-        const std::size_t field_end = d ? static_cast<std::size_t>(d - text) : line_end;
+        std::size_t field_end = line_end;
+        if (whitespace) {
+          field_end = p;
+          while (field_end < line_end && !separator(text[field_end])) ++field_end;
+        } else if (p < line_end) {
+          const char* d = static_cast<const char*>(std::memchr(text + p, delim, line_end - p));
+          if (d) field_end = static_cast<std::size_t>(d - text);
+        }
         std::size_t content_end = field_end;
-        while (content_end > field_start && is_blank(text[content_end - 1], delim)) {
+        while (content_end > field_start && blank(text[content_end - 1])) {
           --content_end;
         }
         cell.size_and_flags = static_cast<std::uint32_t>(content_end - field_start);
@@ -270,7 +595,10 @@ void CsvTable::parse(const CsvOptions& options) {
         p = field_end;
       }
       cells_.push_back(cell);
-      if (p < line_end) {
+      if (whitespace) {
+        while (p < line_end && is_space_or_tab(text[p])) ++p;
+        if (p >= line_end) break;
+      } else if (p < line_end) {
         ++p;  // the delimiter; a field follows (possibly empty)
       } else {
         break;
@@ -280,35 +608,6 @@ void CsvTable::parse(const CsvOptions& options) {
 
     if (all_empty) {  // only delimiters and blanks
       cells_.resize(first_cell);
-      continue;
-    }
-
-    if (need_header) {
-      names_.reserve(n_fields);
-      for (std::size_t f = 0; f < n_fields; ++f) {
-        const Cell& c = cells_[first_cell + f];
-        std::string name;
-        if (c.size_and_flags & kEscaped) {
-          for (const auto& [index, value] : row_escaped) {
-            if (index == f) name = value;
-          }
-        } else {
-          name.assign(text + line_begin + c.offset + ((c.size_and_flags & kQuoted) ? 1 : 0),
-                      c.size_and_flags & kSizeMask);
-        }
-        if (!name.empty() && std::find(names_.begin(), names_.end(), name) != names_.end()) {
-          throw InputError(located_message(file_name_, line_int, static_cast<int>(f + 1),
-                                           fmt::format("duplicate column name '{}'", name)));
-        }
-        names_.push_back(std::move(name));
-      }
-      cells_.resize(first_cell);
-      n_columns_ = n_fields;
-      header_line_ = line_int;
-      need_header = false;
-      width_known = true;
-      cells_.reserve(n_lines_estimate * n_columns_);
-      rows_.reserve(n_lines_estimate);
       continue;
     }
 
@@ -329,17 +628,37 @@ void CsvTable::parse(const CsvOptions& options) {
     }
     rows_.push_back(Row{line_begin, line_no});
   }
+  if (options.decimal == kDetectDecimal) decimal_ = detect_decimal();
+}
 
-  if (need_header) {
-    throw InputError(
-        located_message(file_name_, 0, 0, "no header line (the file is empty or only comments)"));
+char CsvTable::detect_decimal() const {
+  if (delimiter_ == ',') return '.';
+  bool comma = false;
+  const std::size_t n = std::min<std::size_t>(rows_.size(), 200);
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = 0; c < n_columns_; ++c) {
+      const std::string_view s = cell(r, c);
+      double ignored = 0.0;
+      const auto at = s.find(',');
+      if (at == std::string_view::npos) {
+        if (s.find('.') != std::string_view::npos && parse_double(s, ignored)) return '.';
+      } else if (!comma && s.find(',', at + 1) == std::string_view::npos && s.find('.') == std::string_view::npos) {
+        std::string dotted(s);
+        dotted[at] = '.';
+        comma = parse_double(dotted, ignored);
+      }
+    }
   }
+  return comma ? ',' : '.';
 }
 
 CsvTable read_csv_string(std::string text, const std::string& name, const CsvOptions& options) {
   if (options.delimiter == '"' || options.delimiter == '\n' || options.delimiter == '\r' ||
-      (options.comment != '\0' && options.comment == options.delimiter)) {
-    throw std::logic_error("read_csv: invalid delimiter/comment options");
+      (options.comment != '\0' && options.comment == options.delimiter) ||
+      (options.decimal != '.' && options.decimal != ',' && options.decimal != kDetectDecimal) || (options.decimal == ',' && options.delimiter == ',') ||
+      options.skip_lines < 0 || options.header_line < 0 ||
+      (options.header_line > 0 && options.header_line <= options.skip_lines)) {
+    throw std::logic_error("read_csv: invalid delimiter/comment/decimal/skip_lines/header_line options");
   }
   CsvTable table;
   table.file_name_ = name;

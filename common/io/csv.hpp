@@ -13,6 +13,11 @@
 //  - A field may be double-quoted: it may then hold delimiters, surrounding blanks and
 //    doubled quotes ("" -> "). A quoted field must close on the same line.
 //
+// Files written by measuring systems need more (CsvOptions): a preamble of any content
+// before the header (skip_lines, or the header found by a test on its names), a header
+// that is itself a comment line ("#  ID; x [mm]; ..."), names with a unit in brackets that
+// holds the delimiter ("eps [%, technical]"), the delimiter found from the header, fields
+// separated by runs of blanks (delimiter ' '), and a decimal comma.
 // Positions in messages: "FILE:LINE:COLUMN: ..." where LINE is the 1-based line of the file
 // and COLUMN is the 1-based FIELD NUMBER in that row (not a character offset). The
 // character column of a field, counted in UTF-8 characters, is available from
@@ -24,20 +29,53 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace sf::io {
 
+// CsvOptions::delimiter value: find the delimiter from the header line.
+inline constexpr char kDetectDelimiter = '\0';
+// CsvOptions::decimal value: find the decimal separator from the data rows.
+inline constexpr char kDetectDecimal = '\0';
+
 struct CsvOptions {
+  // The field separator. ' ' means runs of blanks (spaces and tabs; a line's leading and
+  // trailing blanks are ignored, so no field is empty). kDetectDelimiter: with a
+  // header_test, the first of ',', ';', tab, ' ' for which the header passes it; otherwise
+  // the most frequent of ',', ';', tab outside quotes in the header line, else ' ' when
+  // that splits the line, else ','.
   char delimiter = ',';
   char comment = '#';  // '\0': no comment lines
   bool has_header = true;
+  // Lines 1..skip_lines of the file are not read at all (a preamble of any content).
+  int skip_lines = 0;
+  // > 0: the header is this line of the file (1-based), whatever it holds; a comment
+  // character in front of its first name is removed. Lines before it are not read.
+  int header_line = 0;
+  // The header search: when set (and header_line is 0), the header is the first line
+  // after skip_lines whose names pass the test. A comment line is tried too, without its
+  // comment character, and is taken when the next non-blank line is neither a comment nor
+  // a header that passes (a commented header over the data). Lines before the header are a
+  // preamble and not read. The search looks at the first 1000 non-blank lines. When no
+  // line passes, the header is the line that looks most like a table's (not all numbers,
+  // as many fields as the next line, the most fields; else the first kept line), so that
+  // the caller's column lookup reports what it found there.
+  std::function<bool(const std::vector<std::string>& names)> header_test;
+  // In the header only: a delimiter inside [...] does not split ("eps [%, technical]").
+  bool brackets_in_header = false;
+  // The decimal separator of numbers: '.' or ',' (then the delimiter cannot be ',').
+  // kDetectDecimal: ',' when the delimiter is not ',' and the first 200 data rows hold a
+  // number that reads only with a decimal comma ("1,25") and none written with a point
+  // ("1.25"); else '.'. CsvTable::decimal() says which.
+  char decimal = '.';
 };
 
 class CsvTable {
@@ -54,6 +92,13 @@ class CsvTable {
   std::size_t n_rows() const { return rows_.size(); }
   // 1-based line number of the header in the file (0 without a header).
   int header_line() const { return header_line_; }
+  // The delimiter used (the one found, with kDetectDelimiter).
+  char delimiter() const { return delimiter_; }
+  // The decimal separator used (the one found, with kDetectDecimal).
+  char decimal() const { return decimal_; }
+  // The non-blank lines before the header (comments and preamble), as written, with
+  // their 1-based line numbers; lines dropped by skip_lines are not kept.
+  const std::vector<std::pair<int, std::string>>& preamble() const { return preamble_; }
 
   bool has_column(std::string_view name) const { return find_column(name).has_value(); }
   // 0-based column index of `name`, or nothing.
@@ -77,7 +122,8 @@ class CsvTable {
   bool is_missing(std::size_t row, std::size_t col) const;
 
   // The cell as a number. The whole cell must be a decimal floating-point number
-  // ("1.5e3", "-2", "+.5"); "1,5", "0x1p3", "inf" and trailing text are rejected.
+  // ("1.5e3", "-2", "+.5", "6.68633E-001"); "1,5" (unless CsvOptions::decimal is ','),
+  // "0x1p3", "inf" and trailing text are rejected.
   // allow_missing: an empty cell or "nan"/"NaN" gives NaN; otherwise those are errors too.
   // Throws sf::InputError "FILE:LINE:COLUMN: expected a number in column 'NAME', found 'abc'".
   double number(std::size_t row, std::size_t col, bool allow_missing = false) const;
@@ -108,6 +154,12 @@ class CsvTable {
   };
 
   void parse(const CsvOptions& options);
+  // Finds the header (CsvOptions: skip_lines, header_line, header_test), sets names_,
+  // header_line_, delimiter_ and preamble_; returns the byte offset after the header line
+  // and its line number, or (text size, lines) without a header.
+  std::pair<std::size_t, std::int64_t> find_header(std::size_t pos, const CsvOptions& options);
+  // The decimal separator of the data rows (CsvOptions::decimal == kDetectDecimal).
+  char detect_decimal() const;
   [[noreturn]] void throw_bad_cell(std::size_t row, std::size_t col, const char* what) const;
 
   std::string file_name_;
@@ -115,6 +167,9 @@ class CsvTable {
   std::vector<std::string> names_;
   std::size_t n_columns_ = 0;
   int header_line_ = 0;
+  char delimiter_ = ',';
+  char decimal_ = '.';
+  std::vector<std::pair<int, std::string>> preamble_;
   std::vector<Row> rows_;
   std::vector<Cell> cells_;                               // n_rows x n_columns, row-major
   std::unordered_map<std::size_t, std::string> escaped_;  // cell index -> unescaped text

@@ -1,84 +1,21 @@
 #include "common/io/grid_file.hpp"
 
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
 #include "common/io/csv.hpp"
+#include "common/io/grid_rows.hpp"
+#include "common/io/grid_series.hpp"
 
 namespace sf::io {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string mapped(const GridReadOptions& o, const std::string& key) {
-  auto it = o.columns.find(key);
-  return it == o.columns.end() ? key : it->second;
-}
-
-CsvTable load(const std::string& path, const GridReadOptions& options) {
-  CsvOptions co;
-  co.delimiter = options.delimiter;
-  return read_csv(path, co);
-}
-
-std::string where_of(const CsvTable& t, std::size_t row) { return t.file_name() + ":" + std::to_string(t.line(row)); }
-
-// Reads a 3-vector from columns (a, b, c); a row with any missing entry is all NaN.
-void read_xyz(const CsvTable& t, std::size_t row, const std::array<std::size_t, 3>& cols, double* out) {
-  bool missing = false;
-  for (int k = 0; k < 3; ++k) {
-    out[k] = t.number(row, cols[k], /*allow_missing=*/true);
-    if (std::isnan(out[k])) missing = true;
-  }
-  if (missing) out[0] = out[1] = out[2] = kNaN;
-}
-
-void read_ij(const CsvTable& t, const GridReadOptions& o, GridData& g, std::size_t row, Index p, bool& first) {
-  const auto ci = t.find_column(mapped(o, "i")), cj = t.find_column(mapped(o, "j"));
-  if (first) {
-    g.has_ij = ci.has_value() && cj.has_value();
-    first = false;
-  }
-  if (!g.has_ij) return;
-  if (t.is_missing(row, *ci) || t.is_missing(row, *cj)) {
-    g.i[p] = g.j[p] = kNoGridIndex;
-    return;
-  }
-  g.i[p] = t.integer(row, *ci);
-  g.j[p] = t.integer(row, *cj);
-}
-
-// Reads row r's id and records it in `seen` (id -> row); empty or repeated ids
-// are input errors naming the file, line and column (and the first occurrence).
-std::string take_id(const CsvTable& t, std::size_t r, std::size_t col, std::unordered_map<std::string, std::size_t>& seen) {
-  std::string id(t.cell(r, col));
-  if (id.empty()) throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, col), "empty id"));
-  auto [it, fresh] = seen.emplace(id, r);
-  if (!fresh)
-    throw InputError(located_message(t.file_name(), t.line(r), t.char_column(r, col),
-                                     "duplicate id '" + id + "' (first at line " + std::to_string(t.line(it->second)) +
-                                         "); ids must be unique"));
-  return id;
-}
-
-void resize(GridData& g, std::size_t n) {
-  g.ids.resize(n);
-  g.undeformed.resize(static_cast<Index>(n), 3);
-  g.deformed.resize(static_cast<Index>(n), 3);
-  g.i.resize(n);
-  g.j.resize(n);
-  g.where.resize(n);
-}
-
-void drop_ij_unless_present(GridData& g) {
-  if (g.has_ij) return;
-  g.i.clear();
-  g.j.clear();
-}
 
 void write_comment(std::ostream& out, const std::string& text) {
   std::size_t start = 0;
@@ -90,6 +27,10 @@ void write_comment(std::ostream& out, const std::string& text) {
   }
 }
 
+[[noreturn]] void bad_option(const std::string& field, const std::string& problem) {
+  throw UsageError("GridReadOptions::" + field + ": " + problem);
+}
+
 }  // namespace
 
 bool is_grid_column_key(std::string_view key) {
@@ -98,71 +39,92 @@ bool is_grid_column_key(std::string_view key) {
   return false;
 }
 
+void GridReadOptions::validate() const {
+  for (const auto& [key, name] : columns) {
+    if (!is_grid_column_key(key)) bad_option("columns", "unknown key '" + key + "'");
+    if (name.empty()) bad_option("columns", "no column name for '" + key + "'");
+  }
+  auto mapped = [&](std::initializer_list<const char*> keys) {
+    for (const char* k : keys)
+      if (columns.count(k)) return true;
+    return false;
+  };
+  if (mapped({"X", "Y", "Z"}) && mapped({"x", "y", "z"}) && mapped({"u", "v", "w"}))
+    bad_option("columns", "reference positions (X, Y, Z), current positions (x, y, z) and displacements (u, v, w) "
+                          "all mapped; map two of them");
+  if (format == MeasurementFormat::kPlain && positions != Positions::kAsFormat)
+    bad_option("positions", "applies to a measuring system's format; in the plain grid file the names say it "
+                            "(X, Y, Z reference, x, y, z current positions)");
+  if (!id_columns.empty() && columns.count("id")) bad_option("id_columns", "give the id columns once, not also as columns id=...");
+  if (id_from_row && (!id_columns.empty() || columns.count("id")))
+    bad_option("id_from_row", "the id is either the row number or taken from columns");
+  for (const std::string& c : id_columns)
+    if (c.empty()) bad_option("id_columns", "an empty column name");
+  if (decimal != '.' && decimal != ',' && decimal != kDetectDecimal)
+    bad_option("decimal", std::string("must be '.', ',' or kDetectDecimal, found '") + decimal + "'");
+  if (decimal == ',' && delimiter == ',') bad_option("decimal", "',' needs a delimiter other than ','");
+  if (skip_lines < 0) bad_option("skip_lines", "must be >= 0, found " + std::to_string(skip_lines));
+  if (header_line < 0) bad_option("header_line", "must be >= 1, found " + std::to_string(header_line));
+  if (header_line > 0 && header_line <= skip_lines)
+    bad_option("header_line", "line " + std::to_string(header_line) + " is among the " + std::to_string(skip_lines) +
+                                  " skipped lines");
+  if (units.empty()) bad_option("units", "empty");
+  if (!std::isnan(pixel_size) && !(pixel_size > 0 && std::isfinite(pixel_size)))
+    bad_option("pixel_size", "must be > 0, found " + std::to_string(pixel_size));
+  if (!std::isnan(pitch) && !(pitch > 0 && std::isfinite(pitch)))
+    bad_option("pitch", "must be > 0, found " + std::to_string(pitch));
+  if (!std::isnan(pitch) && mapped({"X", "Y", "Z"}))
+    bad_option("pitch", "gives the reference positions; do not also map X, Y, Z");
+}
+
 GridData read_grid_file(const std::string& path, const GridReadOptions& options) {
-  const CsvTable t = load(path, options);
+  detail::GridRows rows = detail::read_grid_rows(path, options, detail::FileRole::kBothStates);
   GridData g;
   g.sources = {path};
-  const std::size_t n = t.n_rows();
-  const std::size_t cid = t.column_index(mapped(options, "id"));
-  const std::array<std::size_t, 3> cu = {t.column_index(mapped(options, "X")), t.column_index(mapped(options, "Y")),
-                                         t.column_index(mapped(options, "Z"))};
-  const bool displacement = options.columns.count("u") || options.columns.count("v") || options.columns.count("w");
-  std::array<std::size_t, 3> cd;
-  if (displacement) {
-    cd = {t.column_index(mapped(options, "u")), t.column_index(mapped(options, "v")), t.column_index(mapped(options, "w"))};
-  } else {
-    cd = {t.column_index(mapped(options, "x")), t.column_index(mapped(options, "y")), t.column_index(mapped(options, "z"))};
+  g.units = options.units;
+  g.notes = std::move(rows.notes);
+  const std::size_t n = rows.rows.size();
+  const Index ni = static_cast<Index>(n);
+  g.ids.resize(n);
+  g.where.resize(n);
+  g.undeformed.resize(ni, 3);
+  g.deformed.resize(ni, 3);
+  g.has_ij = rows.has_ij;
+  if (g.has_ij) {
+    g.i.resize(n);
+    g.j.resize(n);
   }
-  resize(g, n);
-  std::unordered_map<std::string, std::size_t> seen;
-  bool first = true;
+  if (rows.has_sigma) {
+    g.sigma_undeformed.resize(n);
+    g.sigma_deformed.resize(n);
+  }
+  std::vector<std::uint8_t> flags(n, 0);
+  bool any_flag = false;
   for (std::size_t r = 0; r < n; ++r) {
+    detail::GridRow& row = rows.rows[r];
     const Index p = static_cast<Index>(r);
-    g.ids[r] = take_id(t, r, cid, seen);
-    read_xyz(t, r, cu, g.undeformed.row(p).data());
-    read_xyz(t, r, cd, g.deformed.row(p).data());
-    if (displacement) g.deformed.row(p) += g.undeformed.row(p);
-    read_ij(t, options, g, r, p, first);
-    g.where[r] = where_of(t, r);
+    g.ids[r] = std::move(row.id);
+    g.where[r] = path + ":" + std::to_string(row.line);
+    g.undeformed.row(p) = row.reference.transpose();
+    g.deformed.row(p) = row.current.transpose();
+    if (g.has_ij) {
+      g.i[r] = row.i;
+      g.j[r] = row.j;
+    }
+    if (rows.has_sigma) g.sigma_undeformed[r] = g.sigma_deformed[r] = row.sigma;
+    flags[r] = static_cast<std::uint8_t>((row.flagged_reference ? kNotMeasuredUndeformed : 0) |
+                                         (row.flagged_current ? kNotMeasuredDeformed : 0));
+    any_flag = any_flag || flags[r] != 0;
   }
-  drop_ij_unless_present(g);
+  if (any_flag) g.not_measured = std::move(flags);
+  const FormatSpec& spec = format_spec(options.format);
+  if (spec.invalid != InvalidRule::kNone) g.not_measured_rule = spec.invalid_text;
   return g;
 }
 
 GridData read_grid_file_pair(const std::string& undeformed_path, const std::string& deformed_path,
                              const GridReadOptions& options) {
-  const CsvTable tu = load(undeformed_path, options), td = load(deformed_path, options);
-  GridData g;
-  g.sources = {undeformed_path, deformed_path};
-  auto cols = [&](const CsvTable& t) {
-    return std::array<std::size_t, 3>{t.column_index(mapped(options, "x")), t.column_index(mapped(options, "y")),
-                                      t.column_index(mapped(options, "z"))};
-  };
-  const std::size_t uid = tu.column_index(mapped(options, "id")), did = td.column_index(mapped(options, "id"));
-  const auto cu = cols(tu), cd = cols(td);
-  const std::size_t n = tu.n_rows();
-  resize(g, n);
-  g.deformed.setConstant(kNaN);
-  std::unordered_map<std::string, std::size_t> index;
-  bool first = true;
-  for (std::size_t r = 0; r < n; ++r) {
-    const Index p = static_cast<Index>(r);
-    g.ids[r] = take_id(tu, r, uid, index);
-    read_xyz(tu, r, cu, g.undeformed.row(p).data());
-    read_ij(tu, options, g, r, p, first);
-    g.where[r] = where_of(tu, r);
-  }
-  std::unordered_map<std::string, std::size_t> seen_deformed;
-  for (std::size_t r = 0; r < td.n_rows(); ++r) {
-    const std::string id = take_id(td, r, did, seen_deformed);
-    auto it = index.find(id);
-    if (it == index.end())
-      throw InputError(located_message(td.file_name(), td.line(r), td.char_column(r, did),
-                                       "id '" + id + "' is not in the undeformed file " + undeformed_path));
-    read_xyz(td, r, cd, g.deformed.row(static_cast<Index>(it->second)).data());
-  }
-  drop_ij_unless_present(g);
-  return g;
+  return detail::build_series(undeformed_path, {deformed_path}, options).stage_grid(0);
 }
 
 struct GridFileWriter::Impl {

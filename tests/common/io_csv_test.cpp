@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -180,6 +181,130 @@ TEST(IoCsv, NoHeaderAndTabDelimiter) {
   ASSERT_EQ(t.n_columns(), 3u);
   EXPECT_EQ(t.cell(0, 2), "");
   EXPECT_EQ(t.cell(1, 1), "x");  // tabs delimit; spaces are still trimmed
+}
+
+// Names as a measuring system writes them: a header found by the names it must hold,
+// after a preamble of other tables; the delimiter found from it.
+TEST(IoCsv, HeaderSearchSkipsAPreambleAndFindsTheDelimiter) {
+  const std::string text =
+      "Project: plate 7\n"                     // 1
+      "Stage;Time [s];Force [kN]\n"            // 2: another table first
+      "12;24.0;18.5\n"                         // 3
+      "\n"                                     // 4
+      "id; x [mm]; y [mm]\n"                   // 5: the header
+      "p1; 1.5; 2\n"                           // 6
+      "# a comment\n"                          // 7
+      "p2; 3; 4\n";                            // 8
+  CsvOptions o;
+  o.delimiter = kDetectDelimiter;
+  o.header_test = [](const std::vector<std::string>& names) {
+    return std::find(names.begin(), names.end(), "id") != names.end();
+  };
+  const CsvTable t = read_csv_string(text, "gom.csv", o);
+  EXPECT_EQ(t.header_line(), 5);
+  EXPECT_EQ(t.delimiter(), ';');
+  EXPECT_EQ(t.names(), (std::vector<std::string>{"id", "x [mm]", "y [mm]"}));
+  ASSERT_EQ(t.n_rows(), 2u);
+  EXPECT_EQ(t.line(1), 8);
+  EXPECT_DOUBLE_EQ(t.number(0, 1), 1.5);
+  ASSERT_EQ(t.preamble().size(), 3u);  // lines 1-3, not the blank line
+  EXPECT_EQ(t.preamble()[1], (std::pair<int, std::string>{2, "Stage;Time [s];Force [kN]"}));
+}
+
+TEST(IoCsv, WithoutAPassingLineTheFirstKeptLineIsTheHeader) {
+  CsvOptions o;
+  o.delimiter = kDetectDelimiter;
+  o.header_test = [](const std::vector<std::string>&) { return false; };
+  const CsvTable t = read_csv_string("# c\na;b;c\n1;2;3\n", "f.csv", o);
+  EXPECT_EQ(t.header_line(), 2);
+  EXPECT_EQ(t.delimiter(), ';');  // by counting
+  EXPECT_EQ(t.names(), (std::vector<std::string>{"a", "b", "c"}));
+}
+
+TEST(IoCsv, CommentedHeaderOverTheDataIsTheHeader) {
+  CsvOptions o;
+  o.delimiter = kDetectDelimiter;
+  o.header_test = [](const std::vector<std::string>& names) { return names.size() == 3 && names[0] == "ID"; };
+  const CsvTable t = read_csv_string("# exported 2024\n#   ID;  x_undef [mm];  u [mm]\n  1;  -8.5;  0.25\n", "n.txt", o);
+  EXPECT_EQ(t.header_line(), 2);
+  EXPECT_EQ(t.names(), (std::vector<std::string>{"ID", "x_undef [mm]", "u [mm]"}));
+  ASSERT_EQ(t.n_rows(), 1u);
+  EXPECT_DOUBLE_EQ(t.number(0, 2), 0.25);
+  // A commented copy of the header just above the real one is not taken.
+  const CsvTable u = read_csv_string("# ID;a;b\nID;a;b\n1;2;3\n", "n.txt", o);
+  EXPECT_EQ(u.header_line(), 2);
+  EXPECT_EQ(u.n_rows(), 1u);
+}
+
+TEST(IoCsv, SkipLinesAndAnExplicitHeaderLine) {
+  const std::string text = "garbage,with,commas\n*** more, text\nid,v\np,1\n";
+  CsvOptions o;
+  o.skip_lines = 2;
+  const CsvTable t = read_csv_string(text, "s.csv", o);
+  EXPECT_EQ(t.header_line(), 3);
+  EXPECT_EQ(t.line(0), 4);
+  EXPECT_TRUE(t.preamble().empty());  // skipped lines are not kept
+  CsvOptions h;
+  h.header_line = 3;
+  const CsvTable u = read_csv_string(text, "s.csv", h);
+  EXPECT_EQ(u.names(), (std::vector<std::string>{"id", "v"}));
+  EXPECT_EQ(u.preamble().size(), 2u);
+  h.header_line = 9;
+  EXPECT_THAT(message_of<InputError>([&] { read_csv_string(text, "s.csv", h); }),
+              HasSubstr("s.csv: the header line 9 is past the end of the file (4 lines)"));
+}
+
+TEST(IoCsv, QuotedPaddedNamesAndBracketsHoldingTheDelimiter) {
+  // VIC-3D pads quoted names with spaces; a unit in brackets may hold the delimiter.
+  const CsvTable vic = read_csv_string(" \"X\",  \"Y\",  \"sigma\"\n0,0,-1\n", "vic.csv");
+  EXPECT_EQ(vic.names(), (std::vector<std::string>{"X", "Y", "sigma"}));
+  CsvOptions o;
+  o.brackets_in_header = true;
+  const CsvTable t = read_csv_string("id,eps [%, technical],\"a,b\"\np,1.5,2\n", "b.csv", o);
+  EXPECT_EQ(t.names(), (std::vector<std::string>{"id", "eps [%, technical]", "a,b"}));
+  EXPECT_DOUBLE_EQ(t.number(0, 1), 1.5);
+  // An unclosed bracket is an ordinary character.
+  const CsvTable u = read_csv_string("id,a [mm,b\np,1,2\n", "b.csv", o);
+  EXPECT_EQ(u.names(), (std::vector<std::string>{"id", "a [mm", "b"}));
+}
+
+TEST(IoCsv, BlankRunsDelimitWithDelimiterSpace) {
+  CsvOptions o;
+  o.delimiter = ' ';
+  const CsvTable t = read_csv_string("  SUBSET_ID  X\tY\n0   1.5e0 -2\n  1 \"a b\"   3\n", "d.txt", o);
+  EXPECT_EQ(t.names(), (std::vector<std::string>{"SUBSET_ID", "X", "Y"}));
+  ASSERT_EQ(t.n_rows(), 2u);
+  EXPECT_DOUBLE_EQ(t.number(0, 1), 1.5);
+  EXPECT_DOUBLE_EQ(t.number(0, 2), -2.0);
+  EXPECT_EQ(t.cell(1, 1), "a b");
+  EXPECT_EQ(t.char_column(1, 2), 13);
+  // Detected when nothing else splits the header.
+  CsvOptions d;
+  d.delimiter = kDetectDelimiter;
+  EXPECT_EQ(read_csv_string("a  b c\n1 2 3\n", "w.txt", d).delimiter(), ' ');
+  EXPECT_EQ(read_csv_string("a\tb c\n1\t2 3\n", "w.txt", d).delimiter(), '\t');
+}
+
+TEST(IoCsv, DecimalComma) {
+  CsvOptions o;
+  o.delimiter = ';';
+  o.decimal = ',';
+  const CsvTable t = read_csv_string("a;b\n1,25;-3e-1\n", "de.csv", o);
+  EXPECT_DOUBLE_EQ(t.number(0, 0), 1.25);
+  EXPECT_DOUBLE_EQ(t.number(0, 1), -0.3);
+  // Read with the default '.', the message says what the cell looks like.
+  CsvOptions dot;
+  dot.delimiter = ';';
+  const CsvTable u = read_csv_string("a;b\n1,25;2\n", "de.csv", dot);
+  EXPECT_EQ(message_of<InputError>([&] { u.number(0, 0); }),
+            "de.csv:2:1: expected a number in column 'a', found '1,25' (a decimal comma? read the file with ',' as "
+            "the decimal separator)");
+}
+
+TEST(IoCsv, ThreeDigitExponents) {
+  const CsvTable t = read_csv_string("x\n6.68633E-001\n-2.3296E+000\n", "m.csv");
+  EXPECT_DOUBLE_EQ(t.number(0, 0), 0.668633);
+  EXPECT_DOUBLE_EQ(t.number(1, 0), -2.3296);
 }
 
 TEST(IoCsv, FileReadingAndMissingFile) {

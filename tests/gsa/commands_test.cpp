@@ -46,6 +46,9 @@ constexpr double kTrellisShearDegAllMarks = 0.05;
 // the same strains: exactly, up to x = X + u rounding in the displacement form.
 // Also the bound on the triangles method's exact homogeneous stretch.
 constexpr double kSameData = 1e-9;
+// Strains of the example exports of measuring systems against the exact ones: their
+// positions are written with 6 digits (measured worst 1.2e-6, MatchID).
+constexpr double kExactFromExport = 1e-5;
 // Positions on the tessellated fitted surfaces (mm): the flat blank's z, the dome's
 // apex height 80 (the tessellation passes through the apex). Measured < 1e-4.
 constexpr double kSurfacePosition = 1e-3;
@@ -357,6 +360,87 @@ TEST_F(GsaCli, UnitsAreWrittenIntoTheOutputs) {
   const std::string out = analyse_ok(quoted(synth("rigid")) + " --units in");
   EXPECT_EQ(nlohmann::json::parse(read_text(out + "/summary.json")).at("units").at("length"), "in");
   EXPECT_THAT(read_text(out + "/strains.csv"), HasSubstr("lengths in in"));
+}
+
+// Every preset's example export (data/formats/, made-up numbers from one stretch
+// 1.10 x 0.95 plus a rigid motion) analysed as a user would: the marks the system
+// marked invalid get no strain, all others the exact strains.
+TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
+  struct Case {
+    std::string args;
+    std::size_t rows, ok;
+  };
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
+  const std::vector<Case> cases = {
+      {quoted(d + "gom_stage.csv") + " --format gom", 47, 45},
+      {quoted(d + "matchid_image.csv") + " --format matchid", 47, 46},
+      {quoted(d + "vic3d_frame.csv") + " --format vic3d --pixel-size 0.02", 49, 46},
+      {quoted(d + "dice_solution_10.txt") + " --format dice", 49, 46},
+      {quoted(d + "plain_no_id_metres.csv") + " --columns X=X0,Y=Y0,Z=Z0,u=ux,v=uy,w=uz", 49, 49},
+      {quoted(d + "grid_indices.csv") + " --pitch 5", 49, 49},
+      // Found from the header (--format auto), the decimal comma from the numbers.
+      {quoted(d + "gom_stage_decimal_comma.csv"), 47, 45},
+      {quoted(d + "dice_solution_10.txt"), 49, 46},
+      {quoted(d + "matchid_2023_image.csv"), 47, 47},
+      {quoted(d + "dice_2d_pixels.txt") + " --pixel-size 0.02", 49, 47},
+  };
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const Strains s = read_strains(analyse_ok(cases[k].args + " --no-plots", "format" + std::to_string(k)));
+    EXPECT_EQ(s.t.n_rows(), cases[k].rows) << cases[k].args;
+    std::size_t ok = 0;
+    double worst = 0;
+    for (const auto& [id, r] : s.row) {
+      if (s.status(id) != "ok") {
+        EXPECT_TRUE(std::isnan(s.num(id, "E1"))) << cases[k].args << " " << id;
+        continue;
+      }
+      ++ok;
+      worst = std::max({worst, std::abs(s.num(id, "E1") - 0.105), std::abs(s.num(id, "E2") + 0.04875)});
+    }
+    EXPECT_EQ(ok, cases[k].ok) << cases[k].args;
+    EXPECT_LT(worst, kExactFromExport) << cases[k].args;
+  }
+}
+
+// Without --format the status lines say which preset the header was taken for, and
+// how the columns were read.
+TEST_F(GsaCli, FormatFoundFromTheHeaderIsStated) {
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
+  const CommandResult r = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --no-plots --out " +
+                                            quoted(dir_.file("out")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("format found from the header: vic3d (Correlated Solutions VIC-3D"),
+                           HasSubstr("X, Y, Z = reference positions; U, V, W = displacements; key x, y"),
+                           HasSubstr("sigma' (uncertainty) is in image pixels and no pixel size was given")));
+}
+
+TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
+  const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
+  const std::string out = " --no-plots --out " + quoted(dir_.file("out"));
+  const CommandResult preset = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic" + "x" + out);
+  EXPECT_EQ(preset.exit_code, 2);
+  EXPECT_THAT(preset.err, HasSubstr("--format: unknown format 'vicx'"));
+  const CommandResult column = run_gsa(dir_, "analyse " + quoted(d + "gom_stage.csv") + " --format matchid" + out);
+  EXPECT_EQ(column.exit_code, 1);
+  // The 2023 layout (x, y, z, u, v, w) comes closest to GOM's x, y, z; the message names
+  // it first and the 2024 names after it.
+  EXPECT_THAT(column.err, AllOf(HasSubstr("gom_stage.csv:6: missing required column 'u'"),
+                                HasSubstr("--format matchid reads x, y, z, u, v, w (or coor.X, coor.Y")));
+  const CommandResult pixels = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic3d --units px" + out);
+  EXPECT_EQ(pixels.exit_code, 1);
+  EXPECT_THAT(pixels.err, HasSubstr("vic3d_frame.csv:1:1: column 'X' holds lengths"));
+  // A unit gsa does not convert, named by file, header line and field.
+  write_text(dir_.file("deg.csv"), "id,X [mm],Y [mm],Z [mm],x [deg],y [mm],z [mm]\na,0,0,0,1,0,0\n");
+  const CommandResult unit = run_gsa(dir_, "analyse " + quoted(dir_.file("deg.csv")) + out);
+  EXPECT_EQ(unit.exit_code, 1);
+  EXPECT_THAT(unit.err, HasSubstr("deg.csv:1:5: column 'x [deg]' is in 'deg', which is not a length unit"));
+  // --positions needs a preset; auto found none.
+  const CommandResult positions =
+      run_gsa(dir_, "analyse " + quoted(d + "grid_indices.csv") + " --pitch 5 --positions current" + out);
+  EXPECT_EQ(positions.exit_code, 1);
+  EXPECT_THAT(positions.err, AllOf(HasSubstr("grid_indices.csv: --positions applies to a measuring system's format"),
+                                   HasSubstr("give --format")));
+  EXPECT_FALSE(fs::exists(dir_.file("out")));
 }
 
 // ---------------------------------------------------------------- failures

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "common/core/error.hpp"
@@ -71,6 +72,73 @@ TEST(GsaGrid, DelimiterNames) {
   EXPECT_THAT(message_of<InputError>([&] { read_grid(path, o); }), HasSubstr(path + ":2:2:"));
   write_text(path, "id;X;Y;Z;x;y;z\nk1;1.5;2;3;4;5;6\n");
   EXPECT_LT((row(read_grid(path, o).undeformed, 0) - Vec3(1.5, 2, 3)).norm(), kRead);
+}
+
+TEST(GsaGrid, FormatIdAndQuotedColumnNames) {
+  EXPECT_EQ(parse_format("vic3d"), io::MeasurementFormat::kVic3d);
+  EXPECT_EQ(parse_format("GOM"), io::MeasurementFormat::kGom);
+  EXPECT_EQ(message_of<UsageError>([] { parse_format("ncorr"); }),
+            "--format: unknown format 'ncorr' (expected one of auto, plain, gom, matchid, vic3d, dice)");
+  EXPECT_THAT(parse_id_columns("x_pic,y_pic"), ElementsAre("x_pic", "y_pic"));
+  EXPECT_THAT(message_of<UsageError>([] { parse_id_columns("a,,b"); }), HasSubstr("--id"));
+  // A column name that holds a comma is quoted.
+  const auto map = parse_column_map("x=\"eps [%, technical]\",u=du");
+  EXPECT_EQ(map.at("x"), "eps [%, technical]");
+  EXPECT_EQ(map.at("u"), "du");
+  EXPECT_EQ(parse_column_map("sigma=s").at("sigma"), "s");
+  EXPECT_EQ(parse_delimiter("auto"), io::kDetectDelimiter);
+  EXPECT_THAT(message_of<UsageError>([] { parse_delimiter("#"); }), HasSubstr("--delimiter"));
+}
+
+// The reading flags become GridReadOptions; wrong values are usage errors naming the flag.
+TEST(GsaGrid, ReadingFlagsAndTheirErrors) {
+  AnalyseFlags a;
+  a.format = "matchid";
+  a.id = "x_pic,y_pic";
+  a.positions = "current";
+  a.decimal = "comma";
+  a.delimiter = "semicolon";
+  a.header_line = 3;
+  a.units = "m";
+  a.pixel_size = 1e-5;
+  const GridReadOptions o = grid_read_options(a);
+  EXPECT_EQ(o.format, io::MeasurementFormat::kMatchId);
+  EXPECT_THAT(o.id_columns, ElementsAre("x_pic", "y_pic"));
+  EXPECT_EQ(o.positions, io::Positions::kCurrent);
+  EXPECT_EQ(o.decimal, ',');
+  EXPECT_EQ(o.delimiter, ';');
+  EXPECT_EQ(o.header_line, 3);
+  EXPECT_EQ(o.units, "m");
+  EXPECT_EQ(o.pixel_size, 1e-5);
+  AnalyseFlags row;
+  row.id = "row";
+  EXPECT_TRUE(grid_read_options(row).id_from_row);
+  EXPECT_EQ(grid_read_options(AnalyseFlags{}).delimiter, io::kDetectDelimiter);
+
+  auto error = [](const std::function<void(AnalyseFlags&)>& set) {
+    AnalyseFlags f;
+    set(f);
+    return message_of<UsageError>([&] { grid_read_options(f); });
+  };
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.format = "excel"; }), HasSubstr("--format: unknown format 'excel'"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.format = "plain";
+                f.positions = "current";
+              }),
+              HasSubstr("--positions: applies to --format"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.format = "gom";
+                f.positions = "later";
+              }),
+              HasSubstr("--positions: expected 'reference' or 'current'"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "comma"; f.delimiter = ","; }), HasSubstr("--decimal comma"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "dot"; }), HasSubstr("--decimal: expected 'auto'"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.pitch = 0; }), HasSubstr("--pitch: must be > 0"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.pixel_size = -1; }), HasSubstr("--pixel-size"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.skip_lines = 2; f.header_line = 4; }), HasSubstr("--skip-lines or --header-line"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.id = "a"; f.columns = "id=b"; }), HasSubstr("--id"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.columns = "X=a,x=b,u=c"; }), HasSubstr("--columns: reference positions"));
+  EXPECT_THAT(error([](AnalyseFlags& f) { f.pitch = 5; f.columns = "X=a"; }), HasSubstr("--pitch"));
 }
 
 // ---------------------------------------------------------------- grids analyse refuses

@@ -72,14 +72,14 @@ void fill_point_results(std::vector<PointResult>& points, const GridData& grid, 
   std::size_t next = 0;  // marks.point is ascending: the points between marks have no undeformed position
   for (std::size_t p = 0; p < points.size(); ++p) {
     if (next < marks.point.size() && marks.point[next] == static_cast<Index>(p)) ++next;
-    else points[p].status = kStatusMissingUndeformed;
+    else points[p].status = grid.not_measured_undeformed(static_cast<Index>(p)) ? kStatusNotMeasured : kStatusMissingUndeformed;
   }
   for (Index k = 0; k < marks.size(); ++k) {
     const auto kk = static_cast<std::size_t>(k);
     PointResult& pr = points[static_cast<std::size_t>(marks.point[kk])];
     const bool has_deformed = grid.has_deformed(marks.point[kk]);
     pr.status = flag_u[kk]      ? kStatusOutlierUndeformed
-                : !has_deformed ? kStatusMissingDeformed
+                : !has_deformed ? (grid.not_measured_deformed(marks.point[kk]) ? kStatusNotMeasured : kStatusMissingDeformed)
                 : flag_d[kk]    ? kStatusOutlierDeformed
                                 : kStatusOk;
     if (const OutlierFlag* f = flag_u[kk] ? flag_u[kk] : flag_d[kk]) pr.flag = *f;

@@ -57,6 +57,8 @@ struct AnalyseOptions {
 inline constexpr const char* kStatusOk = "ok";
 inline constexpr const char* kStatusMissingUndeformed = "missing_undeformed";
 inline constexpr const char* kStatusMissingDeformed = "missing_deformed";
+// The measuring system marked the point invalid in a state (GridData::not_measured).
+inline constexpr const char* kStatusNotMeasured = "not_measured";
 inline constexpr const char* kStatusOutlierUndeformed = "outlier_undeformed";
 inline constexpr const char* kStatusOutlierDeformed = "outlier_deformed";
 inline constexpr const char* kStatusDegenerate = "degenerate";

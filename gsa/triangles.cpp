@@ -86,8 +86,8 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
   std::vector<Index> usable;
   bool all_ij = g.has_ij;
   for (Index p = 0; p < n; ++p) {
-    if (!g.has_undeformed(p)) r.points[p].status = kStatusMissingUndeformed;
-    else if (!g.has_deformed(p)) r.points[p].status = kStatusMissingDeformed;
+    if (!g.has_undeformed(p)) r.points[p].status = g.not_measured_undeformed(p) ? kStatusNotMeasured : kStatusMissingUndeformed;
+    else if (!g.has_deformed(p)) r.points[p].status = g.not_measured_deformed(p) ? kStatusNotMeasured : kStatusMissingDeformed;
     else usable.push_back(p);
     if (g.has_ij && g.i[p] == std::numeric_limits<long>::min()) all_ij = false;
   }

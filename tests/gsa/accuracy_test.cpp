@@ -473,6 +473,24 @@ TEST(GsaTriangles, MissingDeformedMarksAreFlaggedAndTheRestStayExact) {
 
 // ---------------------------------------------------------------- missing marks and outliers
 
+// Points the measuring system marked invalid are reported as not_measured (both methods).
+TEST(GsaMissing, PointsTheSystemMarkedInvalidAreNotMeasured) {
+  GridData g = make_synthetic_grid(synthetic_case("stretch"), {});
+  g.not_measured.assign(static_cast<std::size_t>(g.n_points()), 0);
+  const Index a = 3 * 21 + 4, b = 10 * 21 + 10;
+  g.deformed.row(a).setConstant(std::numeric_limits<double>::quiet_NaN());
+  g.not_measured[static_cast<std::size_t>(a)] = io::kNotMeasuredDeformed;
+  g.deformed.row(b).setConstant(std::numeric_limits<double>::quiet_NaN());  // simply missing
+  for (const Method m : {Method::kSurface, Method::kTriangles}) {
+    AnalyseOptions o;
+    o.method = m;
+    const AnalysisResult res = analyse(g, o);
+    EXPECT_EQ(res.points[a].status, kStatusNotMeasured);
+    EXPECT_FALSE(res.points[a].strain);
+    EXPECT_EQ(res.points[b].status, kStatusMissingDeformed);
+  }
+}
+
 TEST(GsaMissing, MissingDeformedMarksHaveNoStrainAndOthersAreOk) {
   SyntheticGridOptions go;
   go.missing_deformed = 0.1;

@@ -154,6 +154,7 @@ struct Blob {
   Shape shape;
   double area = 0;       // pixels above the threshold
   double contrast = 0;   // median C over the blob
+  double peak = 0;       // 90th percentile of C over the blob: the ink's contrast
   Vec2 centre = Vec2::Zero();  // refined
   double grey_area = 0;  // sum of (P - I) / P over the window: the dot's area times its contrast
   double rim_residual = 0;  // RMS deviation of the window's rim from a plane / sheet level
@@ -319,6 +320,8 @@ DotDetection detect_dots(const Prepared& p, const DetectOptions& o, ViewMarks& v
       for (int x = b.box.x; x < b.box.x + b.box.width; ++x)
         if (labels.at<int>(y, x) == lab) cs.push_back(p.C.at<float>(y, x));
     b.contrast = median(cs);
+    std::nth_element(cs.begin(), cs.begin() + (cs.size() * 9) / 10, cs.end());
+    b.peak = cs[(cs.size() * 9) / 10];
     if (b.contrast < o.min_contrast) {
       v.rejected.push_back({c, fmt::format("contrast {:.2f} < {}", b.contrast, o.min_contrast)});
       continue;
@@ -651,7 +654,7 @@ void find_dots(const Prepared& p, const std::string& name, const DetectOptions& 
     v.centres.push_back(kept[k]);
     v.labels.push_back(*lr.labels[k]);
     // The dot's image area: its grey-level area over its ink contrast.
-    v.areas.push_back(det.dots[from[k]].grey_area / std::max(det.dots[from[k]].contrast, 1e-3));
+    v.areas.push_back(det.dots[from[k]].grey_area / std::max(det.dots[from[k]].peak, 1e-3));
     v.axis_i.push_back(lr.axis_i[k]);
     v.axis_j.push_back(lr.axis_j[k]);
   }

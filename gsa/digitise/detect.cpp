@@ -63,21 +63,25 @@ struct Prepared {
 Prepared prepare(const GreyImage& image, const std::string& name, const DetectOptions& o) {
   Prepared p;
   cv::Mat src(image.height, image.width, CV_32F, const_cast<float*>(image.pixels.data()));
-  p.I = o.dark_marks ? src.clone() : cv::Mat(1.0f - src);
+  // Dark marks: the image itself, not a copy (it is only read; large buffers cost page
+  // faults).
+  p.I = o.dark_marks ? src : cv::Mat(1.0f - src);
   p.size = o.mark_size_px;
   if (!(p.size > 0)) {
-    // Otsu's global threshold is enough to measure the typical mark (or cell) size.
-    cv::Mat u8, bin;
-    p.I.convertTo(u8, CV_8U, 255.0);
+    // Otsu's global threshold on the image at half size is enough to measure the typical
+    // mark (or cell) size.
+    cv::Mat half, u8, bin;
+    cv::resize(p.I, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    half.convertTo(u8, CV_8U, 255.0);
     cv::threshold(u8, bin, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);  // dark = 255
     if (o.kind == MarkKind::kLines) bin = 255 - bin;                          // light cells
     cv::Mat labels, stats, centroids;
     const int n = cv::connectedComponentsWithStats(bin, labels, stats, centroids, o.kind == MarkKind::kLines ? 4 : 8);
-    std::vector<double> areas;
+    std::vector<double> areas;  // full-size pixels
     const double max_area = 0.01 * image.width * image.height;
     for (int k = 1; k < n; ++k) {
-      const double a = stats.at<int>(k, cv::CC_STAT_AREA);
-      if (a >= std::max(o.min_area_px, 4.0) && a < max_area) areas.push_back(a);
+      const double a = 4.0 * stats.at<int>(k, cv::CC_STAT_AREA);
+      if (a >= std::max(o.min_area_px, 8.0) && a < max_area) areas.push_back(a);
     }
     if (static_cast<int>(areas.size()) < kMinMarks)
       throw InputError(name + ": no grid found (" + std::to_string(areas.size()) +
@@ -90,13 +94,17 @@ Prepared prepare(const GreyImage& image, const std::string& name, const DetectOp
   int k = o.kind == MarkKind::kDots ? static_cast<int>(2.0 * p.size) + 3 : static_cast<int>(p.size / 2.5) + 3;
   k |= 1;
   k = std::min(k, (std::min(image.width, image.height) / 2) | 1);
-  cv::Mat B;
-  cv::morphologyEx(p.I, B, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
   // No smoothing of B: it would spread the sheet's brightness over the dark surroundings
-  // and raise the contrast in a band along the part's edge.
-  cv::Mat Bc;
-  cv::max(B, 0.02, Bc);
-  p.C = (Bc - p.I) / Bc;
+  // and raise the contrast in a band along the part's edge. C is computed in B's buffer.
+  cv::morphologyEx(p.I, p.C, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+  for (int y = 0; y < p.I.rows; ++y) {
+    const float* i = p.I.ptr<float>(y);
+    float* c = p.C.ptr<float>(y);
+    for (int x = 0; x < p.I.cols; ++x) {
+      const float bb = std::max(c[x], 0.02f);
+      c[x] = (bb - i[x]) / bb;
+    }
+  }
   return p;
 }
 

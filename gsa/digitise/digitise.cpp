@@ -23,7 +23,7 @@ void DigitiseOptions::validate() const {
   if (!(triangulation.max_reprojection_px > 0))
     throw UsageError("--max-reprojection: expected a distance in pixels > 0");
   if (!(dot_diameter_mm >= 0)) throw UsageError("--dot-diameter: expected a diameter in mm >= 0 (0: measured)");
-  if (threads < 0) throw UsageError("--threads: expected a count >= 0");
+  if (threads < 0) throw UsageError("digitise: the thread count must be >= 0");
 }
 
 namespace {
@@ -57,15 +57,30 @@ std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::st
                                    for (const Camera& c : rig.cameras) s += (s.empty() ? "" : ", ") + c.name;
                                    return s;
                                  }()));
-  std::vector<NamedImage> out;
+  // Read (decode) in parallel, one thread per image; errors reported in the rig's order.
+  std::vector<NamedImage> out(paths.size());
+  std::vector<std::exception_ptr> errors(paths.size());
+  {
+    std::vector<std::thread> pool;
+    for (std::size_t k = 0; k < paths.size(); ++k)
+      pool.emplace_back([&, k] {
+        try {
+          out[k] = {paths[k], read_image(paths[k])};
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
+      });
+    for (auto& t : pool) t.join();
+  }
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
   for (std::size_t k = 0; k < paths.size(); ++k) {
-    NamedImage ni{paths[k], read_image(paths[k])};
+    const NamedImage& ni = out[k];
     const Camera& c = rig.cameras[k];
     if (ni.image.width != c.width || ni.image.height != c.height)
       throw InputError(fmt::format("{}: {} x {} pixels, but camera {} of {} was calibrated at {} x {} (is it the "
                                    "right camera, in the rig's order, and the full uncropped image?)",
                                    paths[k], ni.image.width, ni.image.height, c.name, rig_name, c.width, c.height));
-    out.push_back(std::move(ni));
   }
   return out;
 }
@@ -183,7 +198,12 @@ SetResult digitise_set(const Rig& rig, const std::vector<NamedImage>& images, co
   // 4. Triangulation.
   std::map<std::pair<int, int>, TriangulatedPoint> pts;
   for (const auto& [ij, ob] : obs) {
-    if (ob.size() < 2) continue;  // seen once: no position, not an error
+    if (ob.size() < 2) {  // reported below, with no position
+      TriangulatedPoint one;
+      one.why = "seen by one camera only (hidden or left out in the others)";
+      pts[ij] = one;
+      continue;
+    }
     pts[ij] = triangulate(rig, ob, o.triangulation);
   }
 

@@ -18,6 +18,11 @@
 // prediction first. A label that two paths put in different places, a mark that two
 // paths give different labels, and two candidates near one prediction are reported and
 // left unlabelled: never guessed.
+//
+// Why not a Delaunay triangulation of the centres reduced to quads (dropping each
+// triangle's longest edge)? Beyond about 30 degrees of shear a cell's short diagonal is
+// shorter than its sides and the reduction drops a lattice edge instead; the growth above
+// never compares lengths across directions, and it labels the flat blank as well.
 
 #include <Eigen/Core>
 #include <optional>

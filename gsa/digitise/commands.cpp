@@ -14,7 +14,7 @@
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
-#include "common/io/csv.hpp"
+#include "common/io/grid_file.hpp"
 #include "common/io/json.hpp"
 #include "gsa/digitise/calibrate.hpp"
 #include "gsa/digitise/digitise.hpp"
@@ -270,7 +270,6 @@ int run_digitise(const DigitiseArgs& a, bool quiet) {
 
   std::vector<std::string> comments = {
       "grid file written by gsa digitise (docs/digitise.md)",
-      "units: " + units,
       "calibration: " + a.calibration,
       "undeformed: " + (und ? [&] {
         std::string s;
@@ -290,11 +289,11 @@ int run_digitise(const DigitiseArgs& a, bool quiet) {
       "i, j: grid indices; i along camera 0's image rows, j down the image, (0, 0) at the reference mark",
       "views_*: cameras that saw the mark; reproj_*_px: its RMS reprojection error (pixels)"};
   if (a.out == "-") {
-    write_grid(std::cout, rows, comments);
+    write_grid(std::cout, rows, comments, units);
     std::cout.flush();
   } else {
     make_parent(a.out);
-    io::write_file_atomic(a.out, [&](std::ostream& os) { write_grid(os, rows, comments); });
+    io::write_file_atomic(a.out, [&](std::ostream& os) { write_grid(os, rows, comments, units); });
   }
   if (!a.report.empty()) {
     nlohmann::json j;
@@ -375,17 +374,17 @@ int run_synth_images(const SynthImagesArgs& a, bool quiet) {
   // stretches of the forming.
   const int dj = o.marks == synth::PatternKind::kLines ? 1 : 0;
   io::write_file_atomic(out.path("truth.csv"), [&](std::ostream& os) {
-    os << "# exact grid of the synthetic images (gsa synth-images): units mm; world frame = the flat blank's frame\n"
-       << "# formed shape: " << a.shape << "; lambda1 >= lambda2: exact principal stretches of the forming\n";
-    io::CsvWriter w(os, {"id", "i", "j", "X", "Y", "Z", "x", "y", "z", "lambda1", "lambda2"});
+    io::GridWriteOptions wo;
+    wo.comments = {"exact grid of the synthetic images (gsa synth-images); world frame = the flat blank's frame",
+                   "formed shape: " + a.shape + "; lambda1 >= lambda2: exact principal stretches of the forming"};
+    wo.units = "mm";
+    wo.with_ij = true;
+    wo.extra_columns = {"lambda1", "lambda2"};
+    io::GridFileWriter w(os, wo);
     for (const synth::TrueMark& m : synth::true_marks(formed)) {
       const int i = m.i, j = dj - m.j;
       const Vec3 X = flat.sheet.position(Vec2(m.i * o.pitch, m.j * o.pitch));
-      w.begin_row().add(fmt::format("i{}_j{}", i, j)).add(i).add(j);
-      for (int k = 0; k < 3; ++k) w.add(X(k));
-      for (int k = 0; k < 3; ++k) w.add(m.position(k));
-      w.add(m.lambda1).add(m.lambda2);
-      w.end_row();
+      w.add(mark_id(i, j), X, m.position, i, j, {m.lambda1, m.lambda2});
     }
   });
   Rig truth;

@@ -7,13 +7,14 @@
 #include <cstdint>
 #include <exception>
 #include <fmt/format.h>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
 
 #include "common/core/error.hpp"
-#include "common/io/csv.hpp"
+#include "common/io/grid_file.hpp"
 
 namespace sf::gsa::digitise {
 
@@ -381,6 +382,8 @@ std::vector<GridRow> join_sets(const SetResult* und, const Eigen::Isometry3d& Tu
   return out;
 }
 
+std::string mark_id(long i, long j) { return fmt::format("i{}_j{}", i, j); }
+
 GridData grid_data(const std::vector<GridRow>& rows) {
   GridData g;
   const Index n = static_cast<Index>(rows.size());
@@ -390,7 +393,7 @@ GridData grid_data(const std::vector<GridRow>& rows) {
   g.sources = {"gsa digitise"};
   for (Index k = 0; k < n; ++k) {
     const GridRow& r = rows[k];
-    g.ids.push_back(fmt::format("i{}_j{}", r.ij.x(), r.ij.y()));
+    g.ids.push_back(mark_id(r.ij.x(), r.ij.y()));
     g.undeformed.row(k) = r.undeformed.transpose();
     g.deformed.row(k) = r.deformed.transpose();
     g.i.push_back(r.ij.x());
@@ -400,21 +403,22 @@ GridData grid_data(const std::vector<GridRow>& rows) {
   return g;
 }
 
-void write_grid(std::ostream& out, const std::vector<GridRow>& rows, const std::vector<std::string>& comments) {
-  for (const std::string& c : comments) out << "# " << c << "\n";
-  io::CsvWriter w(out, {"id", "i", "j", "X", "Y", "Z", "x", "y", "z", "views_undeformed", "reproj_undeformed_px",
-                        "views_deformed", "reproj_deformed_px"});
-  auto round_um = [](double v) { return std::isfinite(v) ? std::round(v * 1e5) / 1e5 : v; };  // 0.01 um
-  auto round_px = [](double v) { return std::isfinite(v) ? std::round(v * 1e4) / 1e4 : v; };
+void write_grid(std::ostream& out, const std::vector<GridRow>& rows, const std::vector<std::string>& comments,
+                const std::string& units) {
+  io::GridWriteOptions o;
+  o.comments = comments;
+  o.units = units;
+  o.with_ij = true;
+  o.extra_columns = {"views_undeformed", "reproj_undeformed_px", "views_deformed", "reproj_deformed_px"};
+  io::GridFileWriter w(out, o);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  auto round_um = [](const Vec3& v) { return Vec3(((v * 1e5).array().round() / 1e5).matrix()); };  // 0.01 um; NaN stays
+  auto round_px = [](double v) { return std::round(v * 1e4) / 1e4; };
   for (const GridRow& r : rows) {
-    w.begin_row().add(fmt::format("i{}_j{}", r.ij.x(), r.ij.y())).add(r.ij.x()).add(r.ij.y());
-    for (int k = 0; k < 3; ++k) w.add(round_um(r.undeformed(k)));
-    for (int k = 0; k < 3; ++k) w.add(round_um(r.deformed(k)));
-    if (r.views_undeformed > 0) w.add(r.views_undeformed).add(round_px(r.rms_undeformed));
-    else w.add("").add("");
-    if (r.views_deformed > 0) w.add(r.views_deformed).add(round_px(r.rms_deformed));
-    else w.add("").add("");
-    w.end_row();
+    const bool u = r.views_undeformed > 0, d = r.views_deformed > 0;  // 0: not measured (empty cells)
+    w.add(mark_id(r.ij.x(), r.ij.y()), round_um(r.undeformed), round_um(r.deformed), r.ij.x(), r.ij.y(),
+          {u ? r.views_undeformed : kNaN, u ? round_px(r.rms_undeformed) : kNaN, d ? r.views_deformed : kNaN,
+           d ? round_px(r.rms_deformed) : kNaN});
   }
 }
 

@@ -111,12 +111,18 @@ struct GridRow {
 std::vector<GridRow> join_sets(const SetResult* undeformed, const Eigen::Isometry3d& undeformed_frame,
                                const SetResult& deformed, const Eigen::Isometry3d& deformed_frame, double pitch);
 
+// The id of mark (i, j) in the grid files digitise and synth-images write: "i<i>_j<j>".
+std::string mark_id(long i, long j);
+
 // The rows as the grid data `gsa analyse` works on (ids "i<i>_j<j>", labels in i, j; a
 // state not measured is NaN), for running the analysis straight from the library.
 GridData grid_data(const std::vector<GridRow>& rows);
 
-// Writes the grid file: `#` comment lines, then the columns
-// id, i, j, X, Y, Z, x, y, z, views_undeformed, reproj_undeformed_px, views_deformed, reproj_deformed_px.
-void write_grid(std::ostream& out, const std::vector<GridRow>& rows, const std::vector<std::string>& comments);
+// Writes the grid file through io::GridFileWriter: `#` comment lines (and "# units: U"
+// when `units` is not empty), then the columns id, X, Y, Z, x, y, z, i, j and digitise's
+// own views_undeformed, reproj_undeformed_px, views_deformed, reproj_deformed_px (empty
+// where the state was not measured). Positions are rounded to 1e-5 units, errors to 1e-4 px.
+void write_grid(std::ostream& out, const std::vector<GridRow>& rows, const std::vector<std::string>& comments,
+                const std::string& units = "");
 
 }  // namespace sf::gsa::digitise

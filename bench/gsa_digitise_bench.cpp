@@ -36,17 +36,6 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-std::vector<NamedImage> render_set(const std::vector<Camera>& cams, const synth::Scene& sc, const synth::Effects& fx,
-                                   unsigned seed) {
-  std::vector<NamedImage> out;
-  for (std::size_t c = 0; c < cams.size(); ++c) {
-    synth::Effects e = fx;
-    e.seed = seed + 31 * static_cast<unsigned>(c);
-    out.push_back({cams[c].name, synth::render(cams[c], sc, e)});
-  }
-  return out;
-}
-
 Eigen::Isometry3d pose(const Camera& c) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = c.R;
@@ -149,7 +138,7 @@ int main(int argc, char** argv) {
     ko.occlusion = k.occlusion;
     ko.n_cameras = k.cameras;
     const synth::Scene sc = synth::example_part(ko, k.shape);
-    const auto images = render_set(truth, sc, ko.effects, 7);
+    const auto images = synth::render_views(truth, sc, ko.effects, 7);
     DigitiseOptions d;
     d.detect.kind = k.marks == synth::PatternKind::kLines ? MarkKind::kLines : MarkKind::kDots;
     const SetResult se = digitise_set(exact_rig, images, d);
@@ -169,7 +158,7 @@ int main(int argc, char** argv) {
     Rig rig3;
     rig3.cameras = cams3;
     const synth::Scene sc = synth::example_part(ko, synth::SheetShape::kDome);
-    const SetResult s = digitise_set(rig3, render_set(cams3, sc, ko.effects, 9), DigitiseOptions{});
+    const SetResult s = digitise_set(rig3, synth::render_views(cams3, sc, ko.effects, 9), DigitiseOptions{});
     // No reference mark: labels start at the mark nearest the middle; find the shift.
     const DigitisedMark& mid = s.marks[s.marks.size() / 2];
     Label shift(0, 0);
@@ -188,7 +177,7 @@ int main(int argc, char** argv) {
   // 3. Time for one image pair from PNG files.
   {
     const synth::Scene sc = synth::example_part(o, synth::SheetShape::kDome);
-    const auto images = render_set(truth, sc, o.effects, 11);
+    const auto images = synth::render_views(truth, sc, o.effects, 11);
     const std::string dir = (std::filesystem::temp_directory_path() / "gsa_digitise_bench").string();
     std::filesystem::create_directories(dir);
     std::vector<std::string> paths;
@@ -215,7 +204,8 @@ int main(int argc, char** argv) {
   {
     const synth::Scene flat = synth::example_part(o, synth::SheetShape::kFlat);
     const synth::Scene dome = synth::example_part(o, synth::SheetShape::kDome);
-    const auto flat_images = render_set(truth, flat, o.effects, 13), dome_images = render_set(truth, dome, o.effects, 17);
+    const auto flat_images = synth::render_views(truth, flat, o.effects, 13);
+    const auto dome_images = synth::render_views(truth, dome, o.effects, 17);
     std::printf("\n4. Images to strains (dome; RMS error of E1 and E2 against the exact strains, marks inside the "
                 "outer ring)\n");
     for (const auto& [label, rig] : {std::pair<const char*, const Rig*>{"calibrated rig", &cal.rig}, {"exact cameras", &exact_rig}}) {

@@ -147,6 +147,17 @@ std::vector<Scene> example_calibration_boards(const ExampleOptions& o) {
   return out;
 }
 
+std::vector<NamedImage> render_views(const std::vector<Camera>& cameras, const Scene& scene, const Effects& effects,
+                                     unsigned seed) {
+  std::vector<NamedImage> out;
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    Effects e = effects;
+    e.seed = seed + 31 * static_cast<unsigned>(c);
+    out.push_back({cameras[c].name, render(cameras[c], scene, e)});
+  }
+  return out;
+}
+
 std::vector<TrueMark> true_marks(const Scene& scene) {
   std::vector<TrueMark> out;
   for (const Pattern::Mark& mk : scene.pattern.marks()) {

@@ -54,6 +54,11 @@ struct TrueMark {
 };
 std::vector<TrueMark> true_marks(const Scene& scene);
 
+// One photograph of `scene` per camera, named after the camera; camera c's noise is seeded
+// with seed + 31 c (the 2-megapixel studies of the benchmark and the long tests).
+std::vector<NamedImage> render_views(const std::vector<Camera>& cameras, const Scene& scene, const Effects& effects,
+                                     unsigned seed);
+
 // The material index (I, J) of a label as gsa digitise gives it for this study's camera 0
 // (i along the image rows = +X, j down the image = -Y; lines: junction (0, 0) is the
 // reference cell's corner at Y = pitch), shifted by `shift` first (sets labelled without a

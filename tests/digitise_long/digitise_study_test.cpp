@@ -20,17 +20,6 @@ constexpr double kReprojectionPx = 0.1;     // calibration reprojection error
 constexpr double kMarkRmsMm = 0.02;         // 3-D marks from two views
 constexpr double kStrainRatio = 2.0;        // images-to-strains error / exact grid + 0.01 mm noise
 
-std::vector<NamedImage> render_set(const std::vector<Camera>& cams, const synth::Scene& sc, const synth::Effects& fx,
-                                   unsigned seed) {
-  std::vector<NamedImage> out;
-  for (std::size_t c = 0; c < cams.size(); ++c) {
-    synth::Effects e = fx;
-    e.seed = seed + 31 * static_cast<unsigned>(c);
-    out.push_back({cams[c].name, synth::render(cams[c], sc, e)});
-  }
-  return out;
-}
-
 std::vector<ExactStrain> exact_strains(const std::vector<GridRow>& rows, const synth::Scene& formed) {
   std::vector<ExactStrain> out;
   for (const GridRow& r : rows) {
@@ -72,7 +61,8 @@ TEST(DigitiseStudy, CalibrationMarksAndStrainsAtTwoMegapixels) {
   exact.cameras = truth;
   const synth::Scene flat = synth::example_part(o, synth::SheetShape::kFlat);
   const synth::Scene dome = synth::example_part(o, synth::SheetShape::kDome);
-  const auto flat_images = render_set(truth, flat, o.effects, 13), dome_images = render_set(truth, dome, o.effects, 17);
+  const auto flat_images = synth::render_views(truth, flat, o.effects, 13);
+  const auto dome_images = synth::render_views(truth, dome, o.effects, 17);
   // Marks with the exact cameras (world frame) and the calibrated rig (rigidly aligned).
   const SetResult de = digitise_set(exact, dome_images, DigitiseOptions{});
   const synth::Comparison ce = synth::compare_marks(de.marks, dome, o.marks);
@@ -117,7 +107,7 @@ TEST(DigitiseStudy, LineGridOnTheBendAtTwoMegapixels) {
   const synth::Scene bend = synth::example_part(o, synth::SheetShape::kBend);
   DigitiseOptions d;
   d.detect.kind = MarkKind::kLines;
-  const SetResult s = digitise_set(exact, render_set(truth, bend, o.effects, 3), d);
+  const SetResult s = digitise_set(exact, synth::render_views(truth, bend, o.effects, 3), d);
   const synth::Comparison c = synth::compare_marks(s.marks, bend, o.marks);
   EXPECT_EQ(c.mislabelled, 0);
   EXPECT_GE(c.n, 930);  // corner junctions need two cells; steep flanks lose some (measured 945-957 of 961)

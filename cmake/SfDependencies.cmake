@@ -8,6 +8,10 @@ find_package(CGAL 5.5 REQUIRED)
 find_package(VTK 9 REQUIRED COMPONENTS CommonCore CommonDataModel IOXML IOImage FiltersCore
              FiltersSources FiltersModeling RenderingCore RenderingOpenGL2
              RenderingAnnotation RenderingFreeType)
+# OpenCV: camera calibration and image processing of `gsa calibrate` / `gsa digitise`
+# (gsa/digitise/*.cpp only; never in a public header).
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc calib3d imgcodecs features2d)
+set(SF_OPENCV_LIBS opencv_core opencv_imgproc opencv_calib3d opencv_imgcodecs opencv_features2d)
 # Xlib, to test a DISPLAY before VTK opens it (optional: VTK builds without X need none).
 find_package(X11 QUIET)
 

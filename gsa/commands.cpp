@@ -18,6 +18,7 @@
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/command_options.hpp"
+#include "gsa/digitise/commands.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/flc.hpp"
 #include "gsa/output.hpp"
@@ -225,7 +226,7 @@ void add_analyse_command(sf::cli::Program& program) {
   program.add_command(
       "analyse", "Grid strain analysis of a digitised part (surface fit or classical triangles)",
       [args](CLI::App& app) {
-        app.add_option("grid", args->grid, "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j]), or a measuring system's export with --format");
+        app.add_option("grid", args->grid, "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j]), or a measuring system's export with --format; - reads it from stdin");
         app.add_option("--undeformed", args->undeformed, "Undeformed grid file (id,x,y,z), with --deformed");
         app.add_option("--deformed", args->deformed, "Deformed grid file (id,x,y,z), with --undeformed");
         app.add_option("-o,--out", args->out, "Output folder (created; files replaced only on success)")->required();
@@ -311,6 +312,7 @@ void register_commands(sf::cli::Program& program) {
   add_analyse_command(program);
   add_plot_command(program);
   add_synth_command(program);
+  digitise::register_commands(program);  // calibrate, digitise, synth-images (docs/digitise.md)
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},
       [] {

@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -668,6 +670,11 @@ CsvTable read_csv_string(std::string text, const std::string& name, const CsvOpt
 }
 
 CsvTable read_csv(const std::string& path, const CsvOptions& options) {
+  if (path == "-") {  // standard input (e.g. `gsa digitise ... -o - | gsa analyse - ...`)
+    std::string text((std::istreambuf_iterator<char>(std::cin)), std::istreambuf_iterator<char>());
+    if (std::cin.bad()) throw InputError("<stdin>: cannot read standard input");
+    return read_csv_string(std::move(text), "<stdin>", options);
+  }
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw InputError(located_message(path, 0, 0, "cannot open file (it is a directory)"));

@@ -175,8 +175,9 @@ class CsvTable {
   std::unordered_map<std::size_t, std::string> escaped_;  // cell index -> unescaped text
 };
 
-// Reads a CSV file. Throws sf::InputError "PATH: cannot open file (reason)" when it cannot be
-// read, and the positioned errors described above when its content is malformed.
+// Reads a CSV file ("-": standard input, named "<stdin>" in messages). Throws sf::InputError
+// "PATH: cannot open file (reason)" when it cannot be read, and the positioned errors
+// described above when its content is malformed.
 CsvTable read_csv(const std::string& path, const CsvOptions& options = {});
 // Same from text in memory; `name` stands for the file name in messages.
 CsvTable read_csv_string(std::string text, const std::string& name, const CsvOptions& options = {});

@@ -129,16 +129,26 @@ GridData read_grid_file_pair(const std::string& undeformed_path, const std::stri
 
 struct GridFileWriter::Impl {
   bool with_ij;
+  std::size_t n_extra;
   CsvWriter csv;
-  Impl(std::ostream& out, bool ij, std::vector<std::string> header) : with_ij(ij), csv(out, std::move(header)) {}
+  Impl(std::ostream& out, bool ij, std::size_t extra, std::vector<std::string> header)
+      : with_ij(ij), n_extra(extra), csv(out, std::move(header)) {}
 
-  void row(std::string_view id, const Vec3& undeformed, const Vec3& deformed) {
+  void row(std::string_view id, const Vec3& undeformed, const Vec3& deformed, const std::vector<double>& extra) {
     if (id.empty()) throw std::logic_error("GridFileWriter: empty id");
+    if (extra.size() != n_extra)
+      throw std::logic_error("GridFileWriter: " + std::to_string(extra.size()) + " extra values for " +
+                             std::to_string(n_extra) + " extra columns");
     csv.begin_row().add(id);
     for (const Vec3* v : {&undeformed, &deformed}) {
       const bool known = v->allFinite();  // a position is digitised as a whole or not at all
       for (int k = 0; k < 3; ++k) csv.add(known ? (*v)[k] : kNaN);
     }
+  }
+
+  void end(const std::vector<double>& extra) {
+    for (const double v : extra) csv.add(v);
+    csv.end_row();
   }
 };
 
@@ -147,30 +157,37 @@ GridFileWriter::GridFileWriter(std::ostream& out, const GridWriteOptions& option
   if (!options.units.empty()) write_comment(out, "units: " + options.units);
   std::vector<std::string> header = {"id", "X", "Y", "Z", "x", "y", "z"};
   if (options.with_ij) header.insert(header.end(), {"i", "j"});
-  impl_ = std::make_unique<Impl>(out, options.with_ij, std::move(header));
+  for (const std::string& c : options.extra_columns) {
+    if (is_grid_column_key(c)) throw std::logic_error("GridFileWriter: extra column '" + c + "' is a grid file key");
+    header.push_back(c);
+  }
+  impl_ = std::make_unique<Impl>(out, options.with_ij, options.extra_columns.size(), std::move(header));
 }
 
 GridFileWriter::~GridFileWriter() = default;
 
-void GridFileWriter::add(std::string_view id, const Vec3& undeformed, const Vec3& deformed) {
+void GridFileWriter::add(std::string_view id, const Vec3& undeformed, const Vec3& deformed,
+                         const std::vector<double>& extra) {
   if (impl_->with_ij) throw std::logic_error("GridFileWriter: this grid has i, j columns; give them");
-  impl_->row(id, undeformed, deformed);
-  impl_->csv.end_row();
+  impl_->row(id, undeformed, deformed, extra);
+  impl_->end(extra);
 }
 
-void GridFileWriter::add(std::string_view id, const Vec3& undeformed, const Vec3& deformed, long i, long j) {
+void GridFileWriter::add(std::string_view id, const Vec3& undeformed, const Vec3& deformed, long i, long j,
+                         const std::vector<double>& extra) {
   if (!impl_->with_ij) throw std::logic_error("GridFileWriter: this grid has no i, j columns");
-  impl_->row(id, undeformed, deformed);
+  impl_->row(id, undeformed, deformed, extra);
   for (const long v : {i, j}) {
     if (v == kNoGridIndex) impl_->csv.add(kNaN);
     else impl_->csv.add(v);
   }
-  impl_->csv.end_row();
+  impl_->end(extra);
 }
 
 void write_grid_file(const std::string& path, const GridData& grid, const GridWriteOptions& options) {
   GridWriteOptions o = options;
   o.with_ij = grid.has_ij;
+  o.extra_columns.clear();  // GridData holds the contract's columns only
   write_file_atomic(path, [&](std::ostream& out) {
     GridFileWriter w(out, o);
     for (Index p = 0; p < grid.n_points(); ++p) {

@@ -20,6 +20,8 @@
 //   i, j      no        integer grid row and column of the mark
 //   sigma     no        uncertainty of the measured positions (length), for fit weights
 //
+// Other columns (a writer's own, e.g. `gsa digitise`'s reprojection errors) are ignored.
+//
 // An empty cell or "nan" means "not digitised in that state": a position with any
 // coordinate missing counts as missing as a whole. Rows come in any order.
 //
@@ -156,6 +158,11 @@ struct GridWriteOptions {
   std::vector<std::string> comments;
   std::string units;     // not empty: a last comment line "# units: U"
   bool with_ij = false;  // GridFileWriter: columns i, j after z
+  // GridFileWriter: more numeric columns after the contract's (after i, j), a writer's own
+  // per-mark figures (e.g. `gsa digitise`'s views and reprojection errors). Readers of the
+  // grid file ignore them. A name that is a contract key (kGridColumnKeys) is a programming
+  // error (std::logic_error).
+  std::vector<std::string> extra_columns;
 };
 
 // Writes a grid file row by row (for writers that compute the marks one at a time):
@@ -166,9 +173,10 @@ struct GridWriteOptions {
 //     w.add("m0_0", X, x, 0, 0);
 //   });
 //
-// Header id,X,Y,Z,x,y,z (and i,j). Numbers are written in the shortest form that reads
-// back to the same double; a position with a NaN coordinate is written as empty cells
-// (not digitised). What it writes, read_grid_file() reads back exactly.
+// Header id,X,Y,Z,x,y,z (and i,j, then the extra columns). Numbers are written in the
+// shortest form that reads back to the same double; a position with a NaN coordinate is
+// written as empty cells (not digitised), and so is a NaN extra value. What it writes,
+// read_grid_file() reads back exactly.
 class GridFileWriter {
  public:
   // Writes the comment lines and the header.
@@ -177,11 +185,12 @@ class GridFileWriter {
   GridFileWriter(const GridFileWriter&) = delete;
   GridFileWriter& operator=(const GridFileWriter&) = delete;
 
-  // One mark. The first form needs options.with_ij == false, the second true; an empty id
-  // or the wrong form is a programming error (std::logic_error). kNoGridIndex writes an
-  // empty cell.
-  void add(std::string_view id, const Vec3& undeformed, const Vec3& deformed);
-  void add(std::string_view id, const Vec3& undeformed, const Vec3& deformed, long i, long j);
+  // One mark. The first form needs options.with_ij == false, the second true; an empty id,
+  // the wrong form, or `extra` not one value per options.extra_columns is a programming
+  // error (std::logic_error). kNoGridIndex writes an empty cell.
+  void add(std::string_view id, const Vec3& undeformed, const Vec3& deformed, const std::vector<double>& extra = {});
+  void add(std::string_view id, const Vec3& undeformed, const Vec3& deformed, long i, long j,
+           const std::vector<double>& extra = {});
 
  private:
   struct Impl;
@@ -189,7 +198,8 @@ class GridFileWriter {
 };
 
 // Writes `grid` to `path` atomically (io/atomic_file.hpp), with i, j when grid.has_ij
-// (options.with_ij is ignored). Throws sf::Error naming the path when it cannot write.
+// (options.with_ij and options.extra_columns are ignored). Throws sf::Error naming the
+// path when it cannot write.
 void write_grid_file(const std::string& path, const GridData& grid, const GridWriteOptions& options = {});
 
 }  // namespace sf::io

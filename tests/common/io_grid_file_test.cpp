@@ -253,6 +253,27 @@ TEST(IoGridFile, WriterRejectsEmptyIdsAndTheWrongRowForm) {
   EXPECT_THROW(plain.add("m", Vec3::Zero(), Vec3::Zero(), 1, 2), std::logic_error);
 }
 
+// A writer's own per-mark columns follow the contract's; NaN is an empty cell, and the
+// reader ignores them.
+TEST(IoGridFile, WriterExtraColumns) {
+  std::ostringstream out;
+  {
+    GridWriteOptions o;
+    o.with_ij = true;
+    o.extra_columns = {"views", "reproj_px"};
+    GridFileWriter w(out, o);
+    w.add("a", Vec3(1, 2, 3), Vec3(4, 5, 6), 0, 1, {2, 0.125});
+    w.add("b", Vec3(1, 2, 3), Vec3(kNaN, 5, 6), 1, 1, {kNaN, kNaN});
+    EXPECT_THROW(w.add("c", Vec3::Zero(), Vec3::Zero(), 2, 1), std::logic_error);  // no extras given
+  }
+  EXPECT_EQ(out.str(),
+            "id,X,Y,Z,x,y,z,i,j,views,reproj_px\na,1,2,3,4,5,6,0,1,2,0.125\nb,1,2,3,,,,1,1,,\n");
+  GridWriteOptions clash;
+  clash.extra_columns = {"X"};
+  std::ostringstream out2;
+  EXPECT_THROW(GridFileWriter(out2, clash), std::logic_error);
+}
+
 TEST(IoGridFile, ColumnKeys) {
   for (const char* key : {"id", "X", "Y", "Z", "x", "y", "z", "u", "v", "w", "i", "j"})
     EXPECT_TRUE(is_grid_column_key(key)) << key;

@@ -48,7 +48,8 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       out.choice = choose_smoothing_gcv(problem, so, d);
     } else {
       out.noise = deformed_noise(problem, marks, setup, undeformed_noise);
-      auto choose = [&] { return choose_smoothing_noise_model(problem, so, out.noise, marks.undeformed, d); };
+      const MatX probes = noise_probes(out.noise, marks.undeformed, kCpNoiseProbes);
+      auto choose = [&] { return choose_smoothing_noise_model(problem, so, probes, d); };
       out.choice = choose();
       if (so.local) out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose);
     }

@@ -65,6 +65,7 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
   const VariogramPairs pairs(marks.undeformed, usable, d, vo);
   std::vector<NoiseEstimate> ladder;
   MatX residual(m, 1);
+  const ProbeBank bank = make_probe_bank(marks.undeformed, d);
   for (int k = 8; k >= 1; --k) {
     const Penalty pilot = jumps_penalty(k, d);
     system.set_values(marks.undeformed);
@@ -76,14 +77,15 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
       const FitResult g = system.solve(pilot, MatX::Zero(mesh.n_dofs(), probes.cols()), 0, 1);
       return MatX(probes - g.fitted);
     };
-    ladder.push_back(fit_noise_model(pairs, pairs.gamma(residual, 1), marks.undeformed, shrink));
+    ladder.push_back(fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink));
+    // The lighter pilots are only needed until one confirms its heavier neighbour.
+    if (ladder.size() >= 2) {
+      const NoiseEstimate& e = ladder[ladder.size() - 2];
+      const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
+      if (unbiased && confirms(e, ladder.back(), d)) return e;
+    }
   }
   if (ladder.empty()) return {};
-  for (std::size_t i = 0; i + 1 < ladder.size(); ++i) {
-    const NoiseEstimate& e = ladder[i];
-    const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
-    if (unbiased && confirms(e, ladder[i + 1], d)) return e;
-  }
   return ladder.back();
 }
 
@@ -101,6 +103,8 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
   // cannot follow leaves bias that looks like noise; lighter pilots leave less of it,
   // while true noise gives the same estimate at every pilot (the shrinkage correction).
   std::vector<NoiseEstimate> ladder;
+  // Independent noise is a correlated one with a length far below the spacing.
+  const ProbeBank bank = make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
   for (int k = 4; k >= -1; --k) {
     const Penalty pilot = jumps_penalty(k, d);
     const FitResult f = problem.fit(pilot, 1);
@@ -123,25 +127,20 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
       usable[static_cast<std::size_t>(i)] = w[i] > 0 && ms[static_cast<std::size_t>(i)] <= kMisfitFactor * typical;
     const VariogramPairs pairs(marks.undeformed, usable, d, vo);
     auto shrink = [&](const MatX& probes) { return MatX(probes - problem.smooth(probes, pilot, 1)); };
-    // Independent noise is a correlated one with a length far below the spacing.
-    NoiseEstimate e = fit_noise_model(pairs, pairs.gamma(residual, 3), marks.undeformed, shrink,
-                                      length > 0 ? length : 0.01 * d);
+    NoiseEstimate e = fit_noise_model(pairs, pairs.gamma(residual, 3), bank, shrink);
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;
     ladder.push_back(e);
-  }
-  if (ladder.empty()) return {};
-  NoiseEstimate out = ladder.back();
-  for (std::size_t i = 0; i + 1 < ladder.size(); ++i) {
-    const NoiseEstimate& e = ladder[i];
-    const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
-    const double sh = e.sigma_total(), sl = ladder[i + 1].sigma_total();
-    if (unbiased && std::abs(sh - sl) <= kSigmaAgreement * sl) {
-      out = e;
-      break;
+    // Lighter pilots only until one confirms its heavier neighbour.
+    if (ladder.size() >= 2) {
+      const NoiseEstimate& h = ladder[ladder.size() - 2];
+      const bool unbiased = h.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * h.sigma_total() * h.sigma_total();
+      const double sh = h.sigma_total(), sl = ladder.back().sigma_total();
+      if (unbiased && std::abs(sh - sl) <= kSigmaAgreement * sl) return h;
     }
   }
-  return out;
+  if (ladder.empty()) return {};
+  return ladder.back();
 }
 
 }  // namespace sf::gsa

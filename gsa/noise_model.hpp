@@ -47,6 +47,7 @@ struct VariogramOptions {
   double max_lag = 0.0;         // mm; 0 = 12 spacings
   double bin_width = 0.0;       // mm; 0 = half a spacing
   int max_query_points = 3000;  // points whose neighbourhoods are sampled (a random subset, fixed seed)
+  int max_pairs_per_bin = 6000; // pairs kept per distance bin (a random subset, fixed seed)
 };
 
 // One realisation of Gaussian noise with covariance sigma^2 exp(-r^2 / (2 L^2)): a
@@ -85,14 +86,24 @@ class VariogramPairs {
   double spacing_ = 0.0;
 };
 
+// Unit probe fields at the points for fit_noise_model: one correlated field (three
+// components) per trial correlation length, 13 lengths from 0.5 to 8 spacings (or the
+// one fixed length), and three white columns last. Made once per set of points and
+// used for every pilot smoother (the cosines are most of the cost).
+struct ProbeBank {
+  std::vector<double> lengths;  // mm
+  MatX probes;                  // n x 3 (lengths + 1)
+};
+ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length = 0.0);
+
 // The noise model whose residuals under a smoother match the residuals' variogram:
 // `smooth_residual(w)` returns (I - H) w for probe data w (n x k). Fits
 //   gamma(r) = s_c V_L(r) + s_w V_w(r) + b r^2
-// where V_L, V_w are the variograms of (I - H) applied to unit correlated (length L)
-// and white probes; L from a grid. Accounts for the noise the smoother itself takes up.
-NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed,
-                              const Points3& positions,
-                              const std::function<MatX(const MatX&)>& smooth_residual, double fixed_length = 0.0);
+// where V_L, V_w are the variograms of (I - H) applied to the bank's unit correlated
+// (length L) and white probes; L the best of the bank's lengths. Accounts for the noise
+// the smoother itself takes up.
+NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed, const ProbeBank& bank,
+                              const std::function<MatX(const MatX&)>& smooth_residual);
 
 // Probes for a trace estimate tr(H Sigma): `count` columns, each a draw of the
 // noise at the points (n x count; three independent columns per random field,

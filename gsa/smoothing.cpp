@@ -24,8 +24,6 @@ constexpr double kGcvStrainFactor = 2.0;
 // The automatic deformed fit is iterated once (two passes, iterated Tikhonov): the
 // second pass smooths towards the first one, which squares the smoothing bias.
 constexpr int kAutoFitPasses = 2;
-// Noise probes of the Cp trace tr(H Sigma): four random fields, three components each.
-constexpr int kNoiseProbes = 12;
 
 }  // namespace
 
@@ -147,14 +145,13 @@ SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOp
 }
 
 SmoothingChoice choose_smoothing_noise_model(DeformedProblem& problem, const SmoothingOptions& options,
-                                             const NoiseEstimate& noise, const Points3& positions,
-                                             double mark_spacing) {
+                                             const MatX& probes_of_noise, double mark_spacing) {
   const double d = mark_spacing;
   const VecX& w = problem.weight();
   const double n_used = w.sum();
-  const int probes = kNoiseProbes;
+  const int probes = static_cast<int>(probes_of_noise.cols());
   const double tolerance = n_used > 20000 ? 0.3 : 0.2;
-  problem.set_probes(noise_probes(noise, positions, probes));
+  problem.set_probes(probes_of_noise);
   // Cp with correlated noise: E|H z - f|^2 = |z - H z|^2 - tr(Sigma) + 2 tr(H Sigma) per
   // component; the trace from probes drawn from the noise model.
   auto cp = [&](const FitResult& f) {

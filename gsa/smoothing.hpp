@@ -78,13 +78,14 @@ SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOp
 // The same search minimising Mallows' Cp with correlated noise,
 //   Cp = |z - H z|^2 + 2 x 3 tr(H Sigma)   (3 components, Sigma per component),
 // an unbiased estimate of the position error |H z - f|^2 up to a constant, with
-// tr(H Sigma) estimated from probes drawn from `noise` at the marks' undeformed
-// `positions` (m x 3). Where the noise is independent this is close to GCV; where it is
-// correlated, GCV takes the correlated part for signal and under-smooths, Cp does not.
+// tr(H Sigma) estimated from `probes` drawn from the noise model at the marks
+// (noise_probes(noise, undeformed positions, kCpNoiseProbes): made once, used for every
+// choice of one analysis). Where the noise is independent this is close to GCV; where it
+// is correlated, GCV takes the correlated part for signal and under-smooths, Cp does not.
 // The weight used is 2 x the optimum (as for GCV) times options.scale. Leaves the
 // problem's probes set to the noise probes.
+inline constexpr int kCpNoiseProbes = 12;  // four random fields, three components each
 SmoothingChoice choose_smoothing_noise_model(DeformedProblem& problem, const SmoothingOptions& options,
-                                             const NoiseEstimate& noise, const Points3& positions,
-                                             double mark_spacing);
+                                             const MatX& probes, double mark_spacing);
 
 }  // namespace sf::gsa

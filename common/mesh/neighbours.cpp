@@ -68,4 +68,23 @@ std::vector<std::vector<Index>> neighbours_within(const Points3& points, double 
   return out;
 }
 
+std::vector<std::vector<Index>> neighbours_within(const Points3& points, double radius,
+                                                  const std::vector<Index>& query) {
+  std::vector<std::vector<Index>> out(query.size());
+  const std::vector<Sample> samples = finite_samples(points);
+  if (samples.size() < 2 || !(radius > 0.0)) return out;
+  Tree tree(samples.begin(), samples.end());
+  tree.build();
+  std::vector<Sample> found;
+  for (std::size_t i = 0; i < query.size(); ++i) {
+    const Index p = query[i];
+    if (!points.row(p).allFinite()) continue;
+    found.clear();
+    tree.search(std::back_inserter(found), Sphere(Point(points(p, 0), points(p, 1), points(p, 2)), radius, 0.0));
+    for (const Sample& f : found)
+      if (f.second != p) out[i].push_back(f.second);
+  }
+  return out;
+}
+
 }  // namespace sf::mesh

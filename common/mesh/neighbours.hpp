@@ -20,5 +20,8 @@ std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k)
 // For every row p of `points`, the indices of the other points within `radius`
 // (unsorted). Non-finite rows as above.
 std::vector<std::vector<Index>> neighbours_within(const Points3& points, double radius);
+// The same for the rows `query` only (out[i] for query[i]).
+std::vector<std::vector<Index>> neighbours_within(const Points3& points, double radius,
+                                                  const std::vector<Index>& query);
 
 }  // namespace sf::mesh

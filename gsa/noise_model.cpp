@@ -240,18 +240,33 @@ NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<dou
     y[b] = observed[static_cast<std::size_t>(b)];
     w[b] = pairs.count()[static_cast<std::size_t>(b)] / std::max(y[b] * y[b], 1e-300);
   }
+  std::vector<std::vector<double>> v_of_length(static_cast<std::size_t>(nl));
+  for (int l = 0; l < nl; ++l) v_of_length[static_cast<std::size_t>(l)] = pairs.gamma(shrunk.middleCols(3 * l, 3), 3);
+  // Between two trial lengths the variogram is interpolated (in log L, quarter steps):
+  // the bank's lengths are a factor 1.26 apart, too coarse for the estimate itself.
   ModelFit best;
   double best_L = 0.0;
   for (int l = 0; l < nl; ++l) {
-    const std::vector<double> vl = pairs.gamma(shrunk.middleCols(3 * l, 3), 3);
-    MatX A(nb, 3);
-    for (Index b = 0; b < nb; ++b) {
-      A(b, 0) = vw[static_cast<std::size_t>(b)];
-      A(b, 1) = vl[static_cast<std::size_t>(b)];
-      A(b, 2) = pairs.lag()[static_cast<std::size_t>(b)] * pairs.lag()[static_cast<std::size_t>(b)];
+    const int steps = l + 1 < nl ? 4 : 1;
+    for (int s = 0; s < steps; ++s) {
+      const double t = s / 4.0;
+      const auto& va = v_of_length[static_cast<std::size_t>(l)];
+      const auto& vb = v_of_length[static_cast<std::size_t>(std::min(l + 1, nl - 1))];
+      MatX A(nb, 3);
+      for (Index b = 0; b < nb; ++b) {
+        const auto bb = static_cast<std::size_t>(b);
+        A(b, 0) = vw[bb];
+        A(b, 1) = (1.0 - t) * va[bb] + t * vb[bb];
+        A(b, 2) = pairs.lag()[bb] * pairs.lag()[bb];
+      }
+      const ModelFit f = nonnegative_fit(A, y, w);
+      if (f.sse < best.sse) {
+        best = f;
+        const double la = lengths[static_cast<std::size_t>(l)];
+        const double lb = lengths[static_cast<std::size_t>(std::min(l + 1, nl - 1))];
+        best_L = la * std::pow(lb / la, t);
+      }
     }
-    const ModelFit f = nonnegative_fit(A, y, w);
-    if (f.sse < best.sse) best = f, best_L = lengths[static_cast<std::size_t>(l)];
   }
   out.sigma_white = std::sqrt(best.c[0]);
   out.sigma_correlated = std::sqrt(best.c[1]);

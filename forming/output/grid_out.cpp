@@ -4,7 +4,7 @@
 #include <ostream>
 
 #include "common/io/atomic_file.hpp"
-#include "common/io/csv.hpp"
+#include "common/io/grid_file.hpp"
 #include "forming/output/sampling.hpp"
 
 namespace sf::forming {
@@ -14,9 +14,12 @@ void write_grid(const std::string& path, const FormingCase& spec, const Model& m
   const PlyMesh& ply = model.ply(b);
   const MatX xb = PlyMesh::unflatten(x.segment(model.offset(b), ply.n_dofs()));
   io::write_file_atomic(path, [&](std::ostream& out) {
-    out << "# simform --grid-out: " << n << " x " << n << " marks on the top face of ply '" << p.name
-        << "' (case " << spec.file << "), mm\n";
-    io::CsvWriter w(out, {"id", "X", "Y", "Z", "x", "y", "z", "i", "j"});
+    io::GridWriteOptions options;
+    options.comments = {"simform --grid-out: " + std::to_string(n) + " x " + std::to_string(n) +
+                        " marks on the top face of ply '" + p.name + "' (case " + spec.file + ")"};
+    options.units = "mm";
+    options.with_ij = true;
+    io::GridFileWriter w(out, options);
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const double u = double(i) / (n - 1) * p.n1, v = double(j) / (n - 1) * p.n2;
@@ -24,10 +27,7 @@ void write_grid(const std::string& path, const FormingCase& spec, const Model& m
         const Index e = static_cast<Index>(je) * p.n1 + ie;
         const BrickPoint s = sample_brick(ply.element_parameters(e, ply.reference()), ply.element_parameters(e, xb),
                                           Vec3(u - ie, v - je, 1.0));
-        w.begin_row().add("m" + std::to_string(i) + "_" + std::to_string(j));
-        for (int c = 0; c < 3; ++c) w.add(s.X[c]);
-        for (int c = 0; c < 3; ++c) w.add(s.x[c]);
-        w.add(i).add(j).end_row();
+        w.add("m" + std::to_string(i) + "_" + std::to_string(j), s.X, s.x, i, j);
       }
   });
 }

@@ -26,7 +26,8 @@ enum class PenaltyKind {
 
 // How the automatic deformed weight is chosen (jumps penalty).
 enum class SmoothingRule {
-  kNoiseModel,  // Cp with the estimated noise model, correlation included (--smoothing-rule noise-model, the default)
+  kNoiseModel,  // the noise model; Cp where it finds noise correlated over a spacing or more, GCV where
+                // the noise is independent (--smoothing-rule noise-model, the default)
   kGcv,         // generalised cross-validation, which assumes independent errors (--smoothing-rule gcv)
 };
 

@@ -234,7 +234,9 @@ TEST_F(GsaCli, FlaggedMarksAreExplainedInStrainsAndSummary) {
     EXPECT_EQ(f.at("position").size(), 3u);
   }
   EXPECT_NE(j.at("command_line").get<std::string>().find("--out"), std::string::npos) << j.at("command_line");
-  EXPECT_EQ(j.at("parameters").at("smoothing").at("criterion"), "Cp");
+  // Independent noise: the noise-model rule chooses by cross-validation (Cp is for
+  // correlated noise).
+  EXPECT_EQ(j.at("parameters").at("smoothing").at("criterion"), "GCV");
   EXPECT_TRUE(j.at("parameters").at("smoothing").at("criterion_value").is_number());
   EXPECT_GT(j.at("parameters").at("noise_model").at("deformed").at("sigma_total").get<double>(), 0.0);
 }

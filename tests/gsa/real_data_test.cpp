@@ -108,6 +108,7 @@ TEST(GsaRealData, CorrelatedNoiseIsModelledAndSmoothedAsItShouldBe) {
   EXPECT_LT(e_model, 0.5 * e_gcv) << "noise model " << e_model << ", GCV " << e_gcv;
   EXPECT_LT(e_model, 0.5 * e_local) << "noise model " << e_model << ", 24-neighbour fit " << e_local;
   EXPECT_EQ(flagged(noise_model), 0);
+  EXPECT_EQ(noise_model.smoothing_criterion, "Cp");
 }
 
 // A neck from 20 % to 100 % engineering strain, about 7 spacings wide, under DIC-like

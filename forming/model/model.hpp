@@ -65,9 +65,11 @@ class Model {
 
   // Adds an interaction between bodies (or between a body and a tool); returns its index.
   // Throws sf::InputError for a null pointer.
-  int add_interaction(std::shared_ptr<const Interaction> interaction);
+  int add_interaction(std::shared_ptr<Interaction> interaction);
   int n_interactions() const { return static_cast<int>(interactions_.size()); }
   const Interaction& interaction(int i) const { return *interactions_[static_cast<std::size_t>(i)]; }
+  // Non-const: the steppers commit state and update multipliers (interaction.hpp).
+  Interaction& interaction(int i) { return *interactions_[static_cast<std::size_t>(i)]; }
   // False when some interaction's tangent is unsymmetric (solvers then factorise with LU).
   bool symmetric_tangent() const;
 
@@ -138,7 +140,7 @@ class Model {
   ElementRule rule_;
   quadrature::TensorRule<3> brick_rule_;
   std::vector<Body> bodies_;
-  std::vector<std::shared_ptr<const Interaction>> interactions_;
+  std::vector<std::shared_ptr<Interaction>> interactions_;
   Index n_dofs_ = 0;
 };
 

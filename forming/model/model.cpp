@@ -166,6 +166,7 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionConte
     }
   }
   out.strain_energy = out.energy;
+  out.element_force_norm = out.force.norm();
   if (!interactions_.empty() && !add_interactions(x, context, want_tangent, triplets, out)) return out;
   if (want_tangent) out.tangent = triplets.compress();
   return out;

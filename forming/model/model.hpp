@@ -48,6 +48,9 @@ struct Assembly {
   double energy = 0.0;           // stored energy: elements + interactions, N mm
   double strain_energy = 0.0;    // the elements' part, N mm
   VecX force;                    // f, n_dofs, N
+  // |f| of the elements alone, N: the force scale of a state where interactions (contact)
+  // balance the elements without external loads, so |f| itself is only the residual.
+  double element_force_norm = 0.0;
   linalg::SparseMatrix tangent;  // K = df/dx, n_dofs x n_dofs, N/mm (empty unless asked for)
   linalg::SparseMatrix damping;  // D = df/dv, N s/mm (empty unless asked for and some interaction depends on v)
 };

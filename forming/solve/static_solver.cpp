@@ -84,7 +84,7 @@ namespace {
 struct Residual {
   Assembly a;
   VecX residual;
-  double scale = 0.0;  // max(|f_int|, |f_ext|)
+  double scale = 0.0;  // max(|f_int|, |f_elements|, |f_ext|)
 };
 
 // The load steps of one static solve: the dof classes, the tangent solver, and the
@@ -192,7 +192,7 @@ Residual LoadStepping::evaluate_with(double lambda, const VecX& x, bool want_tan
   ExternalLoad ext = load_(lambda, x, want_tangent);
   SF_ASSERT(ext.force.size() == model_.n_dofs(), "external load must have n_dofs entries");
   st.residual = st.a.force - ext.force;
-  st.scale = std::max(st.a.force.norm(), ext.force.norm());
+  st.scale = std::max({st.a.force.norm(), st.a.element_force_norm, ext.force.norm()});
   if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
   return st;
 }

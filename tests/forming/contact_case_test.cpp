@@ -6,7 +6,10 @@
 //    column of the offending character), an unknown tool shape key, a contact naming a
 //    tool or ply that does not exist, S_n <= 0, Coulomb without a stick velocity, an
 //    STL that is missing or malformed (with the STL's own place);
-//  * a built laminate case holds one body per ply and one interaction per contact.
+//  * a built laminate case holds one body per ply and one interaction per contact;
+//  * outputs: history.csv has the tool's displacement and reaction per step (the
+//    punch's force balances the table's when nothing else holds the ply), result.pvd
+//    the tool and the contact points as parts of every written step.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -16,6 +19,8 @@
 #include "forming/case/build.hpp"
 #include "forming/case/contact_reader.hpp"
 #include "forming/case/reader.hpp"
+#include "common/io/vtk_xml.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -176,6 +181,55 @@ TEST(LaminateCase, StlToolsMissingOrMalformed) {
   c = check_case_text(text, case_path);
   ASSERT_EQ(c.problems.size(), 1u);
   EXPECT_NE(c.problems[0].message.find("none.stl"), std::string::npos) << c.problems[0].message;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ContactOutputs, ToolColumnsAndPartsOfEveryStep) {
+  const CaseCheck c = check_case_text(R"(materials:
+  soft: {neo_hookean: {E: 10, nu: 0.3}}
+plies:
+  - {name: p, size: [10, 10], thickness: 1, elements: [2, 2], material: soft}
+tools:
+  - name: table
+    plane: {point: [0, 0, 0], normal: [0, 0, 1]}
+  - name: punch
+    plane: {point: [0, 0, 1], normal: [0, 0, -1]}
+    motion: {displacement: [0, 0, -0.01]}
+contact:
+  - {ply: p, face: bottom, tool: table, stiffness: 100}
+  - {ply: p, face: top, tool: punch, stiffness: 100}
+boundary_conditions:
+  - symmetry: {ply: p, plane: x0}
+  - symmetry: {ply: p, plane: y0}
+solver: {steps: 2}
+)",
+                                      "outputs.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sf_contact_outputs_test";
+  const fixtures::RunOutput out = fixtures::run_into(c.spec, dir);
+  ASSERT_TRUE(out.report.ok()) << out.report.message;
+  const io::CsvTable& h = out.history;
+  ASSERT_EQ(h.n_rows(), 3u);
+  const auto cell = [&](std::size_t row, const char* name) {
+    return std::stod(std::string(h.cell(row, h.column_index(name))));
+  };
+  EXPECT_DOUBLE_EQ(cell(2, "time"), 1.0);
+  EXPECT_DOUBLE_EQ(cell(2, "punch_uz"), -0.01);
+  EXPECT_DOUBLE_EQ(cell(1, "punch_uz"), -0.005);
+  // Squeezed between two planes: the punch is pushed up, the table down, equally.
+  const double up = cell(2, "punch_fz"), down = cell(2, "table_fz");
+  EXPECT_GT(up, 0.1);
+  EXPECT_NEAR(up, -down, 1e-6 * up);
+  const std::string pvd = fixtures::read_text(dir / "result.pvd");
+  for (const char* part : {"steps/tool_table_0002.vtu", "steps/tool_punch_0002.vtu", "steps/contact_0002.vtu"}) {
+    EXPECT_NE(pvd.find(part), std::string::npos) << part;
+    EXPECT_TRUE(std::filesystem::exists(dir / part)) << part;
+  }
+  const io::VolumeMesh points = io::read_vtu((dir / "steps/contact_0002.vtu").string());
+  EXPECT_EQ(points.points.rows(), 2 * 4 * 36);
+  bool has_pressure = false;
+  for (const io::FieldArray& f : points.point_data) has_pressure = has_pressure || f.name == "pressure";
+  EXPECT_TRUE(has_pressure);
   std::filesystem::remove_all(dir);
 }
 

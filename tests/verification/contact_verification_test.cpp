@@ -163,6 +163,48 @@ TEST(SlidingBlock, CoulombForceIsMuN) {
               0.3 * N, N, std::abs(-F.x() - 0.3 * N) / (0.3 * N));
 }
 
+TEST(AugmentedLagrangian, DrivesThePenetrationUnderItsTolerance) {
+  // A block pressed by p = 0.2 MPa onto a table with a soft penalty S_n = 10 N/mm^3:
+  // the penalty alone leaves p / S_n = 0.02 mm; Uzawa updates bring it under 1e-4 mm.
+  const auto max_penetration = [](const std::string& extra, int* updates) {
+    CaseRun r;
+    run(R"(
+materials:
+  block: {neo_hookean: {E: 100, nu: 0.3}}
+plies:
+  - {name: b, size: [10, 10], thickness: 1, elements: [2, 2], material: block}
+tools:
+  - name: table
+    plane: {point: [0, 0, 0], normal: [0, 0, 1]}
+contact:
+  - {ply: b, face: bottom, tool: table, stiffness: 10)" +
+            extra + R"(}
+boundary_conditions:
+  - symmetry: {ply: b, plane: x0}
+  - symmetry: {ply: b, plane: y0}
+loads:
+  - pressure: {ply: b, face: top, value: 0.2}
+solver: {steps: 1, tolerance: 1.0e-10}
+)",
+        r);
+    const auto& c = dynamic_cast<const SurfaceContact&>(r.problem.model.interaction(0));
+    double worst = 0.0;
+    for (const ContactPointRecord& rec : c.sample(r.steps.x.back(), context_of(r, 1)))
+      worst = std::max(worst, -rec.gap);
+    *updates = c.multiplier_updates();
+    return worst;
+  };
+  int updates = 0;
+  const double penalty = max_penetration("", &updates);
+  EXPECT_EQ(updates, 0);
+  const double augmented = max_penetration(", tolerance: 1.0e-4", &updates);
+  EXPECT_GT(penalty, 0.015);
+  EXPECT_LT(augmented, 1e-4);
+  EXPECT_GT(updates, 0);
+  std::printf("augmented Lagrangian: penetration %.3e mm (penalty alone %.3e mm) after %d updates\n", augmented,
+              penalty, updates);
+}
+
 TEST(PlyPullOut, ForceIsTwoWidthsTimesOverlapTimesCfV) {
   // Plies 40 x 10 x 0.5; the middle one pulled along x at v = 1 mm/s to d = 8 mm.
   const double w = 10.0, L0 = 40.0, cf = 0.02, v = 1.0;

@@ -184,6 +184,19 @@ TEST(LaminateCase, StlToolsMissingOrMalformed) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(LaminateCase, ContactSamplesCheckClean) {
+  const std::filesystem::path dir = std::filesystem::path(SF_SOURCE_DIR) / "data/forming/contact";
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    const CaseCheck c = check_case_file(entry.path().string());
+    EXPECT_TRUE(c.ok()) << (c.ok() ? "" : c.located(0));
+    EXPECT_FALSE(c.spec.contacts.empty()) << entry.path();
+    ++n;
+  }
+  EXPECT_GE(n, 1);
+}
+
 TEST(ContactOutputs, ToolColumnsAndPartsOfEveryStep) {
   const CaseCheck c = check_case_text(R"(materials:
   soft: {neo_hookean: {E: 10, nu: 0.3}}

@@ -39,14 +39,14 @@ int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const 
   return n_bodies() - 1;
 }
 
-int Model::add_interaction(std::shared_ptr<const Interaction> interaction) {
+int Model::add_interaction(std::shared_ptr<Interaction> interaction) {
   if (!interaction) throw InputError("model: interaction added as a null pointer");
   interactions_.push_back(std::move(interaction));
   return n_interactions() - 1;
 }
 
 bool Model::symmetric_tangent() const {
-  for (const std::shared_ptr<const Interaction>& i : interactions_)
+  for (const std::shared_ptr<Interaction>& i : interactions_)
     if (!i->symmetric()) return false;
   return true;
 }
@@ -166,6 +166,7 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionConte
     }
   }
   out.strain_energy = out.energy;
+  out.element_force_norm = out.force.norm();
   if (!interactions_.empty() && !add_interactions(x, context, want_tangent, triplets, out)) return out;
   if (want_tangent) out.tangent = triplets.compress();
   return out;
@@ -180,7 +181,7 @@ bool Model::add_interactions(const Eigen::Ref<const VecX>& x, const InteractionC
   sums.stiffness = want_tangent ? &stiffness : nullptr;
   sums.damping = want_tangent && context.velocity ? &damping : nullptr;
   bool velocity_dependent = false;
-  for (const std::shared_ptr<const Interaction>& interaction : interactions_) {
+  for (const std::shared_ptr<Interaction>& interaction : interactions_) {
     interaction->add_to(x, context, sums);
     if (!sums.ok) {
       out.ok = false;

@@ -48,6 +48,9 @@ struct Assembly {
   double energy = 0.0;           // stored energy: elements + interactions, N mm
   double strain_energy = 0.0;    // the elements' part, N mm
   VecX force;                    // f, n_dofs, N
+  // |f| of the elements alone, N: the force scale of a state where interactions (contact)
+  // balance the elements without external loads, so |f| itself is only the residual.
+  double element_force_norm = 0.0;
   linalg::SparseMatrix tangent;  // K = df/dx, n_dofs x n_dofs, N/mm (empty unless asked for)
   linalg::SparseMatrix damping;  // D = df/dv, N s/mm (empty unless asked for and some interaction depends on v)
 };
@@ -65,9 +68,11 @@ class Model {
 
   // Adds an interaction between bodies (or between a body and a tool); returns its index.
   // Throws sf::InputError for a null pointer.
-  int add_interaction(std::shared_ptr<const Interaction> interaction);
+  int add_interaction(std::shared_ptr<Interaction> interaction);
   int n_interactions() const { return static_cast<int>(interactions_.size()); }
   const Interaction& interaction(int i) const { return *interactions_[static_cast<std::size_t>(i)]; }
+  // Non-const: the steppers commit state and update multipliers (interaction.hpp).
+  Interaction& interaction(int i) { return *interactions_[static_cast<std::size_t>(i)]; }
   // False when some interaction's tangent is unsymmetric (solvers then factorise with LU).
   bool symmetric_tangent() const;
 
@@ -138,7 +143,7 @@ class Model {
   ElementRule rule_;
   quadrature::TensorRule<3> brick_rule_;
   std::vector<Body> bodies_;
-  std::vector<std::shared_ptr<const Interaction>> interactions_;
+  std::vector<std::shared_ptr<Interaction>> interactions_;
   Index n_dofs_ = 0;
 };
 

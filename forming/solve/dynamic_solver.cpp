@@ -384,7 +384,7 @@ bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangen
   }
   const VecX inertia = mass_ * aa;
   out.residual = inertia + internal.force - ext.force;
-  out.scale = std::max({internal.force.norm(), ext.force.norm(), inertia.norm()});
+  out.scale = std::max({internal.force.norm(), internal.element_force_norm, ext.force.norm(), inertia.norm()});
   if (!out.residual.allFinite()) {
     why = "non-finite residual";
     return false;

@@ -43,6 +43,8 @@ void StaticOptions::validate() const {
   if (!(residual_tol_abs >= 0.0)) bad_option("residual_tol_abs", "a value >= 0 (N)", residual_tol_abs);
   if (!(divergence_factor > 1.0)) bad_option("divergence_factor", "a factor > 1", divergence_factor);
   if (max_line_search < 0) bad_option("max_line_search", "at least 0", max_line_search);
+  if (!(std::isfinite(clock.start) && std::isfinite(clock.end) && clock.end >= clock.start))
+    throw InputError("static solver clock: expected finite times with end >= start (s)");
   if (!linalg::solver_available(linear_solver))
     throw InputError("static solver linear_solver: '" + linalg::to_string(linear_solver) +
                      "' is not compiled in");
@@ -82,7 +84,7 @@ namespace {
 struct Residual {
   Assembly a;
   VecX residual;
-  double scale = 0.0;  // max(|f_int|, |f_ext|)
+  double scale = 0.0;  // max(|f_int|, |f_elements|, |f_ext|)
 };
 
 // The load steps of one static solve: the dof classes, the tangent solver, and the
@@ -95,12 +97,22 @@ class LoadStepping {
         x_start_(x_start),
         load_(load),
         options_(options),
-        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()) {}
+        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()),
+        rates_from_(options.clock.previous ? *options.clock.previous : VecX(x_start)),
+        rates_time_(options.clock.previous ? options.clock.previous_time : options.clock.start) {
+    last_rates_from_ = rates_from_;
+    last_rates_time_ = rates_time_;
+  }
 
   // Free, prescribed (with their targets at lambda = 1) and held (used by no element)
   // dofs; returns why the input is invalid (empty when valid).
   std::string classify(const std::vector<PrescribedDof>& prescribed);
   Residual evaluate(double lambda, const VecX& x, bool want_tangent) const;
+  // A sub-step converged at (lambda, x): the interactions' rates start from it when the
+  // clock runs (options.clock); the reactions keep the rates of that sub-step.
+  void converged(double lambda, const VecX& x);
+  // Residual at the last converged state with the rates of its own sub-step (reactions).
+  Residual final_residual(double lambda, const VecX& x) const;
 
   enum class Predicted { kOk, kFailed, kInadmissible };
   // Predictor from the converged state x to lam_new: tangent at x, prescribed dofs
@@ -117,11 +129,15 @@ class LoadStepping {
   // Line-search factor along dx; < 0 (rec.failure) when every trial inverted an element.
   double line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec) const;
 
+  Residual evaluate_with(double lambda, const VecX& x, bool want_tangent, const VecX& from, double from_time) const;
+
   const Model& model_;
   const Eigen::Ref<const VecX>& x_start_;
   const LoadFunction& load_;
   const StaticOptions& options_;
   TangentSolver solver_;
+  VecX rates_from_, last_rates_from_;          // where the interactions' rates start (clock)
+  double rates_time_ = 0.0, last_rates_time_ = 0.0;
   std::vector<char> kind_;
   VecX target_;
   FreeDofs free_;
@@ -152,13 +168,31 @@ std::string LoadStepping::classify(const std::vector<PrescribedDof>& prescribed)
 }
 
 Residual LoadStepping::evaluate(double lambda, const VecX& x, bool want_tangent) const {
+  return evaluate_with(lambda, x, want_tangent, rates_from_, rates_time_);
+}
+
+Residual LoadStepping::final_residual(double lambda, const VecX& x) const {
+  return evaluate_with(lambda, x, false, last_rates_from_, last_rates_time_);
+}
+
+void LoadStepping::converged(double lambda, const VecX& x) {
+  if (!(options_.clock.end > options_.clock.start)) return;  // the time stands still
+  last_rates_from_ = rates_from_;
+  last_rates_time_ = rates_time_;
+  rates_from_ = x;
+  rates_time_ = options_.clock.at(lambda);
+}
+
+Residual LoadStepping::evaluate_with(double lambda, const VecX& x, bool want_tangent, const VecX& from,
+                                     double from_time) const {
   Residual st;
-  st.a = model_.assemble(x, want_tangent);
+  const InteractionContext context{options_.clock.at(lambda), nullptr, &from, from_time};
+  st.a = model_.assemble(x, context, want_tangent);
   if (!st.a.ok) return st;
   ExternalLoad ext = load_(lambda, x, want_tangent);
   SF_ASSERT(ext.force.size() == model_.n_dofs(), "external load must have n_dofs entries");
   st.residual = st.a.force - ext.force;
-  st.scale = std::max(st.a.force.norm(), ext.force.norm());
+  st.scale = std::max({st.a.force.norm(), st.a.element_force_norm, ext.force.norm()});
   if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
   return st;
 }
@@ -318,6 +352,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (rec.converged) {
       x = xt;
       lambda = lam_new;
+      steps.converged(lambda, x);
       if (rec.iterations <= options.easy_iterations)
         increment = std::min(options.max_increment, increment * options.growth);
       report.add(std::move(rec));
@@ -339,7 +374,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   }
   report.load_factor = lambda;
   result.positions = x;
-  result.reactions = steps.evaluate(lambda, x, false).residual;
+  result.reactions = steps.final_residual(lambda, x).residual;
   return result;
 }
 
@@ -349,6 +384,12 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
                                       UzawaReport* report) {
   UzawaReport rep;
   StaticResult r = solve_static(model, x_start, prescribed, load, unsymmetric, options);
+  // Repeats start at the step's end with the time standing still there and the rates
+  // measured from the step's start.
+  const VecX step_start = options.clock.previous ? *options.clock.previous : VecX(x_start);
+  StaticOptions repeat = options;
+  repeat.clock = {options.clock.end, options.clock.end, &step_start,
+                  options.clock.previous ? options.clock.previous_time : options.clock.start};
   const bool any = model.any_constrained();
   auto measure = [&](const VecX& x) {
     rep.max_g_J = rep.max_g_T = 0.0;
@@ -382,7 +423,7 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
       }
       ++rep.updates;
       const LoadFunction full = [&load](double, const VecX& x, bool want_tangent) { return load(1.0, x, want_tangent); };
-      const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, options);
+      const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, repeat);
       const int iterations = r.report.total_iterations + again.report.total_iterations;
       r = again;
       r.report.total_iterations = iterations;

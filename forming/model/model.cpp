@@ -184,7 +184,11 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
   const double* xp = x.data();
   double* force = out.force.data();
   double* ktimes = direction ? out.tangent_times.data() : nullptr;
-  const int n_threads = std::max(1, std::min(threads(), static_cast<int>(n_el / 8) + 1));
+  // At least kMinElementsPerThread bricks (~5 ms of kernels) per thread: below that the
+  // barriers between colours cost more than they save, badly so on a loaded machine
+  // where a waiting thread spins while the other is descheduled.
+  constexpr Index kMinElementsPerThread = 48;
+  const int n_threads = std::max(1, std::min(threads(), static_cast<int>(n_el / kMinElementsPerThread)));
   std::atomic<bool> input_error{false};
   std::string input_message;
 #pragma omp parallel num_threads(n_threads)

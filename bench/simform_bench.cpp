@@ -44,6 +44,7 @@
 
 #include <omp.h>
 
+#include "common/core/memory.hpp"
 #include "common/linalg/dense_kernels.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/mesh/surface_mesh.hpp"
@@ -235,6 +236,7 @@ int run_shear_stretch(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory();  // as simform does (common/core/memory.hpp)
   try {
     if (argc >= 4 && std::strcmp(argv[1], "--case") == 0)
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);

@@ -1,152 +1,279 @@
-// Cost of the forming solver's building blocks on flat plies: for n x n bricks per ply
-// (n = 10, 20, 40) and 1 or 4 plies, prints one line per case:
-//   n_dofs      unknowns (24 per surface node per ply)
-//   asm_s       one assembly of internal force + tangent at a deformed state, seconds
-//   fact_s      symbolic analysis + numeric factorisation of the free-dof tangent K_ff
-//               with LinearSolver(kAuto, SPD) (= CHOLMOD when SuiteSparse is built in), s
-//   solve_s     one back-substitution with that factorisation, s
-//   newton      Newton iterations (predictor included) of a static solve: uniaxial 5 %
-//               stretch along x of every ply (grips: all parameters of the nodes at x = 0
-//               held, those at x = L moved affinely), compressible TI law, fibres 0/90
-//   static_s    wall time of that solve (solve_static, its own linear solver choice), s
-//   peak_MB     peak resident memory of the process so far (getrusage; high-water mark,
-//               so it only grows from line to line)
-// Plies: 100 x 100 mm, 0.25 mm thick, stacked in z as separate bodies. There is no
-// contact or interaction between plies yet, so the 4-ply system is block diagonal (4
-// independent plies); the figures show the scaling of assembly and factorisation only.
-// A program that prints figures, not a timed test.
-//   build/bin/simform_bench [max_elements_per_side=40]
+// Cost of one Newton iteration of the forming solver, piece by piece, on flat plies, and
+// the Newton iterations of the shear-and-stretch ply. A program that prints figures, not
+// a timed test.
+//
+//   build/bin/simform_bench [max_elements_per_side=40] [repeats=3]
+//
+// For n x n bricks per ply (n = 10, 20, 40) and 1 or 4 plies (100 x 100 x 0.25 mm,
+// compressible transversely isotropic law, fibres 0/90/0/90, stacked as separate bodies:
+// no contact yet, so the 4-ply system is block diagonal), each case runs in its own
+// process (so that its peak memory is its own) and prints one line:
+//   n_dofs, n_free   unknowns, and those left free by the grips (every parameter of the
+//                    nodes at x = 0 and x = L prescribed: a uniaxial 5 % stretch)
+//   layout_s         laying out the free-unknown pattern and the element scatter tables
+//                    (once per model)
+//   kernel_s         the element kernels alone (force + tangent, all bricks, threaded)
+//   scatter_s        the rest of an assembly with the tangent: writing into the pattern
+//   resid_s          an assembly of the force only (the line search's trial)
+//   fact_s           numeric factorisation of K_ff (symbolic analysis kept; analyse_s once)
+//   solve_s          one forward/back substitution
+//   iter_s           kernel + scatter + residual + factorisation + solve: one Newton iteration
+//   kern_GF, fact_GF GFLOP/s of the kernel (flops counted from the algorithm,
+//                    BrickKernel::tangent_flops) and of the factorisation (CHOLMOD's count)
+//   newton, static_s Newton iterations and wall time of the whole static solve (stretch
+//                    in one load step)
+//   peak_MB          peak resident memory of the case's process
+// Times are medians over `repeats` repetitions, wall clock, seconds. The first line says
+// how many threads the element loop uses and which vector instructions the kernel runs.
+//
+// Then the shear-and-stretch ply (bench/cases/shear_stretch_ply.yaml: 200 mm square ply,
+// 40 x 40 elements, fibres at 30 degrees, clamped on x0, x1 moved 4 mm across and 2 mm
+// along in two load steps): Newton iterations and cut-backs per step, and time.
 #include <sys/resource.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <omp.h>
+
+#include "common/core/memory.hpp"
+#include "common/linalg/dense_kernels.hpp"
 #include "common/linalg/solver.hpp"
-#include "common/linalg/sparse.hpp"
 #include "common/mesh/surface_mesh.hpp"
-#include "forming/material/neo_hookean.hpp"
+#include "forming/case/build.hpp"
+#include "forming/case/reader.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_mesh.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "forming/solve/stepper.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 using namespace sf;
 using namespace sf::forming;
 
-static double peak_mb() {
+namespace {
+
+double peak_mb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return u.ru_maxrss / 1024.0;
 }
 
-static double seconds_since(std::chrono::steady_clock::time_point t0) {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int main(int argc, char** argv) {
-  const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
-  const double L = 100.0, h = 0.25, stretch = 1.05;
+template <class F>
+double median_time(int repeats, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    t.push_back(seconds_since(t0));
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+constexpr double kL = 100.0, kH = 0.25, kStretch = 1.05;
+
+TransverselyIsotropicParams ply_law() {
   TransverselyIsotropicParams tp;
   tp.mu_T = 1.0;
   tp.mu_L = 2.0;
   tp.kappa_f = 500.0;
   tp.incompressible = false;
   tp.lambda = 10.0;
-  std::printf("# simform_bench: flat plies %g x %g x %g mm, compressible TI (mu_T %g, mu_L %g, kappa_f %g, lambda %g "
-              "MPa), fibres 0/90/0/90\n",
-              L, L, h, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
-  std::printf("# times in seconds, memory in MB (peak RSS so far); plies are independent bodies (no contact yet)\n");
-  std::printf("%7s %5s %8s %8s %8s %8s %6s %9s %8s  %s\n", "n x n", "plies", "n_dofs", "asm_s", "fact_s", "solve_s",
-              "newton", "static_s", "peak_MB", "linear solver");
-  for (int n : {10, 20, 40}) {
-    if (n > max_n) break;
-    for (int plies : {1, 4}) {
-      Model model;
-      for (int k = 0; k < plies; ++k) {
-        PlyMesh ply(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, k * h), Vec3::UnitX(), Vec3::UnitY(), L, L, n, n), h,
-                    k % 2 == 0 ? 0.0 : 90.0);
-        auto material = std::make_shared<TransverselyIsotropic>(tp, ply.fibre_direction());
-        model.add_ply(std::move(ply), material);
-      }
-      const Index nd = model.n_dofs();
-      const VecX X = model.reference_positions();
+  return tp;
+}
 
-      // Grips: every parameter of the nodes at x = 0 (held) and x = L (x -> F X).
-      std::vector<PrescribedDof> bcs;
-      std::vector<bool> fixed(nd, false);
-      VecX target = X;
-      for (int b = 0; b < model.n_bodies(); ++b) {
-        const PlyMesh& ply = model.ply(b);
-        for (Index s = 0; s < ply.n_surface_nodes(); ++s) {
-          const double xs = ply.surface().node_position(s).x();
-          const bool left = std::abs(xs) < 1e-9, right = std::abs(xs - L) < 1e-9;
-          if (!left && !right) continue;
-          for (int layer = 0; layer < 2; ++layer)
-            for (int d = 0; d < 4; ++d) {
-              const Index dx = model.dof(b, ply.node(s, layer), d, 0);
-              if (right) target(dx) = stretch * X(dx);
-              for (int i = 0; i < 3; ++i) {
-                const Index dof = model.dof(b, ply.node(s, layer), d, i);
-                bcs.push_back({dof, target(dof)});
-                fixed[dof] = true;
-              }
-            }
+int run_case(int n, int plies, int repeats) {
+  Model model;
+  for (int k = 0; k < plies; ++k) {
+    PlyMesh ply(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, k * kH), Vec3::UnitX(), Vec3::UnitY(), kL, kL, n, n), kH,
+                k % 2 == 0 ? 0.0 : 90.0);
+    auto material = std::make_shared<TransverselyIsotropic>(ply_law(), ply.fibre_direction());
+    model.add_ply(std::move(ply), material);
+  }
+  const Index nd = model.n_dofs();
+  const VecX X = model.reference_positions();
+  // Grips: every parameter of the nodes at x = 0 (held) and x = L (x -> 1.05 x).
+  std::vector<PrescribedDof> bcs;
+  std::vector<bool> is_free(static_cast<std::size_t>(nd), true);
+  VecX target = X;
+  for (int b = 0; b < model.n_bodies(); ++b) {
+    const PlyMesh& ply = model.ply(b);
+    for (Index s = 0; s < ply.n_surface_nodes(); ++s) {
+      const double xs = ply.surface().node_position(s).x();
+      const bool left = std::abs(xs) < 1e-9, right = std::abs(xs - kL) < 1e-9;
+      if (!left && !right) continue;
+      for (int layer = 0; layer < 2; ++layer)
+        for (int d = 0; d < 4; ++d) {
+          const Index dx = model.dof(b, ply.node(s, layer), d, 0);
+          if (right) target(dx) = kStretch * X(dx);
+          for (int i = 0; i < 3; ++i) {
+            const Index dof = model.dof(b, ply.node(s, layer), d, i);
+            bcs.push_back({dof, target(dof)});
+            is_free[static_cast<std::size_t>(dof)] = false;
+          }
         }
-      }
-      // A deformed state for the timing: the affine stretch everywhere.
-      VecX x = X;
-      for (Index p = 0; p < nd / 3; ++p) x(3 * p) *= stretch;
-
-      auto t0 = std::chrono::steady_clock::now();
-      const Assembly a = model.assemble(x, true);
-      const double asm_s = seconds_since(t0);
-      if (!a.ok) {
-        std::printf("assembly failed: %s\n", a.message.c_str());
-        return 1;
-      }
-      // K_ff of the free dofs.
-      std::vector<int> free_index(nd, -1);
-      int nf = 0;
-      for (Index d = 0; d < nd; ++d)
-        if (!fixed[d]) free_index[d] = nf++;
-      std::vector<Eigen::Triplet<double, int>> trip;
-      trip.reserve(a.tangent.nonZeros());
-      for (int c = 0; c < a.tangent.outerSize(); ++c)
-        for (linalg::SparseMatrix::InnerIterator it(a.tangent, c); it; ++it) {
-          const int r = free_index[it.row()], cc = free_index[it.col()];
-          if (r >= 0 && cc >= 0) trip.emplace_back(r, cc, it.value());
-        }
-      linalg::SparseMatrix kff(nf, nf);
-      kff.setFromTriplets(trip.begin(), trip.end());
-      linalg::LinearSolver solver(linalg::SolverKind::kAuto, linalg::MatrixProperty::kSymmetricPositiveDefinite);
-      t0 = std::chrono::steady_clock::now();
-      const linalg::SolveReport& rep = solver.factorize(kff);
-      const double fact_s = seconds_since(t0);
-      double solve_s = 0.0;
-      if (rep.ok()) {
-        Eigen::VectorXd rhs = Eigen::VectorXd::Ones(nf);
-        t0 = std::chrono::steady_clock::now();
-        const Eigen::MatrixXd sol = solver.solve(rhs);
-        solve_s = seconds_since(t0);
-        if (!sol.allFinite()) std::printf("# warning: non-finite solution\n");
-      } else {
-        std::printf("# factorisation failed: %s\n", rep.brief().c_str());
-      }
-      const std::string kind = linalg::to_string(solver.kind());
-
-      t0 = std::chrono::steady_clock::now();
-      const StaticResult res = solve_static(model, X, bcs, VecX());
-      const double static_s = seconds_since(t0);
-      if (!res.report.ok()) std::printf("# static solve: %s\n", res.report.brief().c_str());
-      std::printf("%3dx%-3d %5d %8ld %8.3f %8.3f %8.4f %6d %9.3f %8.1f  %s (K_ff nnz %ld)\n", n, n, plies,
-                  static_cast<long>(nd), asm_s, fact_s, solve_s, res.report.total_iterations, static_s, peak_mb(),
-                  kind.c_str(), static_cast<long>(kff.nonZeros()));
-      std::fflush(stdout);
     }
   }
+  // A deformed state for the timing: the affine stretch everywhere.
+  VecX x = X;
+  for (Index p = 0; p < nd / 3; ++p) x(3 * p) *= kStretch;
+
+  TangentSolver solver(linalg::SolverKind::kAuto, false);
+  auto t0 = std::chrono::steady_clock::now();
+  linalg::PatternAssembler pattern = model.make_pattern(is_free, solver.lower());
+  const double layout_s = seconds_since(t0);
+
+  // Kernels alone: the model's loop without the writing (same threads, same buffers).
+  const std::vector<linalg::ElementEntries>& entries = model.element_entries();
+  std::vector<std::pair<int, Index>> bricks;
+  std::vector<BrickParams> X_e;
+  for (int b = 0; b < model.n_bodies(); ++b)
+    for (Index e = 0; e < model.ply(b).n_elements(); ++e) {
+      bricks.emplace_back(b, e);
+      X_e.push_back(model.ply(b).element_parameters(e, model.ply(b).reference()));
+    }
+  const Index n_el = static_cast<Index>(bricks.size());
+  const int threads = model.threads();
+  auto kernels_only = [&] {
+#pragma omp parallel num_threads(threads)
+    {
+      thread_local BrickScratch scratch;
+      thread_local ElementResult result;
+#pragma omp for schedule(dynamic, 4)
+      for (Index g = 0; g < n_el; ++g) {
+        const linalg::ElementEntries& en = entries[static_cast<std::size_t>(g)];
+        BrickParams xe = BrickParams::Zero();
+        for (std::size_t a = 0; a < en.dofs.size(); ++a)
+          xe(en.local[a] / 3, en.local[a] % 3) += en.coefs[a] * x(en.dofs[a]);
+        model.kernel().evaluate(X_e[static_cast<std::size_t>(g)], xe, model.material(bricks[g].first), true, {},
+                                scratch, result);
+      }
+    }
+  };
+  kernels_only();  // warm-up (thread buffers)
+  model.assemble_into(x, InteractionContext{}, &pattern);
+  const double kernel_s = median_time(repeats, kernels_only);
+  const double asm_s = median_time(repeats, [&] { model.assemble_into(x, InteractionContext{}, &pattern); });
+  const double resid_s = median_time(repeats, [&] { model.assemble_into(x, InteractionContext{}, nullptr); });
+
+  t0 = std::chrono::steady_clock::now();
+  linalg::SolveReport first = solver.factorize(pattern.matrix());
+  const double first_s = seconds_since(t0);
+  if (!first.ok()) std::printf("# factorisation failed: %s\n", first.brief().c_str());
+  const double analyse_s = first.analyze_seconds;
+  double flops = first.factor_flops;
+  const double fact_s = median_time(repeats, [&] { flops = solver.factorize(pattern.matrix()).factor_flops; });
+  (void)first_s;
+  const VecX rhs = VecX::Ones(pattern.n_active());
+  double solve_s = median_time(repeats, [&] {
+    const Eigen::MatrixXd sol = solver.solve(rhs);
+    if (!sol.allFinite()) std::printf("# warning: non-finite solution\n");
+  });
+  const double iter_s = asm_s + resid_s + fact_s + solve_s;
+
+  t0 = std::chrono::steady_clock::now();
+  const StaticResult res = solve_static(model, X, bcs, VecX());
+  const double static_s = seconds_since(t0);
+  if (!res.report.ok()) std::printf("# static solve: %s\n", res.report.brief().c_str());
+
+  const double kern_gf = n_el * model.kernel().tangent_flops() / kernel_s / 1e9;
+  std::printf("%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %8.2f %8.1f\n", n,
+              n, plies, static_cast<long>(nd), static_cast<long>(pattern.n_active()), layout_s, kernel_s,
+              asm_s - kernel_s, resid_s, analyse_s, fact_s, solve_s, iter_s, kern_gf, flops / fact_s / 1e9,
+              res.report.total_iterations, static_s, peak_mb());
+  std::fflush(stdout);
   return 0;
+}
+
+class Recorder final : public StepObserver {
+ public:
+  std::vector<StepInfo> steps;
+  StepAction on_step(const StepInfo& step, const SteppingState&, const VecX&) override {
+    steps.push_back(step);
+    return StepAction::kContinue;
+  }
+};
+
+int run_shear_stretch(const std::string& path) {
+  const FormingCase spec = load_case(path);
+  Problem problem = build_problem(spec);
+  const StepperSettings settings = stepper_settings(spec);
+  std::unique_ptr<Stepper> stepper = make_stepper(problem, settings);
+  SteppingState state;
+  state.x = problem.model.reference_positions();
+  state.v = VecX::Zero(state.x.size());
+  Recorder recorder;
+  const auto t0 = std::chrono::steady_clock::now();
+  const SteppingReport report = stepper->run(state, recorder);
+  const double total_s = seconds_since(t0);
+  std::printf("# shear-and-stretch ply (%s): %ld dofs, %s\n", path.c_str(),
+              static_cast<long>(problem.model.n_dofs()),
+              report.status == SteppingReport::Status::kFinished ? "finished" : report.message.c_str());
+  int iterations = 0;
+  for (const StepInfo& s : recorder.steps) {
+    std::printf("  step %d (load factor %.2f): %d Newton iterations, %d cut-backs, |r| %.3g N\n", s.index,
+                s.load_factor, s.iterations, s.cutbacks, s.residual);
+    iterations += s.iterations;
+  }
+  std::printf("  %d iterations in %zu steps (%.1f per step), %.1f s, peak %.0f MB\n", iterations, recorder.steps.size(),
+              recorder.steps.empty() ? 0.0 : double(iterations) / recorder.steps.size(), total_s, peak_mb());
+  return report.status == SteppingReport::Status::kFinished ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  keep_freed_memory();  // as simform does (common/core/memory.hpp)
+  try {
+    if (argc >= 4 && std::strcmp(argv[1], "--case") == 0)
+      return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);
+    if (argc >= 3 && std::strcmp(argv[1], "--shear-stretch") == 0) return run_shear_stretch(argv[2]);
+    const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
+    const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
+    const TransverselyIsotropicParams tp = ply_law();
+    std::printf("# simform_bench: flat plies %g x %g x %g mm, compressible TI (mu_T %g, mu_L %g, kappa_f %g, lambda %g "
+                "MPa), fibres 0/90/0/90; plies are independent bodies (no contact yet)\n",
+                kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
+    std::printf("# element loop on %d threads (OpenMP), kernel vector instructions: %s (processor's best: %s); "
+                "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n",
+                omp_get_max_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
+                linalg::to_string(linalg::best_kernel_isa()).c_str());
+    std::printf("# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
+                repeats);
+    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %8s %8s\n", "n x n", "plies", "n_dofs",
+                "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s", "iter_s",
+                "kern_GF", "fact_GF", "newton", "static_s", "peak_MB");
+    std::fflush(stdout);
+    const std::string self = argv[0];
+    for (int n : {10, 20, 40}) {
+      if (n > max_n) break;
+      for (int plies : {1, 4}) {
+        const std::string cmd =
+            "'" + self + "' --case " + std::to_string(n) + " " + std::to_string(plies) + " " + std::to_string(repeats);
+        if (std::system(cmd.c_str()) != 0) std::printf("# case %dx%d, %d plies failed\n", n, n, plies);
+      }
+    }
+    const std::string shear = std::string(SF_SOURCE_DIR) + "/bench/cases/shear_stretch_ply.yaml";
+    if (max_n >= 40) {
+      const std::string cmd = "'" + self + "' --shear-stretch '" + shear + "'";
+      if (std::system(cmd.c_str()) != 0) std::printf("# shear-and-stretch ply did not finish\n");
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "simform_bench: %s\n", e.what());
+    return 1;
+  }
 }

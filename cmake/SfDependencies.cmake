@@ -32,6 +32,8 @@ else()
 endif()
 
 find_package(Threads REQUIRED)
+# OpenMP (GCC's libgomp): the threaded element loop of simform's assembly.
+find_package(OpenMP REQUIRED COMPONENTS CXX)
 if(SF_BUILD_TESTS)
   find_package(GTest REQUIRED CONFIG)
   include(GoogleTest)

@@ -404,16 +404,22 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOp
 
 void write_pvd(const std::string& path,
                const std::vector<std::pair<double, std::string>>& time_and_relative_file) {
+  std::vector<PvdDataSet> sets;
+  for (const auto& [time, file] : time_and_relative_file) sets.push_back({time, file, 0});
+  write_pvd(path, sets);
+}
+
+void write_pvd(const std::string& path, const std::vector<PvdDataSet>& data_sets) {
   std::string xml =
       "<?xml version=\"1.0\"?>\n"
       "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       "  <Collection>\n";
-  for (const auto& [time, file] : time_and_relative_file) {
-    if (!std::isfinite(time)) {
-      throw std::logic_error(fmt::format("write_pvd: time {} of '{}' is not finite", time, file));
+  for (const PvdDataSet& d : data_sets) {
+    if (!std::isfinite(d.time)) {
+      throw std::logic_error(fmt::format("write_pvd: time {} of '{}' is not finite", d.time, d.file));
     }
-    xml += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"0\" file=\"{}\"/>\n", time,
-                       xml_escape(file));
+    xml += fmt::format("    <DataSet timestep=\"{}\" group=\"\" part=\"{}\" file=\"{}\"/>\n", d.time, d.part,
+                       xml_escape(d.file));
   }
   xml +=
       "  </Collection>\n"

@@ -89,6 +89,14 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh,
 // A ParaView collection: (time, file relative to the .pvd) per step, in the order given.
 void write_pvd(const std::string& path,
                const std::vector<std::pair<double, std::string>>& time_and_relative_file);
+// The same with several data sets per time step: each its part number (ParaView shows
+// the parts of one time together, e.g. the plies, the tools and the contact points).
+struct PvdDataSet {
+  double time = 0.0;
+  std::string file;  // relative to the .pvd
+  int part = 0;
+};
+void write_pvd(const std::string& path, const std::vector<PvdDataSet>& data_sets);
 
 // Readers (for tests and for plotting results). Every data array is converted to double.
 // Throws sf::InputError "PATH: cannot open file ..." or "PATH: cannot read VTK file (why)".

@@ -39,6 +39,7 @@ constexpr NamedKind kSolverNames[] = {
     {SolverKind::kUmfpack, "umfpack"},
     {SolverKind::kEigenLDLT, "eigen-ldlt"},
     {SolverKind::kEigenLU, "eigen-lu"},
+    {SolverKind::kCholmodLdlt, "cholmod-ldlt"},
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -61,6 +62,8 @@ class Backend {
   virtual Outcome factorize(const SparseMatrix& a) = 0;
   // x = A^-1 b; false when the library reports a failure.
   virtual bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const = 0;
+  // Flops of one numeric factorisation with the current analysis (0: unknown).
+  virtual double factor_flops() const { return 0.0; }
 };
 
 #if SF_LINALG_HAVE_SUITESPARSE
@@ -76,7 +79,7 @@ class CholmodLlt : public Wrapper {
 template <class Wrapper>
 class CholmodBackend final : public Backend {
  public:
-  CholmodBackend() { llt_.cholmod().print = 0; }  // report through SolveReport, never print
+  explicit CholmodBackend(bool ldlt = false) : ldlt_(ldlt) { llt_.cholmod().print = 0; }  // report through SolveReport
 
   Outcome analyze(const SparseMatrix& a) override {
     llt_.analyzePattern(a);
@@ -84,8 +87,11 @@ class CholmodBackend final : public Backend {
     if (llt_.factor() == nullptr || status < CHOLMOD_OK) {
       return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis failed (status {})", status)};
     }
+    flops_ = llt_.cholmod().fl;
     return {};
   }
+
+  double factor_flops() const override { return flops_; }
 
   Outcome factorize(const SparseMatrix& a) override {
     llt_.factorize(a);
@@ -97,6 +103,9 @@ class CholmodBackend final : public Backend {
                           status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "")};
     }
     const cholmod_factor* f = llt_.factor();
+    if (ldlt_)
+      return {Status::kSingular, fmt::format("zero pivot in LDL^T at {} of {} in elimination order (singular, or "
+                                             "needs pivoting)", f->minor + 1, f->n)};
     return {Status::kSingular,
             fmt::format("matrix is not positive definite: Cholesky broke down at pivot {} of {} "
                         "in elimination order; a symmetric indefinite matrix needs "
@@ -111,6 +120,8 @@ class CholmodBackend final : public Backend {
 
  private:
   CholmodLlt<Wrapper> llt_;
+  bool ldlt_ = false;
+  double flops_ = 0.0;
 };
 
 class UmfpackBackend final : public Backend {
@@ -223,6 +234,8 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
       return std::make_unique<CholmodBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>>>();
     case SolverKind::kCholmodSimplicial:
       return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>();
+    case SolverKind::kCholmodLdlt:
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true);
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif
@@ -277,10 +290,23 @@ bool solver_available(SolverKind kind) {
   switch (kind) {
     case SolverKind::kCholmod:
     case SolverKind::kCholmodSimplicial:
+    case SolverKind::kCholmodLdlt:
     case SolverKind::kUmfpack:
       return SF_LINALG_HAVE_SUITESPARSE != 0;
     default:
       return true;
+  }
+}
+
+bool reads_lower_triangle(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::kCholmod:
+    case SolverKind::kCholmodSimplicial:
+    case SolverKind::kCholmodLdlt:
+    case SolverKind::kEigenLDLT:
+      return true;
+    default:
+      return false;
   }
 }
 
@@ -361,8 +387,7 @@ struct LinearSolver::Impl {
 
 LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property)
     : impl_(std::make_unique<Impl>()) {
-  const bool needs_symmetry =
-      kind == SolverKind::kCholmod || kind == SolverKind::kCholmodSimplicial || kind == SolverKind::kEigenLDLT;
+  const bool needs_symmetry = reads_lower_triangle(kind);
   if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
     throw InputError(
         fmt::format("linear solver '{}' needs a symmetric matrix, but this system is unsymmetric "
@@ -405,10 +430,17 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   Impl& im = *impl_;
   if (!im.begin_report(a)) return im.report;
 
-  SparseMatrix copy = a;
-  copy.makeCompressed();
-  const bool reuse = im.analysed && same_pattern(copy, im.matrix);
-  im.matrix = std::move(copy);
+  // Same pattern as the analysed matrix (the Newton case): copy the values only.
+  bool reuse = false;
+  if (im.analysed && a.isCompressed() && same_pattern(a, im.matrix)) {
+    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), im.matrix.valuePtr());
+    reuse = true;
+  } else {
+    SparseMatrix copy = a;
+    copy.makeCompressed();
+    reuse = im.analysed && same_pattern(copy, im.matrix);
+    im.matrix = std::move(copy);
+  }
   if (im.matrix.rows() == 0) {  // nothing to factorise; solve() returns 0 x n_rhs
     im.analysed = false;
     im.report.status = Status::kOk;
@@ -421,6 +453,7 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   const auto start = std::chrono::steady_clock::now();
   Outcome outcome = im.backend->factorize(im.matrix);
   im.report.factor_seconds = seconds_since(start);
+  im.report.factor_flops = im.backend->factor_flops();
   im.report.status = outcome.status;
   im.report.message = std::move(outcome.message);
   return im.report;

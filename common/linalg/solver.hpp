@@ -7,6 +7,8 @@
 //   kCholmod    CHOLMOD supernodal Cholesky A = L L^T. Symmetric positive
 //               definite only; reads the lower triangle of A.
 //   kUmfpack    UMFPACK LU with partial pivoting. Any square nonsingular A.
+//   kCholmodLdlt CHOLMOD simplicial A = L D L^T (no pivoting): symmetric, definite or
+//               not, as long as no pivot vanishes; reads the lower triangle of A.
 //   kEigenLDLT  Eigen SimplicialLDLT, A = P^T L D L^T P without pivoting.
 //               Symmetric only; reads the lower triangle of A.
 //   kEigenLU    Eigen SparseLU (COLAMD ordering). Any square nonsingular A.
@@ -40,9 +42,9 @@ namespace sf::linalg {
 // kCholmod: CHOLMOD's supernodal Cholesky (dense blocks through BLAS);
 // kCholmodSimplicial: its column-by-column Cholesky, which calls no BLAS and so
 // can run on several threads at once (one solver per thread).
-enum class SolverKind { kAuto, kCholmod, kCholmodSimplicial, kUmfpack, kEigenLDLT, kEigenLU };
+enum class SolverKind { kAuto, kCholmod, kCholmodSimplicial, kUmfpack, kEigenLDLT, kEigenLU, kCholmodLdlt };
 
-// "auto", "cholmod", "cholmod-simplicial", "umfpack", "eigen-ldlt", "eigen-lu".
+// "auto", "cholmod", "cholmod-simplicial", "umfpack", "eigen-ldlt", "eigen-lu", "cholmod-ldlt".
 std::string to_string(SolverKind kind);
 
 // Inverse of to_string(SolverKind) (exact, lower case). Throws sf::InputError
@@ -53,6 +55,9 @@ SolverKind parse_solver_kind(const std::string& name, const std::string& where =
 // True when the back end is compiled in (kAuto, kEigenLDLT and kEigenLU
 // always are; kCholmod and kUmfpack need SuiteSparse).
 bool solver_available(SolverKind kind);
+// True when the back end reads only the lower triangle of A (the Cholesky and LDL^T
+// ones), so a matrix stored as its lower triangle may be passed.
+bool reads_lower_triangle(SolverKind kind);
 
 // What the caller knows about A. It selects the kAuto back end and is checked
 // against explicit back ends (kCholmod and kEigenLDLT need symmetry).
@@ -80,6 +85,8 @@ struct SolveReport {
   double analyze_seconds = 0.0;         // symbolic analysis (0 when reused)
   double factor_seconds = 0.0;          // numeric factorisation
   double solve_seconds = 0.0;           // most recent solve() (all its right-hand sides)
+  double factor_flops = 0.0;            // floating-point operations of the numeric factorisation
+                                        // as the library counts them (CHOLMOD), 0 when unknown
 
   bool ok() const { return status == Status::kOk; }
   // One line, e.g. "cholmod n=900 nnz=4380: ok; analyse 0.0004 s, factor 0.0011 s, solve 0.0001 s"

@@ -60,6 +60,9 @@ class TripletAssembler {
   // Drops all triplets (keeps the capacity and the size).
   void clear() { triplets_.clear(); }
 
+  // The triplets added so far (duplicates not summed), in the order they were added.
+  const std::vector<Eigen::Triplet<double, int>>& triplets() const { return triplets_; }
+
  private:
   Index n_rows_;
   Index n_cols_;

@@ -8,6 +8,8 @@
 #include "common/core/error.hpp"
 #include "common/mesh/surface_mesh.hpp"
 #include "forming/case/checks.hpp"
+#include "forming/contact/body_contact.hpp"
+#include "forming/contact/tool_contact.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
@@ -105,12 +107,30 @@ Prescriptions build_prescriptions(const FormingCase& spec, const Model& model) {
   return out;
 }
 
+void add_contacts(const FormingCase& spec, Model& model) {
+  for (const CaseContact& c : spec.contacts) {
+    ContactOptions o;
+    o.normal = c.law.normal;
+    o.friction = c.law.friction;
+    o.points = c.law.points;
+    ContactSurface slave = ContactSurface::whole_face(model, c.ply, c.top);
+    if (c.tool >= 0) {
+      model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),
+                                                          spec.tools.at(static_cast<std::size_t>(c.tool)).tool, o));
+    } else {
+      model.add_interaction(std::make_shared<BodyContact>(
+          c.label, model, std::move(slave), ContactSurface::whole_face(model, c.with, c.with_top), o));
+    }
+  }
+}
+
 Problem build_problem(const FormingCase& spec) {
   Problem problem{build_model(spec), {}, {}, {}};
   problem.loads = build_loads(spec, problem.model);
   problem.prescriptions = build_prescriptions(spec, problem.model);
   for (const CasePly& p : spec.plies)
     problem.density.push_back(spec.materials.at(static_cast<std::size_t>(p.material_index)).density);
+  add_contacts(spec, problem.model);
   return problem;
 }
 
@@ -126,6 +146,7 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.statics.min_increment = s.min_increment;
   out.statics.validate();
   out.uzawa.tolerance = s.constraint_tolerance;
+  out.process_time = s.process_time;
 
   if (s.dynamic) {
     DynamicOptions& d = out.dynamics;

@@ -10,7 +10,10 @@
 //                        over the side faces, point forces on value dofs);
 //   build_prescriptions  the boundary conditions as prescribed dofs
 //                        (forming/model/prescriptions.hpp);
-//   build_problem        all three and the densities (forming/model/problem.hpp);
+//   add_contacts         one interaction per contact pair (forming/contact/): a
+//                        ToolContact against a tool, a BodyContact against a ply, the
+//                        slave being the pair's first ply (all faces of its side);
+//   build_problem        all of these and the densities (forming/model/problem.hpp);
 //   stepper_settings     the solver section as settings of the chosen stepper
 //                        (forming/solve/stepper.hpp).
 #include "forming/case/schema.hpp"
@@ -27,6 +30,7 @@ RampedLoads build_loads(const FormingCase& spec, const Model& model);
 // Throws sf::InputError at the later of two conditions that prescribe a dof differently
 // (check_case_*() reports it first).
 Prescriptions build_prescriptions(const FormingCase& spec, const Model& model);
+void add_contacts(const FormingCase& spec, Model& model);
 Problem build_problem(const FormingCase& spec);
 
 // Throws sf::InputError naming the option if a setting is out of range.

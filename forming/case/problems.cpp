@@ -14,6 +14,7 @@ std::string to_string(ProblemKind kind) {
     case ProblemKind::kOutOfRange: return "out-of-range";
     case ProblemKind::kUnknownMaterial: return "unknown-material";
     case ProblemKind::kUnknownPly: return "unknown-ply";
+    case ProblemKind::kUnknownTool: return "unknown-tool";
     case ProblemKind::kConflict: return "conflict";
     case ProblemKind::kUnsupported: return "unsupported";
     case ProblemKind::kNothingHeld: return "nothing-held";

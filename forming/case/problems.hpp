@@ -20,6 +20,7 @@ enum class ProblemKind {
   kOutOfRange,       // a value outside its range, or a material set the law cannot reach
   kUnknownMaterial,  // a ply names a material not defined (name = the material)
   kUnknownPly,       // a condition or load names a ply not defined (name = the ply)
+  kUnknownTool,      // a contact names a tool not defined (name = the tool)
   kConflict,         // two boundary conditions prescribe a dof differently
   kUnsupported,      // a combination the solver does not handle (yet)
   kNothingHeld,      // no boundary condition holds any ply

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -13,141 +14,23 @@
 
 #include "common/core/error.hpp"
 #include "forming/case/checks.hpp"
+#include "forming/case/contact_reader.hpp"
+#include "forming/case/yaml_reader.hpp"
 
 namespace sf::forming {
 
+using case_yaml::describe;
+using case_yaml::place_of;
+using case_yaml::pair_of;
+using case_yaml::ply_of;
+using case_yaml::ramp_of;
+using case_yaml::Reader;
+using case_yaml::vector3;
+
 namespace {
 
-SourcePlace place_of(const YAML::Node& n) {
-  if (!n.IsDefined()) return {};
-  const YAML::Mark m = n.Mark();
-  if (m.is_null()) return {};
-  return {m.line + 1, m.column + 1};
-}
-
-std::string describe(const YAML::Node& n) {
-  if (!n.IsDefined()) return "nothing";
-  switch (n.Type()) {
-    case YAML::NodeType::Null: return "null";
-    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a mapping";
-    default: return "nothing";
-  }
-}
-
-// Collects problems while walking the document; every accessor returns what it could
-// read (or nothing) and records a problem otherwise, so the walk goes on.
-class Reader {
- public:
-  explicit Reader(std::vector<CaseProblem>& problems) : problems_(problems) {}
-
-  void problem(ProblemKind kind, const YAML::Node& at, const std::string& message, const std::string& name = {}) {
-    problems_.push_back({kind, place_of(at), message, name});
-  }
-  void problem(ProblemKind kind, SourcePlace at, const std::string& message) {
-    problems_.push_back({kind, at, message, {}});
-  }
-
-  // `n` must be a mapping whose keys are all in `allowed` (no duplicates).
-  bool mapping(const YAML::Node& n, const std::string& what, const std::vector<std::string>& allowed) {
-    if (!n.IsMap()) {
-      problem(ProblemKind::kWrongType, n, what + ": expected a mapping (key: value), found " + describe(n));
-      return false;
-    }
-    std::set<std::string> seen;
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string key = it->first.Scalar();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        std::string list;
-        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        problem(ProblemKind::kUnknownKey, it->first,
-                what + ": unknown key '" + key + "' (expected one of: " + list + ")");
-      } else if (!seen.insert(key).second) {
-        problem(ProblemKind::kDuplicate, it->first, what + ": key '" + key + "' given twice");
-      }
-    }
-    return true;
-  }
-
-  std::optional<double> number(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar()) {
-      problem(ProblemKind::kWrongType, n, what + ": expected a number, found " + describe(n));
-      return std::nullopt;
-    }
-    const std::string& s = n.Scalar();
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) {
-      problem(ProblemKind::kWrongType, n, what + ": expected a finite number, found '" + s + "'");
-      return std::nullopt;
-    }
-    return v;
-  }
-
-  std::optional<double> positive(const YAML::Node& n, const std::string& what, const std::string& unit) {
-    const std::optional<double> v = number(n, what);
-    if (v && !(*v > 0.0)) {
-      problem(ProblemKind::kOutOfRange, n, what + ": expected a positive value (" + unit + "), found " + n.Scalar());
-      return std::nullopt;
-    }
-    return v;
-  }
-
-  std::optional<int> integer(const YAML::Node& n, const std::string& what, int lo, int hi) {
-    if (!n.IsScalar()) {
-      problem(ProblemKind::kWrongType, n, what + ": expected an integer, found " + describe(n));
-      return std::nullopt;
-    }
-    const std::string& s = n.Scalar();
-    char* end = nullptr;
-    errno = 0;
-    const long v = std::strtol(s.c_str(), &end, 10);
-    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE) {
-      problem(ProblemKind::kWrongType, n, what + ": expected an integer, found '" + s + "'");
-      return std::nullopt;
-    }
-    if (v < lo || v > hi) {
-      problem(ProblemKind::kOutOfRange, n,
-              what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " +
-                  s);
-      return std::nullopt;
-    }
-    return static_cast<int>(v);
-  }
-
-  std::optional<bool> boolean(const YAML::Node& n, const std::string& what) {
-    if (n.IsScalar()) {
-      const std::string& s = n.Scalar();
-      if (s == "true" || s == "yes" || s == "on") return true;
-      if (s == "false" || s == "no" || s == "off") return false;
-    }
-    problem(ProblemKind::kWrongType, n, what + ": expected true or false, found " + describe(n));
-    return std::nullopt;
-  }
-
-  std::optional<std::string> text(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar() || n.Scalar().empty()) {
-      problem(ProblemKind::kWrongType, n, what + ": expected a name, found " + describe(n));
-      return std::nullopt;
-    }
-    return n.Scalar();
-  }
-
-  // A required key of mapping `parent`; records "missing" at the parent.
-  YAML::Node required(const YAML::Node& parent, const std::string& key, const std::string& what) {
-    const YAML::Node n = parent[key];
-    if (!n.IsDefined()) problem(ProblemKind::kMissing, parent, what + ": missing required key '" + key + "'");
-    return n;
-  }
-
- private:
-  std::vector<CaseProblem>& problems_;
-};
-
-const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "boundary_conditions", "loads", "solver",
-                                           "output"};
+const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "laminates", "boundary_conditions",
+                                           "loads", "solver", "tools", "contact", "output"};
 
 // The law of material `what` under key `law` (neo_hookean: {E, nu} or {mu, lambda});
 // false (with a problem) when it cannot be read or the law rejects the constants.
@@ -274,15 +157,6 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   if (ok) spec.materials.push_back(m);
 }
 
-// [a, b] of positive numbers, or [n1, n2] of integers.
-bool pair_of(Reader& r, const YAML::Node& n, const std::string& what) {
-  if (!n.IsSequence() || n.size() != 2) {
-    r.problem(ProblemKind::kWrongType, n, what + ": expected a list of two values [x, y], found " + describe(n));
-    return false;
-  }
-  return true;
-}
-
 void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   std::string what = "ply " + std::to_string(index + 1);
   if (!r.mapping(n, what, {"name", "origin", "size", "thickness", "elements", "angle", "material"})) return;
@@ -360,38 +234,6 @@ std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string
   return std::nullopt;
 }
 
-// The required key "ply" of a condition or load: its name and index; false (with a
-// problem recorded) when missing, not a name or not a ply of the case.
-bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, const FormingCase& spec, std::string& name,
-            int& index) {
-  const YAML::Node p = r.required(b, "ply", what);
-  if (!p.IsDefined()) return false;
-  const auto text = r.text(p, what + " ply");
-  if (!text) return false;
-  name = *text;
-  index = spec.find_ply(*text);
-  if (index < 0) {
-    r.problem(ProblemKind::kUnknownPly, p, what + ": unknown ply '" + *text + "'", *text);
-    return false;
-  }
-  return true;
-}
-
-// The optional key "ramp" (linear or smooth) into `ramp`; false on a bad value.
-bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ramp& ramp) {
-  const YAML::Node rp = b["ramp"];
-  if (!rp.IsDefined()) return true;
-  if (rp.IsScalar() && rp.Scalar() == "linear") {
-    ramp = Ramp::kLinear;
-  } else if (rp.IsScalar() && rp.Scalar() == "smooth") {
-    ramp = Ramp::kSmooth;
-  } else {
-    r.problem(ProblemKind::kWrongType, rp, what + " ramp: expected linear or smooth, found " + describe(rp));
-    return false;
-  }
-  return true;
-}
-
 void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   const std::string what = "boundary condition " + std::to_string(index + 1);
   if (!r.mapping(n, what, {"clamp", "displacement", "symmetry"})) return;
@@ -447,20 +289,6 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     if (!ramp_of(r, b, bw, bc.ramp)) ok = false;
   }
   if (ok) spec.boundaries.push_back(bc);
-}
-
-std::optional<Vec3> vector3(Reader& r, const YAML::Node& n, const std::string& what, const std::string& unit) {
-  if (!n.IsSequence() || n.size() != 3) {
-    r.problem(ProblemKind::kWrongType, n, what + ": expected [x, y, z] (" + unit + "), found " + describe(n));
-    return std::nullopt;
-  }
-  Vec3 v;
-  for (int i = 0; i < 3; ++i) {
-    const auto c = r.number(n[i], what);
-    if (!c) return std::nullopt;
-    v[i] = *c;
-  }
-  return v;
 }
 
 // The keys of each load kind (the ply is read before); false (with problems) when one
@@ -590,7 +418,7 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment",
                                "constraint_tolerance", "analysis", "end_time", "time_step", "integrator", "rho_inf",
-                               "control", "arc_length", "stop_displacement"}))
+                               "control", "arc_length", "stop_displacement", "process_time"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -623,6 +451,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   }
   if (n["end_time"].IsDefined())
     if (const auto v = r.positive(n["end_time"], "solver end_time", "s")) s.end_time = *v;
+  if (n["process_time"].IsDefined())
+    if (const auto v = r.positive(n["process_time"], "solver process_time", "s, of the whole load")) s.process_time = *v;
   if (n["time_step"].IsDefined())
     if (const auto v = r.positive(n["time_step"], "solver time_step", "s")) s.time_step = *v;
   if (const YAML::Node i = n["integrator"]; i.IsDefined()) {
@@ -695,7 +525,16 @@ void drop_unknown_names(std::vector<CaseProblem>& problems, std::size_t from, Pr
   problems.erase(std::remove_if(problems.begin() + static_cast<long>(from), problems.end(), follow_on), problems.end());
 }
 
-void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::vector<CaseProblem>& problems) {
+// Names of the tools listed (read or not); false when there are none.
+bool ts_names(const YAML::Node& root, std::set<std::string>& names) {
+  if (const YAML::Node ts = root["tools"]; ts.IsDefined() && ts.IsSequence())
+    for (const YAML::Node& t : ts)
+      if (t.IsMap() && t["name"].IsScalar()) names.insert(t["name"].Scalar());
+  return !names.empty();
+}
+
+void read_document(Reader& r, const YAML::Node& root, const std::string& case_dir, FormingCase& spec,
+                   std::vector<CaseProblem>& problems) {
   if (!root.IsDefined() || root.IsNull()) {
     r.problem(ProblemKind::kMissing, SourcePlace{1, 1},
               "empty case file: expected materials, plies, boundary_conditions");
@@ -728,7 +567,9 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
   std::set<std::string> material_names;
   if (const YAML::Node ms = root["materials"]; ms.IsMap())
     for (auto it = ms.begin(); it != ms.end(); ++it) material_names.insert(it->first.Scalar());
-  if (const YAML::Node ps = r.required(root, "plies", "case"); ps.IsDefined()) {
+  // Plies come from `plies`, `laminates` or both.
+  const YAML::Node ps = root["laminates"].IsDefined() ? root["plies"] : r.required(root, "plies", "case");
+  if (ps.IsDefined()) {
     if (!ps.IsSequence() || ps.size() == 0) {
       r.problem(ProblemKind::kWrongType, ps, "plies: expected a list of plies (- name: ...), found " + describe(ps));
     } else {
@@ -740,13 +581,32 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
       }
     }
   }
+  if (const YAML::Node ls = root["laminates"]; ls.IsDefined()) {
+    const std::size_t before = problems.size();
+    read_laminates(r, ls, spec);
+    drop_unknown_names(problems, before, ProblemKind::kUnknownMaterial, material_names);
+  }
   std::set<std::string> ply_names;
-  if (const YAML::Node ps = root["plies"]; ps.IsSequence())
-    for (const YAML::Node& p : ps)
+  if (const YAML::Node listed = root["plies"]; listed.IsDefined() && listed.IsSequence())
+    for (const YAML::Node& p : listed)
       if (p.IsMap() && p["name"].IsScalar()) ply_names.insert(p["name"].Scalar());
+  // A name "<laminate>.<k>" of a laminate that failed to read: its own problem is enough.
+  std::set<std::string> failed_laminates;
+  if (const YAML::Node ls = root["laminates"]; ls.IsDefined() && ls.IsSequence())
+    for (const YAML::Node& l : ls)
+      if (l.IsMap() && l["name"].IsScalar() &&
+          std::none_of(spec.laminates.begin(), spec.laminates.end(),
+                       [&](const CaseLaminate& c) { return c.name == l["name"].Scalar(); }))
+        failed_laminates.insert(l["name"].Scalar());
+  const auto laminate_ply = [&failed_laminates](const CaseProblem& p) {
+    const std::size_t dot = p.name.rfind('.');
+    return p.kind == ProblemKind::kUnknownPly && dot != std::string::npos && failed_laminates.count(p.name.substr(0, dot));
+  };
   // A condition or load naming a ply that exists but was bad: the ply's own problem is enough.
   auto drop_unknown_ply_problems = [&](std::size_t from) {
     drop_unknown_names(problems, from, ProblemKind::kUnknownPly, ply_names);
+    problems.erase(std::remove_if(problems.begin() + static_cast<long>(from), problems.end(), laminate_ply),
+                   problems.end());
   };
   if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
     if (!bs.IsSequence() || bs.size() == 0) {
@@ -772,6 +632,15 @@ void read_document(Reader& r, const YAML::Node& root, FormingCase& spec, std::ve
     }
   }
   if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
+  if (const YAML::Node ts = root["tools"]; ts.IsDefined()) read_tools(r, ts, case_dir, spec);
+  if (const YAML::Node cs = root["contact"]; cs.IsDefined()) {
+    const std::size_t before = problems.size();
+    read_contacts(r, cs, spec);
+    drop_unknown_ply_problems(before);
+    std::set<std::string> tool_names;
+    if (ts_names(root, tool_names))
+      drop_unknown_names(problems, before, ProblemKind::kUnknownTool, tool_names);
+  }
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
 }
 
@@ -790,7 +659,7 @@ CaseCheck check_case_text(const std::string& text, const std::string& name) {
     return result;
   }
   try {
-    read_document(r, root, result.spec, result.problems);
+    read_document(r, root, std::filesystem::path(name).parent_path().string(), result.spec, result.problems);
   } catch (const YAML::Exception& e) {
     result.problems.push_back(
         {ProblemKind::kUnreadable, {e.mark.line + 1, e.mark.column + 1}, std::string("cannot read: ") + e.msg, {}});

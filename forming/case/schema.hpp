@@ -26,7 +26,19 @@
 // inextensibility), clamps, prescribed edge displacements and symmetry planes;
 // follower or dead pressure, gravity, edge and point forces, each with its ramp;
 // quasi-static load control, arc-length control (through limit points) or implicit
-// dynamics with inertia. Not yet: contact, tools, inter-ply slip.
+// dynamics with inertia; laminates of separate plies from a layup, rigid tools moving
+// by prescribed time functions, and contact (penalty or augmented Lagrangian, viscous
+// and Coulomb friction) between plies and between plies and tools:
+//
+//   laminates:
+//     - {name: lam, size: [100, 100], elements: [10, 10], layup: "[0,90]s",
+//        ply_thickness: 0.5, material: gfpp, interface: {stiffness: 1000, viscous: 0.02}}
+//   tools:
+//     - {name: punch, sphere: {centre: [50, 50, 27], radius: 25},
+//        motion: {displacement: [0, 0, -10], ramp: linear}}
+//   contact:
+//     - {ply: lam.4, face: top, tool: punch, stiffness: 1000}
+//     - {ply: a, face: top, with: b, with_face: bottom, stiffness: 1000, viscous: 0.02}
 //
 // Units: those of the file (the samples use mm, N, MPa, s, t/mm^3).
 
@@ -36,6 +48,8 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "forming/contact/contact_law.hpp"
+#include "forming/contact/rigid_tool.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
@@ -135,8 +149,49 @@ struct CaseSolver {
   // steps, the run ends past lambda 1.
   double arc_length = 0.0;       // mm; 0 = load control
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
+  // Load control: the process time of the load factor (t = lambda process_time, s):
+  // tools move with it and friction takes its slip rates over it.
+  double process_time = 1.0;     // s
   SourcePlace analysis_place;      // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;       // of the value of "control"; 0: not given
+};
+
+// A laminate: plies of one rectangle and mesh stacked bottom first, each its own body
+// named "<name>.<k>" (k = 1 bottom .. n top) in spec.plies, with contact between
+// neighbours (top of ply k against the bottom of ply k + 1; in spec.contacts).
+struct CaseLaminate {
+  std::string name;
+  std::string layup;            // as given (a string), or "list" for an explicit list
+  std::vector<double> angles;   // degrees, bottom first
+  int first_ply = 0;            // index of ply 1 in spec.plies
+  SourcePlace place;
+};
+
+// The laws of one contact pair (forming/contact/contact_law.hpp).
+struct CaseContactLaw {
+  NormalLaw normal;    // stiffness S_n (N/mm^3), augmented + tolerance (mm)
+  FrictionLaw friction;  // viscous c_f (N s/mm^3), coulomb mu, stick_velocity (mm/s), engage_gap (mm)
+  int points = 6;      // contact points per face direction
+};
+
+struct CaseTool {
+  std::string name;
+  RigidTool tool;      // shape at rest and motion
+  std::string file;    // mesh tools: the STL as resolved (relative to the case file)
+  SourcePlace place;
+};
+
+// A contact pair: the `face` of ply `ply` (slave: its contact points) against a tool or
+// against the `with_face` of ply `with`.
+struct CaseContact {
+  int ply = -1;
+  bool top = true;
+  int tool = -1;        // index into spec.tools, or -1
+  int with = -1;        // index into spec.plies, or -1
+  bool with_top = false;
+  CaseContactLaw law;
+  std::string label;    // "lam.1/lam.2", "lam.4/punch"
+  SourcePlace place;
 };
 
 struct CaseOutput {
@@ -152,6 +207,9 @@ struct FormingCase {
   std::vector<CasePly> plies;
   std::vector<CaseBoundary> boundaries;
   std::vector<CaseLoad> loads;
+  std::vector<CaseLaminate> laminates;
+  std::vector<CaseTool> tools;
+  std::vector<CaseContact> contacts;
   CaseSolver solver;
   CaseOutput output;
 

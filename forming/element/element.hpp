@@ -156,6 +156,48 @@ ElementResult plane_element(const PlaneParams& X_e, const PlaneParams& x_e, cons
                             const quadrature::TensorRule<2>& rule, bool want_tangent,
                             const ConstraintTerms& constraints = ConstraintTerms{});
 
+// The brick kernel as the model's assembly runs it: the basis derivatives at the rule's
+// points are computed once, and each call reuses the caller's buffers (no allocation
+// once `out` and `scratch` have their sizes). Same results as brick_element() up to
+// rounding.
+//
+// How the tangent is computed (and why it is fast): in the coordinate-major local order
+// c = 32 i + k (coordinate i, function k) the material part is
+//   K_mat = sum_q B_q^T (dV_q CC_q B_q),  B_q: 6 x 96 (the header's B, columns permuted),
+// one product A^T B with A = [B_1; ...; B_Q] and B = [dV CC B_1; ...] of depth 6 Q,
+// of which only the lower triangle is formed (linalg::add_atb_lower, register-blocked and
+// compiled for AVX-512, AVX2 + FMA and SSE2, chosen at run time: linalg::kernel_isa()).
+// The initial-stress part is one 32 x 32 product of depth 3 Q added to the three
+// diagonal coordinate blocks. B and dV CC B are formed together in vector registers. The
+// symmetric result is then written to out.tangent in the header's order D k + i.
+struct BrickScratch {
+  std::vector<double> b, d, ga, gb, k_mat, k_geo;
+};
+
+class BrickKernel {
+ public:
+  explicit BrickKernel(const quadrature::TensorRule<3>& rule);
+  int n_points() const { return static_cast<int>(weights_.size()); }
+  // As brick_element(X_e, x_e, material, rule, want_tangent, constraints), into `out`.
+  void evaluate(const BrickParams& X_e, const BrickParams& x_e, const Material& material, bool want_tangent,
+                const ConstraintTerms& constraints, BrickScratch& scratch, ElementResult& out) const;
+  // Floating-point operations of one evaluation with the tangent (counted from the
+  // algorithm: products, B and dV CC B, kinematics and force; not the material law).
+  double tangent_flops() const;
+  // ... and of one evaluation without it.
+  double force_flops() const;
+
+ private:
+  std::vector<double> weights_;
+  std::vector<double> dxi_;  // per point 3 x 32: dN_k/dxi_a at [96 q + 32 a + k]
+};
+
+// The straightforward per-point implementation (B^T CC B over the full 96 x 96 at each
+// Gauss point); what the tests check BrickKernel against.
+ElementResult brick_element_reference(const BrickParams& X_e, const BrickParams& x_e, const Material& material,
+                                      const quadrature::TensorRule<3>& rule, bool want_tangent,
+                                      const ConstraintTerms& constraints = ConstraintTerms{});
+
 // Deformation gradient at every point of the rule (order of rule.points); the plane
 // element's F is embedded in 3 x 3 with F_33 = 1.
 std::vector<Mat3> brick_deformation_gradients(const BrickParams& X_e, const BrickParams& x_e,

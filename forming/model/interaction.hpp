@@ -9,11 +9,16 @@
 //
 // What an interaction sees (InteractionContext + the positions):
 //   x         current positions of all bodies, n_dofs (mm), Model numbering;
+//   time      s: in dynamic runs t_{n+1-af}; in quasi-static load steps the process time
+//             lambda * process_time (forming/solve/static_solver.hpp ProcessClock; a tool
+//             moves with it); 0 where the solver has no clock (arc length);
 //   velocity  dx/dt, n_dofs (mm/s), where the solver has one (dynamic runs: at the
 //             generalised-alpha point), else null;
-//   time      s in dynamic runs (t_{n+1-af}); 0 in quasi-static solves for now (a tool
-//             moving with the process in a quasi-static run will need the stepper to
-//             pass the step's load factor down: the place for it is this field).
+//   previous, previous_time  quasi-static runs with a process time: the last converged
+//             state and its time, so rates are finite differences over the step,
+//               v = (x - previous) / (time - previous_time)   where time > previous_time
+//             (rates() below); a velocity-dependent interaction (friction) then adds the
+//             1/dt of that difference to its stiffness.
 // What it adds (InteractionSums, added to, never overwritten):
 //   energy    its stored energy, N mm (0 for a dissipative interaction);
 //   force     its force on the dofs with the sign of an internal force: the gradient of
@@ -24,8 +29,15 @@
 // A state the interaction cannot evaluate (e.g. a contact search that fails) is a
 // numerical outcome: set `ok` false and a message, as an inverted element does.
 //
-// Tools report their reaction (the force the bodies exert on the tool, N) through
-// reactions(), one entry per tool, for history.csv.
+// State. An interaction may carry state the solvers update between solves:
+//   commit()              after every converged step (the steppers, forming/solve/
+//                         stepper.hpp): history such as accumulated slip and dissipation,
+//                         with the step's start state in context.previous;
+//   update_multipliers()  augmented Lagrangian: after a converged solve, the steppers ask
+//                         every interaction to update its multipliers from the state and
+//                         repeat the solve until each reports its constraint met.
+// Tools report their reaction (the force the bodies exert on the tool, N) and their
+// displacement through reactions(), one entry per tool, for history.csv.
 //
 // Units: mm, N, s.
 
@@ -38,10 +50,14 @@
 
 namespace sf::forming {
 
-// Time and velocities an assembly is evaluated with (positions are passed separately).
+// Time and rates an assembly is evaluated with (positions are passed separately).
 struct InteractionContext {
-  double time = 0.0;               // s (dynamic); 0 in quasi-static solves
+  double time = 0.0;               // s
   const VecX* velocity = nullptr;  // n_dofs, mm/s; null where the solver has none
+  const VecX* previous = nullptr;  // n_dofs, mm: last converged state (quasi-static), or null
+  double previous_time = 0.0;      // s, of `previous`
+  // True when rates can be formed: velocities given, or a previous state at an earlier time.
+  bool has_rates() const { return velocity != nullptr || (previous != nullptr && time > previous_time); }
 };
 
 // Running sums of one assembly that interactions add to.
@@ -54,10 +70,19 @@ struct InteractionSums {
   linalg::TripletAssembler* damping = nullptr;     // d force / dv, or null: not wanted
 };
 
-// Reaction on a tool: the resultant force the bodies exert on it (N).
+// Reaction on a tool: the resultant force the bodies exert on it (N) and where the tool
+// is (its displacement from rest, mm).
 struct ToolReaction {
   std::string tool;
   Vec3 force = Vec3::Zero();
+  Vec3 displacement = Vec3::Zero();
+};
+
+// What an augmented-Lagrangian update found (before updating).
+struct MultiplierUpdate {
+  bool converged = true;   // the constraint was met to its tolerance: nothing was updated
+  double violation = 0.0;  // e.g. the largest penetration, mm
+  double tolerance = 0.0;  // the same units
 };
 
 class Interaction {
@@ -75,6 +100,18 @@ class Interaction {
   // Reactions on the tools it drives at positions x (none for a body-body interaction).
   virtual std::vector<ToolReaction> reactions(const Eigen::Ref<const VecX>& x,
                                               const InteractionContext& context) const {
+    (void)x;
+    (void)context;
+    return {};
+  }
+  // After a converged step reaching x (context.previous: the step's start, if known).
+  virtual void commit(const Eigen::Ref<const VecX>& x, const InteractionContext& context) {
+    (void)x;
+    (void)context;
+  }
+  // Augmented Lagrangian: measure the constraint at the converged state x; when it is not
+  // met, update the multipliers (the caller then solves again). Default: nothing to do.
+  virtual MultiplierUpdate update_multipliers(const Eigen::Ref<const VecX>& x, const InteractionContext& context) {
     (void)x;
     (void)context;
     return {};

@@ -1,6 +1,9 @@
 #include "forming/model/model.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
+#include <atomic>
 #include <limits>
 #include <sstream>
 #include <utility>
@@ -20,7 +23,9 @@ std::string short_number(double v) {
 
 }  // namespace
 
-Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()) {}
+Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()), kernel_(brick_rule_) {}
+
+int Model::threads() const { return threads_ > 0 ? threads_ : omp_get_max_threads(); }
 
 int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
   if (!material) throw InputError("model: ply added without a material");
@@ -36,17 +41,26 @@ int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const 
   }
   bodies_.push_back(std::move(b));
   n_dofs_ += n;
-  return n_bodies() - 1;
+  const int body = n_bodies() - 1;
+  const Body& added = bodies_.back();
+  for (Index e = 0; e < ne; ++e) {
+    bricks_.emplace_back(body, e);
+    const ElementDofs ed = element_dofs(body, e);
+    entries_.push_back({ed.dofs, ed.coefs, ed.local});
+    reference_params_.push_back(added.ply.element_parameters(e, added.ply.reference()));
+  }
+  colours_ = linalg::colour_elements(n_dofs_, entries_);
+  return body;
 }
 
-int Model::add_interaction(std::shared_ptr<const Interaction> interaction) {
+int Model::add_interaction(std::shared_ptr<Interaction> interaction) {
   if (!interaction) throw InputError("model: interaction added as a null pointer");
   interactions_.push_back(std::move(interaction));
   return n_interactions() - 1;
 }
 
 bool Model::symmetric_tangent() const {
-  for (const std::shared_ptr<const Interaction>& i : interactions_)
+  for (const std::shared_ptr<Interaction>& i : interactions_)
     if (!i->symmetric()) return false;
   return true;
 }
@@ -125,6 +139,158 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, bool want_tangent) con
 }
 
 Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent) const {
+  if (!want_tangent) return assemble_into(x, context, nullptr);
+  // The full tangent over every dof, through a pattern built for this call.
+  linalg::PatternAssembler full = make_pattern(std::vector<bool>(static_cast<std::size_t>(n_dofs_), true), false);
+  Assembly out = assemble_into(x, context, &full);
+  if (out.ok) out.tangent = std::move(full.matrix());
+  return out;
+}
+
+linalg::PatternAssembler Model::make_pattern(const std::vector<bool>& active, bool symmetric) const {
+  SF_ASSERT(static_cast<Index>(active.size()) == n_dofs_, "one flag per dof");
+  return linalg::PatternAssembler(n_dofs_, active, entries_, symmetric ? linalg::Storage::kLower : linalg::Storage::kFull);
+}
+
+namespace {
+
+// Per-thread buffers of the element loop (kept between assemblies: OpenMP's threads persist).
+struct ThreadWork {
+  BrickScratch scratch;
+  ElementResult result;
+  BrickParams x_e;
+  Eigen::Matrix<double, kBrickDofs, 1> v_e, y_e;
+};
+
+}  // namespace
+
+Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                              linalg::PatternAssembler* tangent, const VecX* direction) const {
+  SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
+  SF_ASSERT(!direction || direction->size() == n_dofs_, "direction must have n_dofs entries");
+  SF_ASSERT(!tangent || (tangent->n_dofs() == n_dofs_ && tangent->n_elements() == static_cast<Index>(bricks_.size())),
+            "pattern made for another model");
+  Assembly out;
+  out.force = VecX::Zero(n_dofs_);
+  if (direction) out.tangent_times = VecX::Zero(n_dofs_);
+  if (tangent) tangent->set_zero();
+  const bool need_k = tangent != nullptr || direction != nullptr;
+  const std::vector<std::vector<Index>>& colours = tangent ? tangent->colours() : colours_;
+  const Index n_el = static_cast<Index>(bricks_.size());
+  std::vector<double> energies(static_cast<std::size_t>(n_el), 0.0);
+  std::atomic<Index> first_failed{n_el};
+  std::vector<ElementResult::Status> status(static_cast<std::size_t>(n_el), ElementResult::Status::kOk);
+  std::vector<double> min_det(static_cast<std::size_t>(n_el), 0.0);
+  const double* xp = x.data();
+  double* force = out.force.data();
+  double* ktimes = direction ? out.tangent_times.data() : nullptr;
+  // At least kMinElementsPerThread bricks (~5 ms of kernels) per thread: below that the
+  // barriers between colours cost more than they save, badly so on a loaded machine
+  // where a waiting thread spins while the other is descheduled.
+  constexpr Index kMinElementsPerThread = 48;
+  const int n_threads = std::max(1, std::min(threads(), static_cast<int>(n_el / kMinElementsPerThread)));
+  std::atomic<bool> input_error{false};
+  std::string input_message;
+#pragma omp parallel num_threads(n_threads)
+  {
+    thread_local ThreadWork w;
+    for (const std::vector<Index>& colour : colours) {
+      const Index n_c = static_cast<Index>(colour.size());
+#pragma omp for schedule(dynamic, 4)
+      for (Index i = 0; i < n_c; ++i) {
+        const Index g = colour[static_cast<std::size_t>(i)];
+        if (first_failed.load(std::memory_order_relaxed) < n_el || input_error.load(std::memory_order_relaxed))
+          continue;
+        const auto [body, e] = bricks_[static_cast<std::size_t>(g)];
+        const Body& b = bodies_[static_cast<std::size_t>(body)];
+        const linalg::ElementEntries& en = entries_[static_cast<std::size_t>(g)];
+        const int m = static_cast<int>(en.dofs.size());
+        w.x_e.setZero();
+        double* xe = w.x_e.data();  // column-major 32 x 3: entry 3 k + i at k + 32 i
+        for (int a = 0; a < m; ++a) {
+          const int l = en.local[static_cast<std::size_t>(a)];
+          xe[l / 3 + kBrickFunctions * (l % 3)] += en.coefs[static_cast<std::size_t>(a)] * xp[en.dofs[static_cast<std::size_t>(a)]];
+        }
+        try {
+          kernel_.evaluate(reference_params_[static_cast<std::size_t>(g)], w.x_e, *b.material, need_k,
+                           element_constraints(b, e), w.scratch, w.result);
+        } catch (const std::exception& ex) {  // bad constraint input: rethrown after the loop
+#pragma omp critical(sf_model_input_error)
+          {
+            if (!input_error.load()) input_message = ex.what();
+            input_error.store(true);
+          }
+          continue;
+        }
+        const ElementResult& r = w.result;
+        status[static_cast<std::size_t>(g)] = r.status;
+        min_det[static_cast<std::size_t>(g)] = r.min_det_f;
+        if (!r.ok()) {
+          Index seen = first_failed.load();
+          while (g < seen && !first_failed.compare_exchange_weak(seen, g)) {
+          }
+          continue;
+        }
+        energies[static_cast<std::size_t>(g)] = r.energy;
+        for (int a = 0; a < m; ++a)
+          force[en.dofs[static_cast<std::size_t>(a)]] +=
+              en.coefs[static_cast<std::size_t>(a)] * r.force(en.local[static_cast<std::size_t>(a)]);
+        if (tangent) tangent->add_element(g, r.tangent.data(), kBrickDofs);
+        if (direction) {
+          w.v_e.setZero();
+          bool any = false;
+          for (int a = 0; a < m; ++a) {
+            const double v = (*direction)(en.dofs[static_cast<std::size_t>(a)]);
+            if (v != 0.0) {
+              w.v_e(en.local[static_cast<std::size_t>(a)]) += en.coefs[static_cast<std::size_t>(a)] * v;
+              any = true;
+            }
+          }
+          if (any) {
+            w.y_e.noalias() = r.tangent * w.v_e;
+            for (int a = 0; a < m; ++a)
+              ktimes[en.dofs[static_cast<std::size_t>(a)]] +=
+                  en.coefs[static_cast<std::size_t>(a)] * w.y_e(en.local[static_cast<std::size_t>(a)]);
+          }
+        }
+      }
+    }
+  }
+  if (input_error.load()) throw InputError(input_message);
+  // The element that failed first in element order among those evaluated: with
+  // failures, the loop skips elements, so which one is named may depend on the timing;
+  // that the state is inadmissible does not.
+  if (first_failed.load() < n_el) {
+    const Index g = first_failed.load();
+    const auto [body, e] = bricks_[static_cast<std::size_t>(g)];
+    out.ok = false;
+    out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
+                  to_string(status[static_cast<std::size_t>(g)]) + " (min det F " +
+                  short_number(min_det[static_cast<std::size_t>(g)]) + ")";
+    out.energy = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  for (double en : energies) out.energy += en;
+  out.strain_energy = out.energy;
+  out.element_force_norm = out.force.norm();
+  if (interactions_.empty()) return out;
+  linalg::TripletAssembler stiffness(n_dofs_, n_dofs_);
+  if (!add_interactions(x, context, need_k, stiffness, out)) return out;
+  if (need_k) merge_interactions(stiffness, tangent, direction, out);
+  return out;
+}
+
+void Model::merge_interactions(const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
+                               const VecX* direction, Assembly& out) const {
+  for (const Eigen::Triplet<double, int>& t : stiffness.triplets()) {
+    if (tangent) tangent->add(t.row(), t.col(), t.value());
+    if (direction) out.tangent_times(t.row()) += t.value() * (*direction)(t.col());
+  }
+  if (tangent) tangent->flush();
+}
+
+Assembly Model::assemble_reference(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                                   bool want_tangent) const {
   SF_ASSERT(x.size() == n_dofs_, "positions must have n_dofs entries");
   Assembly out;
   out.force = VecX::Zero(n_dofs_);
@@ -166,6 +332,7 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionConte
     }
   }
   out.strain_energy = out.energy;
+  out.element_force_norm = out.force.norm();
   if (!interactions_.empty() && !add_interactions(x, context, want_tangent, triplets, out)) return out;
   if (want_tangent) out.tangent = triplets.compress();
   return out;
@@ -180,7 +347,7 @@ bool Model::add_interactions(const Eigen::Ref<const VecX>& x, const InteractionC
   sums.stiffness = want_tangent ? &stiffness : nullptr;
   sums.damping = want_tangent && context.velocity ? &damping : nullptr;
   bool velocity_dependent = false;
-  for (const std::shared_ptr<const Interaction>& interaction : interactions_) {
+  for (const std::shared_ptr<Interaction>& interaction : interactions_) {
     interaction->add_to(x, context, sums);
     if (!sums.ok) {
       out.ok = false;

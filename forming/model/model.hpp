@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/linalg/pattern_assembler.hpp"
 #include "common/linalg/sparse.hpp"
 #include "forming/element/element.hpp"
 #include "forming/material/material.hpp"
@@ -48,8 +49,12 @@ struct Assembly {
   double energy = 0.0;           // stored energy: elements + interactions, N mm
   double strain_energy = 0.0;    // the elements' part, N mm
   VecX force;                    // f, n_dofs, N
+  // |f| of the elements alone, N: the force scale of a state where interactions (contact)
+  // balance the elements without external loads, so |f| itself is only the residual.
+  double element_force_norm = 0.0;
   linalg::SparseMatrix tangent;  // K = df/dx, n_dofs x n_dofs, N/mm (empty unless asked for)
   linalg::SparseMatrix damping;  // D = df/dv, N s/mm (empty unless asked for and some interaction depends on v)
+  VecX tangent_times;            // K d for the direction d of assemble_into (n_dofs, N), else empty
 };
 
 class Model {
@@ -65,9 +70,11 @@ class Model {
 
   // Adds an interaction between bodies (or between a body and a tool); returns its index.
   // Throws sf::InputError for a null pointer.
-  int add_interaction(std::shared_ptr<const Interaction> interaction);
+  int add_interaction(std::shared_ptr<Interaction> interaction);
   int n_interactions() const { return static_cast<int>(interactions_.size()); }
   const Interaction& interaction(int i) const { return *interactions_[static_cast<std::size_t>(i)]; }
+  // Non-const: the steppers commit state and update multipliers (interaction.hpp).
+  Interaction& interaction(int i) { return *interactions_[static_cast<std::size_t>(i)]; }
   // False when some interaction's tangent is unsymmetric (solvers then factorise with LU).
   bool symmetric_tangent() const;
 
@@ -119,6 +126,33 @@ class Model {
   // want_tangent also asks for the damping matrix when velocities are given.
   Assembly assemble(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent) const;
 
+  // Assembly for a Newton solver (the fast path): energy and force as above; with
+  // `tangent`, K restricted to that assembler's active dofs written into its fixed
+  // pattern (set to zero first; interaction entries merged, the pattern growing only
+  // when one falls outside it); with `direction` (n_dofs), also K direction over ALL
+  // dofs in tangent_times (e.g. K_fp dx_p for a predictor). Elements are evaluated on
+  // threads() threads, colour by colour, so the result is the same bit for bit for any
+  // thread count. The damping matrix (velocity-dependent interactions, velocities
+  // given, tangent asked for) comes back in `damping` as with assemble().
+  Assembly assemble_into(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                         linalg::PatternAssembler* tangent, const VecX* direction = nullptr) const;
+  // The pattern for assemble_into: the unknowns `active` (n_dofs flags), the lower
+  // triangle when `symmetric` (else both).
+  linalg::PatternAssembler make_pattern(const std::vector<bool>& active, bool symmetric) const;
+  // The element entries (global dof, coefficient, local index) of every brick of every
+  // body, bodies in order: what make_pattern lays out.
+  const std::vector<linalg::ElementEntries>& element_entries() const { return entries_; }
+  // Threads for the element loop: 0 (default) = as many as OpenMP offers (OMP_NUM_THREADS
+  // or the cores); results do not depend on it.
+  void set_threads(int threads) { threads_ = threads; }
+  int threads() const;
+  // The brick kernel the assembly uses (its flop counts, for benchmarks).
+  const BrickKernel& kernel() const { return kernel_; }
+  // The straightforward assembly (triplets, full n_dofs x n_dofs tangent) that
+  // assemble() replaced; kept as the reference the tests compare the fast path with.
+  Assembly assemble_reference(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                              bool want_tangent) const;
+
   // Deformation gradient at every Gauss point of every brick of `body` (element-major,
   // points in ElementRule::brick() order), for checks and outputs.
   std::vector<Mat3> deformation_gradients(int body, const Eigen::Ref<const VecX>& x) const;
@@ -135,10 +169,21 @@ class Model {
   // Adds the interactions' sums to `out` (elements done); false when one rejects the state.
   bool add_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent,
                         linalg::TripletAssembler& stiffness, Assembly& out) const;
+  // Interactions' stiffness (and direction product) into the fast assembly.
+  void merge_interactions(const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
+                          const VecX* direction, Assembly& out) const;
   ElementRule rule_;
   quadrature::TensorRule<3> brick_rule_;
+  BrickKernel kernel_;
   std::vector<Body> bodies_;
-  std::vector<std::shared_ptr<const Interaction>> interactions_;
+  // Per brick of every body (bodies in order): body, element, entries, reference
+  // parameters; and the colouring of the bricks for the threaded loop.
+  std::vector<std::pair<int, Index>> bricks_;
+  std::vector<linalg::ElementEntries> entries_;
+  std::vector<BrickParams> reference_params_;
+  std::vector<std::vector<Index>> colours_;
+  int threads_ = 0;
+  std::vector<std::shared_ptr<Interaction>> interactions_;
   Index n_dofs_ = 0;
 };
 

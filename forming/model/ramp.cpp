@@ -11,4 +11,9 @@ double ramp_value(Ramp ramp, double t) {
   return ramp == Ramp::kLinear ? t : t * t * (3.0 - 2.0 * t);
 }
 
+double ramp_rate(Ramp ramp, double t) {
+  if (t < 0.0 || t > 1.0) return 0.0;
+  return ramp == Ramp::kLinear ? 1.0 : 6.0 * t * (1.0 - t);
+}
+
 }  // namespace sf::forming

@@ -13,5 +13,7 @@ enum class Ramp { kLinear, kSmooth };
 // "linear", "smooth" (the case-file names).
 std::string to_string(Ramp ramp);
 double ramp_value(Ramp ramp, double t);
+// dr/dt (0 outside [0, 1]; the linear ramp's rate is 1 on the whole closed interval).
+double ramp_rate(Ramp ramp, double t);
 
 }  // namespace sf::forming

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "forming/contact/surface_contact.hpp"
+#include "forming/contact/tool_contact.hpp"
 #include "forming/material/material.hpp"
 #include "forming/output/sampling.hpp"
 
@@ -87,14 +89,81 @@ std::string step_file_name(int k) {
   return buf;
 }
 
-void FrameSeries::write(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x) {
+void FrameSeries::write(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x,
+                        const InteractionContext* context) {
   const std::string name = step_file_name(k);
   io::write_vtu(out.path(name), tessellate(model_, x, samples_inplane_, samples_thickness_));
   frames_.erase(std::remove_if(frames_.begin(), frames_.end(), [&](const auto& f) { return f.second == name; }),
                 frames_.end());
   frames_.emplace_back(lambda, name);
+  if (context) write_contact_parts(out, k, lambda, x, *context);
 }
 
-void FrameSeries::write_collection(const std::string& path) const { io::write_pvd(path, frames_); }
+void FrameSeries::write_contact_parts(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x,
+                                      const InteractionContext& context) {
+  char number[16];
+  std::snprintf(number, sizeof number, "%04d", k);
+  // The plies' reference box, enlarged: the region tools are drawn over.
+  const VecX X = model_.reference_positions();
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (Index i = 0; i + 2 < X.size(); i += 3) {
+    // Value dofs and derivative dofs share the layout; derivatives are small lengths too,
+    // so the box of all triples is a (loose) box of the plies.
+    lo = lo.cwiseMin(X.segment<3>(i));
+    hi = hi.cwiseMax(X.segment<3>(i));
+  }
+  const Vec3 pad = Vec3::Constant(0.1 * (hi - lo).norm());
+  io::VolumeMesh points;
+  std::vector<double> pressure, gap, slip, slip_rate, shear, pair;
+  std::vector<std::string> tools_done;
+  int part = 1;
+  for (int i = 0; i < model_.n_interactions(); ++i) {
+    const auto* sc = dynamic_cast<const SurfaceContact*>(&model_.interaction(i));
+    if (!sc) continue;
+    for (const ContactPointRecord& r : sc->sample(x, context)) {
+      const Index id = points.points.rows();
+      points.points.conservativeResize(id + 1, 3);
+      points.points.row(id) = r.position.transpose();
+      points.add_cell(io::CellType::kVertex, {id});
+      pressure.push_back(r.pressure);
+      gap.push_back(r.partner ? r.gap : 0.0);
+      for (int c = 0; c < 3; ++c) {
+        slip.push_back(r.slip[c]);
+        slip_rate.push_back(r.slip_rate[c]);
+        shear.push_back(r.shear[c]);
+      }
+      pair.push_back(i);
+    }
+    const auto* tc = dynamic_cast<const ToolContact*>(sc);
+    if (!tc || std::find(tools_done.begin(), tools_done.end(), tc->tool().name) != tools_done.end()) continue;
+    tools_done.push_back(tc->tool().name);
+    const ToolTessellation t = tc->tool().shape->tessellate(lo - pad, hi + pad);
+    const Vec3 d = tc->tool().motion.displacement(context.time);
+    io::VolumeMesh surface;
+    surface.points.resize(t.points.rows(), 3);
+    for (Index p = 0; p < t.points.rows(); ++p) surface.points.row(p) = t.points.row(p) + d.transpose();
+    for (const auto& tri : t.triangles) surface.add_cell(io::CellType::kTriangle, {tri[0], tri[1], tri[2]});
+    const std::string file = "steps/tool_" + tc->tool().name + "_" + number + ".vtu";
+    io::write_vtu(out.path(file), surface);
+    parts_.push_back({lambda, file, part++});
+  }
+  if (points.points.rows() == 0) return;
+  points.point_data.push_back({"pressure", 1, std::move(pressure)});
+  points.point_data.push_back({"gap", 1, std::move(gap)});
+  points.point_data.push_back({"slip", 3, std::move(slip)});
+  points.point_data.push_back({"slip_rate", 3, std::move(slip_rate)});
+  points.point_data.push_back({"shear", 3, std::move(shear)});
+  points.point_data.push_back({"pair", 1, std::move(pair)});
+  const std::string file = std::string("steps/contact_") + number + ".vtu";
+  io::write_vtu(out.path(file), points);
+  parts_.push_back({lambda, file, part});
+}
+
+void FrameSeries::write_collection(const std::string& path) const {
+  std::vector<io::PvdDataSet> sets;
+  for (const auto& [lambda, name] : frames_) sets.push_back({lambda, name, 0});
+  sets.insert(sets.end(), parts_.begin(), parts_.end());
+  io::write_pvd(path, sets);
+}
 
 }  // namespace sf::forming

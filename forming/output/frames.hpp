@@ -10,6 +10,17 @@
 // F a0 / |F a0|), "fibre_stretch" (|F a0|), "ply" (body index); with a constrained body
 // also "pressure" (MPa, positive in compression) and "fibre_tension" (MPa), and the
 // stress includes -p I + (T/J) a (x) a.
+//
+// With contact (forming/contact/), each written step also has, as further parts of the
+// same time step in result.pvd:
+//   steps/tool_<name>_NNNN.vtu     each rigid tool's surface (triangles) where it moves
+//                                  then, over the plies' region (part 1, 2, ...);
+//   steps/contact_NNNN.vtu         the contact points of every pair on the slave ply
+//                                  faces (vertex cells), point data "pressure" (MPa),
+//                                  "gap" (mm; 0 where the point has no partner), "slip"
+//                                  (accumulated tangential slip, mm, vector), "slip_rate"
+//                                  (mm/s, vector), "shear" (friction traction on the ply,
+//                                  MPa, vector), "pair" (index of the contact pair).
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,18 +44,24 @@ class FrameSeries {
 
   // Writes step k (load factor lambda, positions x) into `out`; a frame of the same
   // name (a restarted run with other step counts) is replaced in the collection.
-  void write(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x);
+  // `context`: the time and rates the contact fields are evaluated with (tools placed at
+  // context.time); null: no tool or contact parts.
+  void write(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x,
+             const InteractionContext* context = nullptr);
   // A frame already in the output folder (kept by a restart).
   void keep(double lambda, const std::string& name) { frames_.emplace_back(lambda, name); }
   // (load factor, file name) of every frame, in the order written.
   const std::vector<std::pair<double, std::string>>& frames() const { return frames_; }
-  // result.pvd listing them.
+  // result.pvd listing them (and the tool and contact parts written by this run).
   void write_collection(const std::string& path) const;
 
  private:
+  void write_contact_parts(const io::AtomicOutputDir& out, int k, double lambda, const VecX& x,
+                           const InteractionContext& context);
   const Model& model_;
   int samples_inplane_, samples_thickness_;
   std::vector<std::pair<double, std::string>> frames_;
+  std::vector<io::PvdDataSet> parts_;  // tool and contact parts (part >= 1)
 };
 
 }  // namespace sf::forming

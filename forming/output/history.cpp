@@ -37,22 +37,50 @@ ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX
   return s;
 }
 
+namespace {
+
+std::vector<std::string> history_columns(const Model& model) {
+  std::vector<std::string> cols = {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy",
+                                   "tool_fz", "strain_energy", "newton_iterations", "cutbacks", "residual"};
+  std::vector<ToolReaction> tools;
+  const VecX X = model.reference_positions();
+  for (int i = 0; i < model.n_interactions(); ++i)
+    for (const ToolReaction& r : model.interaction(i).reactions(X, {})) tools.push_back(r);
+  if (tools.empty()) return cols;
+  cols.push_back("time");
+  for (const ToolReaction& r : tools)
+    for (const char* c : {"_ux", "_uy", "_uz", "_fx", "_fy", "_fz"}) cols.push_back(r.tool + c);
+  return cols;
+}
+
+}  // namespace
+
 HistoryTable::HistoryTable(const Model& model, ToolEdge tool)
     : model_(model),
       tool_(std::move(tool)),
       X_(model.reference_positions()),
-      writer_(out_, {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy", "tool_fz",
-                     "strain_energy", "newton_iterations", "cutbacks", "residual"}),
-      header_size_(out_.str().size()) {}
+      writer_(out_, history_columns(model)),
+      header_size_(out_.str().size()) {
+  for (int i = 0; i < model.n_interactions(); ++i) tools_ = tools_ || !model.interaction(i).reactions(X_, {}).empty();
+}
 
 ToolState HistoryTable::add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations,
-                                int cutbacks, double residual) {
+                                int cutbacks, double residual, const InteractionContext& context) {
   const ToolState ts = measure(tool_, x, X_, reactions);
-  const Assembly a = model_.assemble(x, false);
+  const Assembly a = model_.assemble(x, context, false);
   writer_.begin_row().add(k).add(load_factor);
   for (int c = 0; c < 3; ++c) writer_.add(ts.displacement[c]);
   for (int c = 0; c < 3; ++c) writer_.add(ts.force[c]);
-  writer_.add(a.strain_energy).add(iterations).add(cutbacks).add(residual).end_row();
+  writer_.add(a.strain_energy).add(iterations).add(cutbacks).add(residual);
+  if (tools_) {
+    writer_.add(context.time);
+    for (int i = 0; i < model_.n_interactions(); ++i)
+      for (const ToolReaction& r : model_.interaction(i).reactions(x, context)) {
+        for (int c = 0; c < 3; ++c) writer_.add(r.displacement[c]);
+        for (int c = 0; c < 3; ++c) writer_.add(r.force[c]);
+      }
+  }
+  writer_.end_row();
   return ts;
 }
 

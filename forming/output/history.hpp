@@ -10,8 +10,15 @@
 // energy (N mm); residual: |r_f| at the end of the step (N).
 //
 // The tool edge is the edge of the first `displacement` condition of the case (or of the
-// first condition when there is none). Rigid tools will add their reaction columns here
-// (forming/model/interaction.hpp ToolReaction).
+// first condition when there is none). Each rigid tool (forming/model/interaction.hpp
+// ToolReaction) adds its own columns after these, in the order of the model's
+// interactions:
+//
+//   time, <tool>_ux, <tool>_uy, <tool>_uz, <tool>_fx, <tool>_fy, <tool>_fz, ...
+//
+// time (s): the process time (load control) or the time (dynamics); <tool>_u*: the
+// tool's displacement (mm); <tool>_f*: the force the plies exert on it (N; a punch
+// pressing down on a ply sees f_z > 0).
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,9 +48,10 @@ class HistoryTable {
   HistoryTable(const Model& model, ToolEdge tool);
   // The rows of an earlier run (restart.json), appended after the header.
   void append_rows(const std::string& rows) { out_ << rows; }
-  // A row for step k; returns the tool's state in it.
+  // A row for step k; returns the tool's state in it. `context`: the time and rates of
+  // the step (rigid tools' reactions include friction).
   ToolState add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
-                    double residual);
+                    double residual, const InteractionContext& context = {});
   const ToolEdge& tool() const { return tool_; }
   std::string text() const { return out_.str(); }
   std::string rows() const { return out_.str().substr(header_size_); }
@@ -55,6 +63,7 @@ class HistoryTable {
   std::ostringstream out_;
   io::CsvWriter writer_;
   std::size_t header_size_ = 0;
+  bool tools_ = false;  // some interaction reports tool reactions
 };
 
 }  // namespace sf::forming

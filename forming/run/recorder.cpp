@@ -55,19 +55,36 @@ SteppingState RunRecorder::start() {
   } else {
     history_.add_row(0, 0.0, state.x, VecX::Zero(problem_.model.n_dofs()), 0, 0, 0.0);
     const Clock::time_point t0 = Clock::now();
-    frames_.write(out_, 0, 0.0, state.x);
+    const InteractionContext at_rest{};
+    frames_.write(out_, 0, 0.0, state.x, &at_rest);
     seconds_write_ += seconds_since(t0);
   }
   last_ = state;
+  last_time_ = state.load_factor * (spec_.solver.dynamic ? spec_.solver.end_time : spec_.solver.process_time);
   start_load_factor_ = state.load_factor;
   stepping_started_ = Clock::now();
   return state;
 }
 
+InteractionContext RunRecorder::context() const {
+  InteractionContext c;
+  c.time = last_time_;
+  if (spec_.solver.dynamic) c.velocity = &last_.v;
+  if (have_previous_) {
+    c.previous = &previous_.x;
+    c.previous_time = previous_time_;
+  }
+  return c;
+}
+
 StepAction RunRecorder::on_step(const StepInfo& step, const SteppingState& state, const VecX& reactions) {
+  previous_ = last_;
+  previous_time_ = last_time_;
+  have_previous_ = true;
   last_ = state;
+  last_time_ = step.time;
   const ToolState tool = history_.add_row(step.index, step.load_factor, state.x, reactions, step.iterations,
-                                          step.cutbacks, step.residual);
+                                          step.cutbacks, step.residual, context());
   report_.max_displacement = largest_displacement(problem_.model, state.x, X_);
   report_.steps_converged = step.index;
   report_.load_factor = step.load_factor;
@@ -112,7 +129,8 @@ std::string RunRecorder::progress_line(const StepInfo& step) const {
 
 void RunRecorder::write_step(int k, double load_factor) {
   const Clock::time_point t0 = Clock::now();
-  frames_.write(out_, k, load_factor, last_.x);
+  const InteractionContext c = context();
+  frames_.write(out_, k, load_factor, last_.x, &c);
   last_written_ = k;
   restart_.step = k;
   restart_.load_factor = load_factor;

@@ -56,7 +56,14 @@ class RunRecorder final : public StepObserver {
   RestartState restart_;
   RunReport report_;
 
+  // The time and rates of the last converged state, for the contact outputs and tool
+  // reactions (rates over the last step, or the velocities of a dynamic run).
+  InteractionContext context() const;
+
   SteppingState last_;        // the last converged state (the start until a step converges)
+  SteppingState previous_;    // the one before it
+  double last_time_ = 0.0, previous_time_ = 0.0;  // s
+  bool have_previous_ = false;
   double start_load_factor_ = 0.0;
   int steps_this_run_ = 0;
   int last_written_ = 0;

@@ -40,7 +40,8 @@ struct ArcState {
   std::string message;
   VecX r, q;           // free parts of f_int - lambda q and of q
   double scale = 0.0;  // max(|f_int|, |lambda q|)
-  linalg::SparseMatrix k;
+  // With the tangent: K_ff - lambda (dq/dx)_ff is in the continuation's pattern until
+  // the next evaluation.
 };
 
 // An attempted step: the increment from the last converged point and how it went.
@@ -62,11 +63,12 @@ class Continuation {
         load_(load),
         options_(options),
         free_(is_free),
-        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()) {}
+        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()),
+        pattern_(model.make_pattern(is_free, solver_.lower())) {}
 
   Index n_free() const { return free_.size(); }
-  const linalg::SparseMatrix& select() const { return free_.select; }
-  ArcState evaluate(const VecX& x, double lambda, bool want_tangent) const;
+  const FreeDofs& free() const { return free_; }
+  ArcState evaluate(const VecX& x, double lambda, bool want_tangent);
   // A step of length `arc` from (x, lambda): predictor along the tangent (in the
   // direction of the previous increment), then Newton on (dx, dlambda) with the
   // constraint |dx| = arc.
@@ -81,11 +83,12 @@ class Continuation {
   const ArcLengthOptions& options_;
   FreeDofs free_;
   TangentSolver solver_;
+  linalg::PatternAssembler pattern_;
 };
 
-ArcState Continuation::evaluate(const VecX& x, double lambda, bool want_tangent) const {
+ArcState Continuation::evaluate(const VecX& x, double lambda, bool want_tangent) {
   ArcState s;
-  Assembly a = model_.assemble(x, want_tangent);
+  Assembly a = model_.assemble_into(x, InteractionContext{}, want_tangent ? &pattern_ : nullptr);
   if (!a.ok) {
     s.message = a.message;
     return s;
@@ -94,9 +97,9 @@ ArcState Continuation::evaluate(const VecX& x, double lambda, bool want_tangent)
   s.r = free_.restrict(a.force - lambda * shape.force);
   s.q = free_.restrict(shape.force);
   s.scale = std::max(a.force.norm(), std::abs(lambda) * shape.force.norm());
-  if (want_tangent) {
-    if (shape.tangent.size() > 0) a.tangent -= lambda * shape.tangent;
-    s.k = free_.select.transpose() * a.tangent * free_.select;
+  if (want_tangent && shape.tangent.size() > 0) {
+    pattern_.add(shape.tangent, -lambda);
+    pattern_.flush();
   }
   s.ok = true;
   return s;
@@ -106,7 +109,11 @@ ArcStep Continuation::attempt(const VecX& x, double lambda, const VecX& previous
   ArcStep step;
   step.dx = VecX::Zero(n_free());
   const ArcState s = evaluate(x, lambda, true);
-  if (!solver_.factorize(s.k).ok()) {
+  if (!s.ok) {
+    step.failure = s.message;
+    return step;
+  }
+  if (!solver_.factorize(pattern_.matrix()).ok()) {
     step.failure = "singular tangent at the start of the step";
     return step;
   }
@@ -115,7 +122,7 @@ ArcStep Continuation::attempt(const VecX& x, double lambda, const VecX& previous
   step.dlambda = dir * arc / std::max(dq.norm(), 1e-300);
   step.dx = step.dlambda * dq;
   for (step.iterations = 1; step.iterations <= options_.max_iterations; ++step.iterations) {
-    const VecX xt = x + free_.select * step.dx;
+    const VecX xt = x + free_.expand(step.dx);
     const ArcState st = evaluate(xt, lambda + step.dlambda, true);
     if (!st.ok) {
       step.failure = st.message;
@@ -140,7 +147,7 @@ ArcStep Continuation::attempt(const VecX& x, double lambda, const VecX& previous
 // K dx_r = -r and K dx_q = q; dx = dx + dx_r + dl dx_q with dl from |dx|^2 = arc^2, the
 // root whose increment makes the smaller angle with the current one.
 bool Continuation::correct(const ArcState& st, double arc, ArcStep& step) {
-  if (!solver_.factorize(st.k).ok()) {
+  if (!solver_.factorize(pattern_.matrix()).ok()) {
     step.failure = "singular tangent";
     return false;
   }
@@ -216,7 +223,7 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
       }
       continue;
     }
-    x += path.select() * step.dx;
+    x += path.free().expand(step.dx);
     lambda += step.dlambda;
     previous = step.dx;
     result.path.push_back({lambda, x, step.iterations, step.rnorm});

@@ -186,9 +186,9 @@ struct TimeStep {
 };
 
 // Residual R (all dofs) at an iterate, the effective tangent S and the force scale.
+// (S itself is in the integration's pattern, until the next balance with the tangent.)
 struct Balance {
   VecX residual;
-  linalg::SparseMatrix tangent;
   double scale = 0.0;
 };
 
@@ -247,6 +247,9 @@ class TimeIntegration {
   FreeDofs free_;
   double length_scale_ = 1e-300;
   std::unique_ptr<TangentSolver> solver_;
+  std::unique_ptr<linalg::PatternAssembler> pattern_;  // S_ff, laid out for solver_
+  std::vector<std::int64_t> mass_pos_;                 // positions of M's entries in pattern_
+  int mass_generation_ = -1;                           // pattern_ generation mass_pos_ is for
   bool unsymmetric_ = false;
   bool fatal_ = false;
 
@@ -279,6 +282,7 @@ std::string TimeIntegration::start(const Eigen::Ref<const VecX>& x0, const Eigen
   // Effective-tangent solver: symmetric until an unsymmetric tangent shows up.
   unsymmetric_ = !model_.symmetric_tangent();
   solver_ = std::make_unique<TangentSolver>(options_.linear_solver, unsymmetric_);
+  pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(free_.is_free, solver_->lower()));
   return {};
 }
 
@@ -372,7 +376,7 @@ bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangen
     va = v_ + ((1.0 - af_) * s.h) * ((1.0 - gamma_) * a_ + gamma_ * a1);
     context.velocity = &va;
   }
-  const Assembly internal = model_.assemble(xa, context, want_tangent);
+  const Assembly internal = model_.assemble_into(xa, context, want_tangent ? pattern_.get() : nullptr);
   if (!internal.ok) {
     why = internal.message;
     return false;
@@ -384,27 +388,45 @@ bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangen
   }
   const VecX inertia = mass_ * aa;
   out.residual = inertia + internal.force - ext.force;
-  out.scale = std::max({internal.force.norm(), ext.force.norm(), inertia.norm()});
+  out.scale = std::max({internal.force.norm(), internal.element_force_norm, ext.force.norm(), inertia.norm()});
   if (!out.residual.allFinite()) {
     why = "non-finite residual";
     return false;
   }
   if (!want_tangent) return true;
-  out.tangent = (s.c0 * (1.0 - am_)) * mass_ + (1.0 - af_) * internal.tangent;
-  if (internal.damping.size() > 0) out.tangent += ((1.0 - af_) * gamma_ * s.h * s.c0) * internal.damping;
-  if (has_nonzeros(ext.tangent)) {
-    out.tangent -= (1.0 - af_) * ext.tangent;
-    if (!unsymmetric_) {
-      try {
-        solver_ = std::make_unique<TangentSolver>(options_.linear_solver, true);
-      } catch (const InputError& e) {
-        why = std::string("the external load has an unsymmetric tangent: ") + e.what();
-        fatal_ = true;
-        return false;
-      }
-      unsymmetric_ = true;
+  if (has_nonzeros(ext.tangent) && !unsymmetric_) {
+    // The first unsymmetric tangent: both triangles and an unsymmetric solver from now on.
+    try {
+      solver_ = std::make_unique<TangentSolver>(options_.linear_solver, true);
+    } catch (const InputError& e) {
+      why = std::string("the external load has an unsymmetric tangent: ") + e.what();
+      fatal_ = true;
+      return false;
     }
+    unsymmetric_ = true;
+    pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(free_.is_free, solver_->lower()));
+    mass_generation_ = -1;
+    return balance(s, y, want_tangent, out, why);
   }
+  // S = (1 - af) K + c0 (1 - am) M + (1 - af) gamma h c0 D - (1 - af) dF_ext/dx on the free dofs.
+  linalg::SparseMatrix& S = pattern_->matrix();
+  S.coeffs() *= (1.0 - af_);
+  if (mass_generation_ != pattern_->generation()) {
+    mass_pos_ = pattern_->positions_of(mass_);
+    mass_generation_ = pattern_->generation();
+  }
+  const double cm = s.c0 * (1.0 - am_);
+  std::size_t t = 0;
+  for (int k = 0; k < mass_.outerSize(); ++k)
+    for (linalg::SparseMatrix::InnerIterator it(mass_, k); it; ++it, ++t) {
+      if (mass_pos_[t] >= 0)
+        S.valuePtr()[mass_pos_[t]] += cm * it.value();
+      else
+        pattern_->add(it.row(), it.col(), cm * it.value());  // dropped, or outside the pattern
+    }
+  if (internal.damping.size() > 0) pattern_->add(internal.damping, (1.0 - af_) * gamma_ * s.h * s.c0);
+  if (has_nonzeros(ext.tangent)) pattern_->add(ext.tangent, -(1.0 - af_));
+  if (pattern_->flush()) mass_generation_ = -1;
   return true;
 }
 
@@ -442,7 +464,6 @@ StepRecord TimeIntegration::attempt(double t_new, TimeStep& s, Balance& end) {
 // the round-off floor; the record gets every residual norm and line-search factor.
 void TimeIntegration::newton(TimeStep& s, Balance& end, StepRecord& rec) {
   double first_norm = -1.0;
-  const linalg::SparseMatrix& select = free_.select;
   for (;;) {
     std::string why;
     if (!balance(s, s.y, true, end, why)) {
@@ -468,7 +489,7 @@ void TimeIntegration::newton(TimeStep& s, Balance& end, StepRecord& rec) {
                     detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
       return;
     }
-    const linalg::SolveReport& sr = solver_->factorize(select.transpose() * end.tangent * select);
+    const linalg::SolveReport& sr = solver_->factorize(pattern_->matrix());
     if (!sr.ok()) {
       rec.failure = "linear solve " + sr.brief();
       return;
@@ -479,7 +500,7 @@ void TimeIntegration::newton(TimeStep& s, Balance& end, StepRecord& rec) {
       rec.failure = "linear solve returned non-finite values";
       return;
     }
-    const VecX dy = select * dyf;
+    const VecX dy = free_.expand(dyf);
     if (dyf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale_) {
       s.y += dy;
       rec.step_lengths.push_back(1.0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -43,6 +44,8 @@ void StaticOptions::validate() const {
   if (!(residual_tol_abs >= 0.0)) bad_option("residual_tol_abs", "a value >= 0 (N)", residual_tol_abs);
   if (!(divergence_factor > 1.0)) bad_option("divergence_factor", "a factor > 1", divergence_factor);
   if (max_line_search < 0) bad_option("max_line_search", "at least 0", max_line_search);
+  if (!(std::isfinite(clock.start) && std::isfinite(clock.end) && clock.end >= clock.start))
+    throw InputError("static solver clock: expected finite times with end >= start (s)");
   if (!linalg::solver_available(linear_solver))
     throw InputError("static solver linear_solver: '" + linalg::to_string(linear_solver) +
                      "' is not compiled in");
@@ -82,7 +85,7 @@ namespace {
 struct Residual {
   Assembly a;
   VecX residual;
-  double scale = 0.0;  // max(|f_int|, |f_ext|)
+  double scale = 0.0;  // max(|f_int|, |f_elements|, |f_ext|)
 };
 
 // The load steps of one static solve: the dof classes, the tangent solver, and the
@@ -95,12 +98,25 @@ class LoadStepping {
         x_start_(x_start),
         load_(load),
         options_(options),
-        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()) {}
+        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()),
+        rates_from_(options.clock.previous ? *options.clock.previous : VecX(x_start)),
+        rates_time_(options.clock.previous ? options.clock.previous_time : options.clock.start) {
+    last_rates_from_ = rates_from_;
+    last_rates_time_ = rates_time_;
+  }
 
   // Free, prescribed (with their targets at lambda = 1) and held (used by no element)
   // dofs; returns why the input is invalid (empty when valid).
   std::string classify(const std::vector<PrescribedDof>& prescribed);
-  Residual evaluate(double lambda, const VecX& x, bool want_tangent) const;
+  // Residual at (lambda, x); with want_tangent also K_ff - (load tangent)_ff in pattern_,
+  // and with `direction` K direction (all dofs) in a.tangent_times.
+  Residual evaluate(double lambda, const VecX& x, bool want_tangent, const VecX* direction = nullptr);
+  // A sub-step converged at (lambda, x): the interactions' rates start from it when the
+  // clock runs (options.clock); the reactions keep the rates of that sub-step.
+  void converged(double lambda, const VecX& x);
+  // Residual at the last converged state with the rates of its own sub-step (reactions);
+  // residual only (no pattern).
+  Residual final_residual(double lambda, const VecX& x);
 
   enum class Predicted { kOk, kFailed, kInadmissible };
   // Predictor from the converged state x to lam_new: tangent at x, prescribed dofs
@@ -115,16 +131,24 @@ class LoadStepping {
   enum : char { kFree, kPrescribed, kHeld };
   VecX prescribed_at(double lambda, const VecX& x) const;
   // Line-search factor along dx; < 0 (rec.failure) when every trial inverted an element.
-  double line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec) const;
+  // `at_step` receives the residual norm and force scale at the accepted step.
+  double line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec,
+                     std::pair<double, double>& at_step);
+
+  Residual evaluate_with(double lambda, const VecX& x, bool want_tangent, const VecX* direction, const VecX& from,
+                         double from_time);
 
   const Model& model_;
   const Eigen::Ref<const VecX>& x_start_;
   const LoadFunction& load_;
   const StaticOptions& options_;
   TangentSolver solver_;
+  VecX rates_from_, last_rates_from_;          // where the interactions' rates start (clock)
+  double rates_time_ = 0.0, last_rates_time_ = 0.0;
   std::vector<char> kind_;
   VecX target_;
   FreeDofs free_;
+  std::unique_ptr<linalg::PatternAssembler> pattern_;  // K_ff, laid out once per solve
   double length_scale_ = 0.0;
 };
 
@@ -146,20 +170,45 @@ std::string LoadStepping::classify(const std::vector<PrescribedDof>& prescribed)
     is_free[static_cast<std::size_t>(d)] = kind_[d] == kFree;
   }
   free_ = FreeDofs(is_free);
+  pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(is_free, solver_.lower()));
   for (Index d = 0; d < n; ++d) length_scale_ = std::max(length_scale_, std::abs(x_start_(d)));
   length_scale_ = std::max(length_scale_, 1e-300);
   return {};
 }
 
-Residual LoadStepping::evaluate(double lambda, const VecX& x, bool want_tangent) const {
+Residual LoadStepping::evaluate(double lambda, const VecX& x, bool want_tangent, const VecX* direction) {
+  return evaluate_with(lambda, x, want_tangent, direction, rates_from_, rates_time_);
+}
+
+Residual LoadStepping::final_residual(double lambda, const VecX& x) {
+  return evaluate_with(lambda, x, false, nullptr, last_rates_from_, last_rates_time_);
+}
+
+void LoadStepping::converged(double lambda, const VecX& x) {
+  if (!(options_.clock.end > options_.clock.start)) return;  // the time stands still
+  last_rates_from_ = rates_from_;
+  last_rates_time_ = rates_time_;
+  rates_from_ = x;
+  rates_time_ = options_.clock.at(lambda);
+}
+
+Residual LoadStepping::evaluate_with(double lambda, const VecX& x, bool want_tangent, const VecX* direction,
+                                     const VecX& from, double from_time) {
   Residual st;
-  st.a = model_.assemble(x, want_tangent);
+  const InteractionContext context{options_.clock.at(lambda), nullptr, &from, from_time};
+  st.a = model_.assemble_into(x, context, want_tangent ? pattern_.get() : nullptr, direction);
   if (!st.a.ok) return st;
-  ExternalLoad ext = load_(lambda, x, want_tangent);
+  ExternalLoad ext = load_(lambda, x, want_tangent || direction != nullptr);
   SF_ASSERT(ext.force.size() == model_.n_dofs(), "external load must have n_dofs entries");
   st.residual = st.a.force - ext.force;
-  st.scale = std::max(st.a.force.norm(), ext.force.norm());
-  if (want_tangent && ext.tangent.size() > 0) st.a.tangent -= ext.tangent;
+  st.scale = std::max({st.a.force.norm(), st.a.element_force_norm, ext.force.norm()});
+  if (ext.tangent.size() > 0) {
+    if (want_tangent) {
+      pattern_->add(ext.tangent, -1.0);
+      pattern_->flush();
+    }
+    if (direction) st.a.tangent_times -= ext.tangent * (*direction);
+  }
   return st;
 }
 
@@ -173,47 +222,49 @@ VecX LoadStepping::prescribed_at(double lambda, const VecX& x) const {
 
 LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, VecX& xt, StepRecord& rec,
                                               std::string& why) {
-  const linalg::SparseMatrix& select = free_.select;
   xt = x;
   rec.iterations = 1;
-  const Residual st = evaluate(lam_new, x, true);
+  const VecX x_new = prescribed_at(lam_new, x);
+  const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
+  const Residual st = evaluate(lam_new, x, true, &dxp);
   const Assembly& a = st.a;
   if (!a.ok) {
     why = "converged state became inadmissible: " + a.message;
     return Predicted::kInadmissible;
   }
-  const VecX x_new = prescribed_at(lam_new, x);
-  const VecX dxp = x_new - x;  // nonzero on prescribed dofs only
-  const VecX rhs = -free_.restrict(st.residual + a.tangent * dxp);
-  const linalg::SparseMatrix kff = select.transpose() * a.tangent * select;
   if (free_.size() == 0) {
     xt = x_new;
     return Predicted::kOk;
   }
-  const linalg::SolveReport& sr = solver_.factorize(kff);
+  // Linearised response to the load and prescribed-displacement increment:
+  // K_ff dx_f = -(r_f(lambda_new, x) + K_fp dx_p).
+  const VecX rhs = -free_.restrict(st.residual + a.tangent_times);
+  const linalg::SolveReport& sr = solver_.factorize(pattern_->matrix());
   if (!sr.ok()) {
     rec.failure = "predictor: linear solve " + sr.brief();
     return Predicted::kFailed;
   }
   const VecX dxf = solver_.solve(rhs);
-  xt = x_new + select * dxf;
+  xt = x_new + free_.expand(dxf);
   return Predicted::kOk;
 }
 
 void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& force_scale) {
-  const linalg::SparseMatrix& select = free_.select;
   double first_norm = -1.0;
-  for (;;) {
-    const Residual st = evaluate(lam_new, xt, true);
-    const Assembly& a = st.a;
-    if (!a.ok) {
-      rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + a.message;
+  // Residual at xt: the first one assembled here, later ones from the line search's
+  // accepted trial, so a converged state costs no tangent.
+  double rnorm = 0.0, scale = 0.0;
+  {
+    const Residual st = evaluate(lam_new, xt, false);
+    if (!st.a.ok) {
+      rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + st.a.message;
       return;
     }
-    const VecX rf = free_.restrict(st.residual);
-    const double rnorm = rf.norm();
+    rnorm = free_.restrict(st.residual).norm();
+    scale = st.scale;
+  }
+  for (;;) {
     rec.residual_norms.push_back(rnorm);
-    const double scale = st.scale;
     if (first_norm < 0.0) first_norm = rnorm;
     const double tol = std::max(options_.residual_tol_abs, options_.residual_tol_rel * scale);
     if (rnorm <= tol) {
@@ -231,7 +282,13 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
                     detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
       return;
     }
-    const linalg::SolveReport& sr = solver_.factorize(select.transpose() * a.tangent * select);
+    const Residual st = evaluate(lam_new, xt, true);
+    if (!st.a.ok) {
+      rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + st.a.message;
+      return;
+    }
+    const VecX rf = free_.restrict(st.residual);
+    const linalg::SolveReport& sr = solver_.factorize(pattern_->matrix());
     if (!sr.ok()) {
       rec.failure = "linear solve " + sr.brief();
       return;
@@ -242,32 +299,52 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       rec.failure = "linear solve returned non-finite values";
       return;
     }
-    const VecX dx = select * dxf;
+    const VecX dx = free_.expand(dxf);
     // Round-off floor: a correction this small cannot reduce |r| further.
     if (dxf.size() == 0 || dxf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale_) {
       xt += dx;
       rec.step_lengths.push_back(1.0);
       rec.converged = true;
-      force_scale = scale;
+      force_scale = st.scale;
       return;
     }
-    const double alpha = options_.line_search ? line_search(lam_new, xt, dx, rnorm, rec) : 1.0;
-    if (alpha < 0.0) return;
+    std::pair<double, double> at_step{0.0, 0.0};
+    double alpha = 1.0;
+    if (options_.line_search) {
+      alpha = line_search(lam_new, xt, dx, rnorm, rec, at_step);
+      if (alpha < 0.0) return;
+    } else {
+      const Residual trial = evaluate(lam_new, xt + dx, false);
+      if (!trial.a.ok) {
+        rec.failure = "iteration " + std::to_string(rec.iterations) + ": " + trial.a.message;
+        return;
+      }
+      at_step = {free_.restrict(trial.residual).norm(), trial.scale};
+    }
     xt += alpha * dx;
     rec.step_lengths.push_back(alpha);
+    rnorm = at_step.first;
+    scale = at_step.second;
   }
 }
 
-double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm,
-                                 StepRecord& rec) const {
+double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec,
+                                 std::pair<double, double>& at_step) {
+  std::vector<std::pair<double, std::pair<double, double>>> seen;  // step -> (|r_f|, force scale)
   const double alpha =
       detail::backtrack(rnorm, options_.max_line_search, [&](double trial_step, bool&) -> std::optional<double> {
         const Residual trial = evaluate(lam_new, xt + trial_step * dx, false);
         if (!trial.a.ok) return std::nullopt;
-        return free_.restrict(trial.residual).norm();
+        const double norm = free_.restrict(trial.residual).norm();
+        seen.push_back({trial_step, {norm, trial.scale}});
+        return norm;
       }).step;
-  if (alpha < 0.0)
+  if (alpha < 0.0) {
     rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
+    return alpha;
+  }
+  for (const auto& [step, values] : seen)
+    if (step == alpha) at_step = values;
   return alpha;
 }
 
@@ -318,6 +395,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     if (rec.converged) {
       x = xt;
       lambda = lam_new;
+      steps.converged(lambda, x);
       if (rec.iterations <= options.easy_iterations)
         increment = std::min(options.max_increment, increment * options.growth);
       report.add(std::move(rec));
@@ -339,7 +417,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   }
   report.load_factor = lambda;
   result.positions = x;
-  result.reactions = steps.evaluate(lambda, x, false).residual;
+  result.reactions = steps.final_residual(lambda, x).residual;
   return result;
 }
 
@@ -349,6 +427,12 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
                                       UzawaReport* report) {
   UzawaReport rep;
   StaticResult r = solve_static(model, x_start, prescribed, load, unsymmetric, options);
+  // Repeats start at the step's end with the time standing still there and the rates
+  // measured from the step's start.
+  const VecX step_start = options.clock.previous ? *options.clock.previous : VecX(x_start);
+  StaticOptions repeat = options;
+  repeat.clock = {options.clock.end, options.clock.end, &step_start,
+                  options.clock.previous ? options.clock.previous_time : options.clock.start};
   const bool any = model.any_constrained();
   auto measure = [&](const VecX& x) {
     rep.max_g_J = rep.max_g_T = 0.0;
@@ -382,7 +466,7 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
       }
       ++rep.updates;
       const LoadFunction full = [&load](double, const VecX& x, bool want_tangent) { return load(1.0, x, want_tangent); };
-      const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, options);
+      const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, repeat);
       const int iterations = r.report.total_iterations + again.report.total_iterations;
       r = again;
       r.report.total_iterations = iterations;

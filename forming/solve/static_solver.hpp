@@ -37,6 +37,22 @@
 
 namespace sf::forming {
 
+// Process time of a quasi-static solve (forming/solve/stepper.hpp sets it per load step):
+// the solve's load factor lambda in [0, 1] is the time start + lambda (end - start), s,
+// which interactions see (forming/model/interaction.hpp: a tool moves with it). Their
+// rates are finite differences from the solve's last converged state: before the first,
+// `previous` at `previous_time` when given, else x_start at `start`; after each converged
+// sub-step (cut-backs), that state. With end == start the time stands still and the
+// rates keep coming from the first (the repeats of a step for multiplier updates).
+// Default: time 0 and no rates.
+struct ProcessClock {
+  double start = 0.0;              // s
+  double end = 0.0;                // s, >= start
+  const VecX* previous = nullptr;  // n_dofs, mm, or null
+  double previous_time = 0.0;      // s
+  double at(double lambda) const { return start + lambda * (end - start); }
+};
+
 struct StaticOptions {
   double initial_increment = 1.0;  // first load-factor increment, (0, 1]
   double max_increment = 1.0;      // cap after regrowth, (0, 1]
@@ -51,6 +67,7 @@ struct StaticOptions {
   bool line_search = true;
   int max_line_search = 8;         // halvings of the corrector step
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
+  ProcessClock clock;              // time and rates the interactions see
   // Throws sf::InputError naming the option ("static solver max_iterations: ...").
   void validate() const;
 };

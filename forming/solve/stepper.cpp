@@ -1,7 +1,9 @@
 #include "forming/solve/stepper.hpp"
 
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "forming/solve/mass.hpp"
 
@@ -18,6 +20,29 @@ SteppingReport failed(SteppingReport out, int k, int n, double lambda, const std
   out.message = os.str();
   out.step_failure = "step " + std::to_string(k) + " failed: " + why;
   return out;
+}
+
+// Commits every interaction of the model at x, the step having started at `previous`.
+void commit_interactions(Model& model, const VecX& x, const InteractionContext& context) {
+  for (int i = 0; i < model.n_interactions(); ++i) model.interaction(i).commit(x, context);
+}
+
+// Asks every interaction to update its multipliers at x; true when all constraints were
+// met (nothing updated). `worst` gets the largest violation relative to its tolerance.
+bool update_interactions(Model& model, const VecX& x, const InteractionContext& context, std::string& worst) {
+  bool all = true;
+  double ratio = 0.0;
+  for (int i = 0; i < model.n_interactions(); ++i) {
+    const MultiplierUpdate u = model.interaction(i).update_multipliers(x, context);
+    all = all && u.converged;
+    if (u.tolerance > 0.0 && u.violation / u.tolerance > ratio) {
+      ratio = u.violation / u.tolerance;
+      std::ostringstream os;
+      os << model.interaction(i).name() << ": " << u.violation << " (tolerance " << u.tolerance << ")";
+      worst = os.str();
+    }
+  }
+  return all;
 }
 
 // The first output step beyond load factor `lambda` (n + 1 when none is left).
@@ -45,16 +70,47 @@ class LoadStepper final : public Stepper {
       const LoadFunction step_load = [&](double s, const VecX& xs, bool want_tangent) {
         return problem_.loads.at(problem_.model, lambda_prev + s * (lambda - lambda_prev), xs, want_tangent);
       };
+      // Process time over the step: tools move with it, rates are taken over it.
+      const double T = settings_.process_time;
+      StaticOptions statics = settings_.statics;
+      statics.clock = {lambda_prev * T, lambda * T, nullptr, 0.0};
+      const std::vector<PrescribedDof> targets = problem_.prescriptions.at(lambda);
       UzawaReport uzawa;
-      const StaticResult r =
-          solve_static_constrained(problem_.model, state.x, problem_.prescriptions.at(lambda), step_load,
-                                   problem_.loads.follower, settings_.statics, settings_.uzawa, &uzawa);
+      StaticResult r = solve_static_constrained(problem_.model, state.x, targets, step_load, problem_.loads.follower,
+                                                statics, settings_.uzawa, &uzawa);
       out.multiplier_updates += uzawa.updates;
       out.total_iterations += r.report.total_iterations;
       if (!r.report.ok()) return failed(std::move(out), k, n, lambda, r.report.message);
+      // Augmented-Lagrangian interactions: update and solve the step again at its end
+      // (the time standing still, rates still from the step's start) until all are met.
+      const InteractionContext at_end{lambda * T, nullptr, &state.x, lambda_prev * T};
+      std::string worst;
+      int updates = 0;
+      while (!update_interactions(problem_.model, r.positions, at_end, worst)) {
+        if (updates == settings_.max_multiplier_updates)
+          return failed(std::move(out), k, n, lambda,
+                        "contact multipliers not converged after " + std::to_string(updates) +
+                            " updates (largest penetration " + worst + ")");
+        ++updates;
+        ++out.contact_updates;
+        StaticOptions repeat = settings_.statics;
+        repeat.clock = {lambda * T, lambda * T, &state.x, lambda_prev * T};
+        const LoadFunction full = [&](double, const VecX& xs, bool want_tangent) {
+          return problem_.loads.at(problem_.model, lambda, xs, want_tangent);
+        };
+        const StaticResult again = solve_static_constrained(problem_.model, r.positions, targets, full,
+                                                            problem_.loads.follower, repeat, settings_.uzawa, &uzawa);
+        out.multiplier_updates += uzawa.updates;
+        out.total_iterations += again.report.total_iterations;
+        r.report.total_iterations += again.report.total_iterations;
+        if (!again.report.ok()) return failed(std::move(out), k, n, lambda, again.report.message);
+        r.positions = again.positions;
+        r.reactions = again.reactions;
+      }
+      commit_interactions(problem_.model, r.positions, at_end);
       state.x = r.positions;
       state.load_factor = lambda;
-      const StepInfo info{Control::kLoad, k, n, lambda, 0.0, r.report.total_iterations, r.report.n_cutbacks,
+      const StepInfo info{Control::kLoad, k, n, lambda, lambda * T, r.report.total_iterations, r.report.n_cutbacks,
                           r.report.last_residual()};
       if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
         out.status = SteppingReport::Status::kStopped;
@@ -95,6 +151,8 @@ class DynamicStepper final : public Stepper {
       const DynamicResult r = solve_dynamic(problem_.model, mass_, state.x, state.v, moving, external, options);
       out.total_iterations += r.report.total_iterations;
       if (!r.report.ok()) return failed(std::move(out), k, n, lambda, r.report.message);
+      commit_interactions(problem_.model, r.positions,
+                          InteractionContext{options.end_time, &r.velocities, &state.x, options.start_time});
       state.x = r.positions;
       state.v = r.velocities;
       state.load_factor = lambda;
@@ -133,6 +191,7 @@ class ArcLengthStepper final : public Stepper {
     bool stopped = false;
     const auto on_point = [&](const ArcLengthPoint& pt) {
       ++k;
+      commit_interactions(problem_.model, pt.x, InteractionContext{0.0, nullptr, &state.x, 0.0});
       state.x = pt.x;
       state.load_factor = pt.lambda;
       const VecX reactions = model.assemble(state.x, false).force - proportional(pt.lambda, state.x, false).force;

@@ -6,7 +6,12 @@
 //   LoadStepper       quasi-static load control: step k of n solves for the load
 //                     factor k / n with solve_static_constrained (cut back inside the
 //                     step; Uzawa updates of constrained bodies' multipliers); within
-//                     the step the loads move from the previous factor to the new one;
+//                     the step the loads move from the previous factor to the new one.
+//                     The process time is lambda * process_time: interactions see it
+//                     (tools move with it) and take their rates over the step
+//                     (ProcessClock); interactions with multipliers (augmented-Lagrangian
+//                     contact) are updated and the step solved again until each reports
+//                     its constraint met (at most max_multiplier_updates times);
 //   DynamicStepper    implicit dynamics: step k integrates the output interval
 //                     [(k - 1) T / n, k T / n] with solve_dynamic (time steps cut back
 //                     and regrown inside); load factor t / T, starting at rest;
@@ -20,7 +25,9 @@
 //                         SteppingReport (finished | stopped | failed: which step, why)
 //
 // Load and time steppers start at the first step beyond the state's load factor (a
-// restart); the arc-length stepper always starts from the reference state.
+// restart); the arc-length stepper always starts from the reference state. After every
+// converged step each interaction of the model is committed (Interaction::commit, with
+// the step's start state as `previous`), before the observer sees the step.
 #include <memory>
 #include <string>
 
@@ -40,6 +47,8 @@ struct StepperSettings {
   int steps = 10;                  // output steps (arc length: the most steps)
   StaticOptions statics;           // kLoad
   UzawaOptions uzawa;              // kLoad with constrained bodies
+  double process_time = 1.0;       // kLoad: s per unit load factor (t = lambda process_time)
+  int max_multiplier_updates = 30;  // kLoad: augmented-Lagrangian repeats of a step
   DynamicOptions dynamics;         // kDynamic: per output interval (its times are set per step)
   double end_time = 1.0;           // kDynamic, s
   ArcLengthOptions arc;            // kArcLength
@@ -59,7 +68,7 @@ struct StepInfo {
   int index = 0;             // k, 1-based
   int n_steps = 0;           // requested steps (arc length: the most)
   double load_factor = 0.0;
-  double time = 0.0;         // s, dynamic runs (load factor x end_time); 0 otherwise
+  double time = 0.0;         // s: load factor x end_time (dynamic) or x process_time (load control); 0 for arc length
   int iterations = 0;        // Newton iterations of the step
   int cutbacks = 0;          // cut-backs inside the step
   double residual = 0.0;     // |r_f| at its end, N
@@ -83,6 +92,7 @@ struct SteppingReport {
   bool nothing_left = false;  // the start state was already at the last step (a finished run restarted)
   int total_iterations = 0;   // Newton iterations (load and time steps: failed attempts included)
   int multiplier_updates = 0;  // Uzawa updates of the constraint multipliers
+  int contact_updates = 0;     // augmented-Lagrangian repeats of steps for interactions
 };
 
 class Stepper {

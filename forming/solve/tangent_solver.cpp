@@ -5,13 +5,20 @@
 namespace sf::forming {
 
 TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric) {
-  const bool try_cholesky = kind == linalg::SolverKind::kAuto && !unsymmetric &&
-                            linalg::solver_available(linalg::SolverKind::kCholmod);
-  if (try_cholesky)
-    spd_ = std::make_unique<linalg::LinearSolver>(linalg::SolverKind::kCholmod,
+  using linalg::SolverKind;
+  const bool symmetric_auto = kind == SolverKind::kAuto && !unsymmetric;
+  if (symmetric_auto && linalg::solver_available(SolverKind::kCholmod)) {
+    spd_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmod,
                                                   linalg::MatrixProperty::kSymmetricPositiveDefinite);
+    general_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmodLdlt,
+                                                      linalg::MatrixProperty::kSymmetricIndefinite);
+    lower_ = true;
+    return;
+  }
+  if (symmetric_auto) kind = SolverKind::kEigenLDLT;  // no SuiteSparse
   general_ = std::make_unique<linalg::LinearSolver>(
       kind, unsymmetric ? linalg::MatrixProperty::kUnsymmetric : linalg::MatrixProperty::kSymmetricIndefinite);
+  lower_ = !unsymmetric && linalg::reads_lower_triangle(general_->kind());
 }
 
 const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& k) {
@@ -25,6 +32,7 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
     }
     skip_cholesky_ = 4;
   }
+  if (spd_) ++n_indefinite_;
   const linalg::SolveReport& r = general_->factorize(k);
   active_ = r.ok() ? general_.get() : nullptr;
   return r;
@@ -35,10 +43,10 @@ Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b)
   return active_->solve(b);
 }
 
-FreeDofs::FreeDofs(const std::vector<bool>& is_free) {
-  const Index n = static_cast<Index>(is_free.size());
+FreeDofs::FreeDofs(const std::vector<bool>& free) : is_free(free) {
+  const Index n = static_cast<Index>(free.size());
   for (Index d = 0; d < n; ++d)
-    if (is_free[static_cast<std::size_t>(d)]) index.push_back(d);
+    if (free[static_cast<std::size_t>(d)]) index.push_back(d);
   select.resize(n, size());
   std::vector<Eigen::Triplet<double, int>> t;
   t.reserve(index.size());
@@ -49,6 +57,12 @@ FreeDofs::FreeDofs(const std::vector<bool>& is_free) {
 VecX FreeDofs::restrict(const VecX& v) const {
   VecX out(size());
   for (Index j = 0; j < size(); ++j) out(j) = v(index[j]);
+  return out;
+}
+
+VecX FreeDofs::expand(const VecX& v_free) const {
+  VecX out = VecX::Zero(static_cast<Index>(is_free.size()));
+  for (Index j = 0; j < size(); ++j) out(index[j]) = v_free(j);
   return out;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Pieces of a Newton iteration shared by the static, dynamic and arc-length solvers:
-// the free dofs of a solve (and the selection matrix that restricts a tangent to them)
-// and the linear solver of the Newton tangent.
+// the free dofs of a solve (and the selection matrix that restricts a vector or a
+// matrix to them) and the linear solver of the Newton tangent.
 #include <memory>
 #include <vector>
 
@@ -15,28 +15,43 @@ namespace sf::forming {
 // (column j = unit vector of free dof j): K_ff = S^T K S, x += S dx_f.
 struct FreeDofs {
   std::vector<Index> index;
+  std::vector<bool> is_free;
   linalg::SparseMatrix select;
   FreeDofs() = default;
-  explicit FreeDofs(const std::vector<bool>& is_free);
+  explicit FreeDofs(const std::vector<bool>& free);
   Index size() const { return static_cast<Index>(index.size()); }
   VecX restrict(const VecX& v) const;  // the free entries of v (n_dofs)
+  VecX expand(const VecX& v_free) const;  // n_dofs, zero on the other dofs
 };
 
-// Linear solves with a Newton tangent. With kAuto and a symmetric tangent: Cholesky
-// (CHOLMOD) while the tangent is positive definite, as it is at stable equilibria, and
-// a general LU (UMFPACK) for a factorisation where the Cholesky breaks down (past a
-// limit point, under compressive instability). Unsymmetric tangents (follower loads)
-// and an explicit solver kind go straight to that one.
+// Linear solves with a Newton tangent K_ff as Model::assemble_into lays it out
+// (linalg::PatternAssembler). With kAuto and a symmetric tangent the matrix is stored as
+// its lower triangle (lower() is true) and factorised by supernodal Cholesky (CHOLMOD)
+// while it is positive definite, as it is at stable equilibria; where Cholesky breaks
+// down (past a limit point, under compressive instability) by a symmetric-indefinite
+// LDL^T that reads the same lower triangle (CHOLMOD, no pivoting), so a tangent that
+// loses definiteness is neither expanded to both triangles nor handed to an LU. After a
+// breakdown the next few factorisations go to the LDL^T directly. Unsymmetric tangents
+// (follower loads, friction) and an explicit solver kind go straight to that one, with
+// both triangles stored unless the kind reads only the lower one.
+// Each back end keeps its symbolic analysis while the pattern stays the same (across
+// iterations and, with a solver kept between solves, load steps).
 class TangentSolver {
  public:
   TangentSolver(linalg::SolverKind kind, bool unsymmetric);
+  // True when factorize() expects the lower triangle only.
+  bool lower() const { return lower_; }
   const linalg::SolveReport& factorize(const linalg::SparseMatrix& k);
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+  // Factorisations that fell back to the indefinite solver so far.
+  int n_indefinite() const { return n_indefinite_; }
 
  private:
   std::unique_ptr<linalg::LinearSolver> spd_, general_;
   const linalg::LinearSolver* active_ = nullptr;
-  int skip_cholesky_ = 0;  // after a breakdown, the next few factorisations go to the LU
+  bool lower_ = false;
+  int skip_cholesky_ = 0;  // after a breakdown, the next few factorisations go to general_
+  int n_indefinite_ = 0;
 };
 
 }  // namespace sf::forming

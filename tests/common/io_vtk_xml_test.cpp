@@ -135,7 +135,7 @@ TEST(IoVtkXml, WriterAndReaderFailuresNameThePath) {
 
 TEST(IoVtkXml, PvdListsStepsInOrder) {
   test::ScratchDir dir;
-  write_pvd(dir.file("run.pvd"), {{0.0, "steps/step_0000.vtu"}, {0.125, "steps/a&b.vtu"}});
+  write_pvd(dir.file("run.pvd"), std::vector<std::pair<double, std::string>>{{0.0, "steps/step_0000.vtu"}, {0.125, "steps/a&b.vtu"}});
   EXPECT_EQ(test::read_text(dir.path() / "run.pvd"),
             "<?xml version=\"1.0\"?>\n"
             "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
@@ -144,7 +144,7 @@ TEST(IoVtkXml, PvdListsStepsInOrder) {
             "    <DataSet timestep=\"0.125\" group=\"\" part=\"0\" file=\"steps/a&amp;b.vtu\"/>\n"
             "  </Collection>\n"
             "</VTKFile>\n");
-  EXPECT_THROW(write_pvd(dir.file("x.pvd"), {{std::nan(""), "a.vtu"}}), std::logic_error);
+  EXPECT_THROW(write_pvd(dir.file("x.pvd"), std::vector<std::pair<double, std::string>>{{std::nan(""), "a.vtu"}}), std::logic_error);
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ double nominal_stress(double l) { return kMu * (l - 1.0 / l); }
 
 struct Series {
   Model model;
-  std::vector<std::shared_ptr<const NodeSpring>> springs;
+  std::vector<std::shared_ptr<NodeSpring>> springs;
   std::vector<BodyNode> far_end;  // value nodes of block B's free end
 };
 

@@ -1,0 +1,151 @@
+#include "common/linalg/dense_kernels.hpp"
+
+#include <atomic>
+#include <cstdlib>
+#include <cstring>
+
+#include "common/linalg/simd.hpp"
+
+namespace sf::linalg {
+namespace {
+
+KernelIsa detect() {
+#if SF_SIMD_X86
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    return KernelIsa::kAvx512;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return KernelIsa::kAvx2;
+#endif
+  return KernelIsa::kGeneric;
+}
+
+KernelIsa from_environment(KernelIsa best) {
+  const char* s = std::getenv("SF_KERNEL_ISA");
+  if (s == nullptr) return best;
+  KernelIsa want = best;
+  if (std::strcmp(s, "generic") == 0) want = KernelIsa::kGeneric;
+  if (std::strcmp(s, "avx2") == 0) want = KernelIsa::kAvx2;
+  if (std::strcmp(s, "avx512") == 0) want = KernelIsa::kAvx512;
+  return static_cast<int>(want) < static_cast<int>(best) ? want : best;
+}
+
+std::atomic<int>& current() {
+  static std::atomic<int> isa{static_cast<int>(from_environment(best_kernel_isa()))};
+  return isa;
+}
+
+// Register block of MR = MV W rows x NR columns of C, accumulated over the whole depth
+// (MV NR accumulators stay in registers). Needs n % (MV W) == 0 and n % NR == 0.
+template <int W, int MV, int NR>
+[[gnu::always_inline]] inline void atb_lower_blocked(int n, int depth, const double* a, int lda, const double* b,
+                                                     int ldb, double* c, int ldc) {
+  using V = simd::Vec<W>;
+  constexpr int MR = MV * W;
+  for (int j0 = 0; j0 < n; j0 += NR) {
+    for (int i0 = (j0 / MR) * MR; i0 < n; i0 += MR) {
+      V acc[NR][MV];
+      for (int j = 0; j < NR; ++j)
+        for (int v = 0; v < MV; ++v) acc[j][v] = V{};
+      const double* ap = a + i0;
+      const double* bp = b + j0;
+      for (int p = 0; p < depth; ++p, ap += lda, bp += ldb) {
+        V av[MV];
+        for (int v = 0; v < MV; ++v) av[v] = simd::at<W>(ap + v * W);
+        for (int j = 0; j < NR; ++j) {
+          const V bj = V{} + bp[j];
+          for (int v = 0; v < MV; ++v) acc[j][v] += av[v] * bj;
+        }
+      }
+      for (int j = 0; j < NR; ++j) {
+        double* cp = c + static_cast<long>(j0 + j) * ldc + i0;
+        for (int v = 0; v < MV; ++v) simd::at<W>(cp + v * W) += acc[j][v];
+      }
+    }
+  }
+}
+
+void atb_lower_scalar(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc) {
+  for (int j = 0; j < n; ++j)
+    for (int i = j; i < n; ++i) {
+      double s = 0.0;
+      for (int p = 0; p < depth; ++p) s += a[static_cast<long>(p) * lda + i] * b[static_cast<long>(p) * ldb + j];
+      c[static_cast<long>(j) * ldc + i] += s;
+    }
+}
+
+template <int W>
+[[gnu::always_inline]] inline void atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb,
+                                             double* c, int ldc) {
+  // Block shapes: MV NR accumulators + MV loads + 1 broadcast within the register file
+  // (32 vector registers with AVX-512, 16 otherwise).
+  constexpr int kMv = W == 8 ? 3 : 2, kNr = W == 8 ? 8 : 6;
+  if (n % (kMv * W) == 0 && n % kNr == 0) return atb_lower_blocked<W, kMv, kNr>(n, depth, a, lda, b, ldb, c, ldc);
+  if (n % (2 * W) == 0 && n % 4 == 0) return atb_lower_blocked<W, 2, 4>(n, depth, a, lda, b, ldb, c, ldc);
+  atb_lower_scalar(n, depth, a, lda, b, ldb, c, ldc);
+}
+
+SF_SIMD_AVX512 void atb_lower_avx512(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c,
+                                     int ldc) {
+  atb_lower<8>(n, depth, a, lda, b, ldb, c, ldc);
+}
+SF_SIMD_AVX2 void atb_lower_avx2(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c,
+                                 int ldc) {
+  atb_lower<4>(n, depth, a, lda, b, ldb, c, ldc);
+}
+void atb_lower_generic(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc) {
+  atb_lower<2>(n, depth, a, lda, b, ldb, c, ldc);
+}
+
+}  // namespace
+
+std::string to_string(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::kAvx512:
+      return "avx512";
+    case KernelIsa::kAvx2:
+      return "avx2";
+    case KernelIsa::kGeneric:
+      break;
+  }
+  return "generic";
+}
+
+KernelIsa best_kernel_isa() {
+  static const KernelIsa best = detect();
+  return best;
+}
+
+KernelIsa kernel_isa() { return static_cast<KernelIsa>(current().load(std::memory_order_relaxed)); }
+
+KernelIsa set_kernel_isa(KernelIsa isa) {
+  const KernelIsa best = best_kernel_isa();
+  const KernelIsa use = static_cast<int>(isa) < static_cast<int>(best) ? isa : best;
+  current().store(static_cast<int>(use), std::memory_order_relaxed);
+  return use;
+}
+
+int vector_width(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::kAvx512:
+      return 8;
+    case KernelIsa::kAvx2:
+      return 4;
+    case KernelIsa::kGeneric:
+      break;
+  }
+  return 2;
+}
+
+void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc) {
+  switch (kernel_isa()) {
+    case KernelIsa::kAvx512:
+      return atb_lower_avx512(n, depth, a, lda, b, ldb, c, ldc);
+    case KernelIsa::kAvx2:
+      return atb_lower_avx2(n, depth, a, lda, b, ldb, c, ldc);
+    case KernelIsa::kGeneric:
+      break;
+  }
+  atb_lower_generic(n, depth, a, lda, b, ldb, c, ldc);
+}
+
+}  // namespace sf::linalg

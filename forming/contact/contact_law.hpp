@@ -1,0 +1,69 @@
+#pragma once
+// Contact laws: normal pressure from the gap, tangential traction from the slip rate.
+//
+// Normal (per unit REFERENCE area of the contact surface whose points are checked; g the
+// gap, mm, negative when the surfaces overlap):
+//   penalty                  p = S_n <-g>,                 energy (S_n/2) <-g>^2
+//   augmented Lagrangian     p = <lambda - S_n g>,         energy <lambda - S_n g>^2 / (2 S_n)
+//     (Uzawa: after each converged solve lambda <- p at every contact point, and the
+//      solve is repeated until the largest penetration max(-g) over the points that
+//      carry pressure is at most `tolerance`; the penalty alone leaves -g = p / S_n.)
+//   <a> = max(a, 0); S_n in N/mm^3 (= MPa/mm), p in MPa, lambda in MPa.
+//   The kink of <a> at a = 0 is rounded over a band of width delta in the gap (C1, so
+//   Newton converges where many points rest at zero pressure, e.g. the part of a ply
+//   lying on a table outside a punch): with t = lambda - S_n g and b = S_n delta,
+//     p = 0 (t <= -b/2),   (t + b/2)^2 / (2 b) (|t| < b/2),   t (t >= b/2),
+//   energy the integral of p over -g (t^2/2 + b^2/24 above the band). Surfaces that
+//   touch exactly (stacked plies, g = 0) have p = S_n delta / 8 and stiffness S_n / 2,
+//   so they are held from the first iteration and come apart by delta / 2 at rest.
+//   delta = 1e-3 x the ply thickness (forming/contact/surface_contact.cpp).
+//
+// Tangential (Christie 1997; notes/forming-verification.md section 3.4): with v_T the
+// tangential slip rate (slave relative to master, projected on the master's tangent
+// plane, mm/s), the traction on the slave surface is  t_T = -c v_T,
+//   c = c_f [g <= g_v]  +  mu p / sqrt(|v_T|^2 + eps^2)
+// viscous inter-ply slip tau = c_f v (c_f = eta / theta: resin viscosity over the
+// inter-layer thickness; of order 2e7 Pa s/m = 0.02 N s/mm^3 in mm-N-s units), acting
+// where the gap is below the viscous layer's engage gap g_v (the plies are together);
+// Coulomb friction tau = mu p regularised below the stick velocity eps (a stiff viscous
+// law there: per quasi-static step of length dt a stick stiffness mu p / (eps dt) per
+// unit area); both together = the combined (hydrodynamic) law. Rates come from the
+// velocities (dynamic runs) or from finite differences over the step (quasi-static runs
+// with a process time).
+//
+// Units: mm, N, s, MPa.
+#include <string>
+
+namespace sf::forming {
+
+struct NormalLaw {
+  double stiffness = 0.0;   // S_n, N/mm^3 (> 0)
+  bool augmented = false;   // augmented Lagrangian (Uzawa) on top of the penalty
+  double tolerance = 0.0;   // mm, augmented: largest penetration accepted (> 0)
+  // Throws sf::InputError naming the field ("contact normal stiffness: ...").
+  void validate() const;
+};
+
+struct FrictionLaw {
+  double viscous = 0.0;         // c_f, N s/mm^3 (>= 0)
+  double coulomb = 0.0;         // mu (>= 0)
+  double stick_velocity = 0.0;  // eps, mm/s (> 0 when coulomb > 0)
+  double engage_gap = -1.0;     // g_v, mm; < 0: the default, 0.01 x the ply thickness
+  bool active() const { return viscous > 0.0 || coulomb > 0.0; }
+  void validate() const;
+  // "frictionless", "viscous c_f = ...", "Coulomb mu = ...", "viscous + Coulomb".
+  std::string describe() const;
+};
+
+// What the normal law gives at a gap.
+struct NormalResponse {
+  double pressure = 0.0;   // p, MPa (>= 0)
+  double energy = 0.0;     // per unit reference area, N/mm
+  double stiffness = 0.0;  // dp/d(-g), N/mm^3: S_n where closed, 0 where open, between in the band
+};
+
+// p, energy and stiffness at gap g (mm) with multiplier lambda (MPa; 0 for the plain
+// penalty) and rounding band delta (mm, > 0).
+NormalResponse normal_response(const NormalLaw& law, double gap, double lambda, double band);
+
+}  // namespace sf::forming

@@ -1,0 +1,257 @@
+#include "forming/contact/surface_contact.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "common/core/error.hpp"
+
+namespace sf::forming {
+namespace {
+
+// Rounding band of the normal law (contact_law.hpp): delta = this x thickness.
+constexpr double kBand = 1e-3;
+// Default engage gap of the viscous layer, relative to the slave ply's thickness.
+constexpr double kEngage = 1e-2;
+
+// The local block of one (slave face, master face) pair while a slave face is summed.
+struct PairBlock {
+  Index master_face = -1;
+  const FaceDofs* master_dofs = nullptr;
+  LocalContribution local;
+};
+
+void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, const LocalContribution& c,
+             InteractionSums& sums) {
+  std::vector<Index> dofs;
+  std::vector<double> coefs;
+  std::vector<int> local;
+  const auto append = [&](const FaceDofs& d, int shift) {
+    for (std::size_t j = 0; j < d.dofs.size(); ++j) {
+      dofs.push_back(d.dofs[j]);
+      coefs.push_back(d.coefs[j]);
+      local.push_back(d.local[j] + shift);
+    }
+  };
+  append(slave, 0);
+  if (master) append(*master, slave_size);
+  const int m = static_cast<int>(dofs.size());
+  for (int a = 0; a < m; ++a) sums.force(dofs[a]) += coefs[a] * c.force(local[a]);
+  const auto add = [&](const MatX& k, linalg::TripletAssembler* target) {
+    if (!target || k.size() == 0) return;
+    MatX block(m, m);
+    for (int cc = 0; cc < m; ++cc)
+      for (int a = 0; a < m; ++a) block(a, cc) = coefs[a] * coefs[cc] * k(local[a], local[cc]);
+    target->add_block(dofs, dofs, block);
+  };
+  add(c.stiffness, sums.stiffness);
+  add(c.damping, sums.damping);
+}
+
+}  // namespace
+
+void ContactOptions::validate() const {
+  normal.validate();
+  friction.validate();
+  if (points < 1 || points > 12)
+    throw InputError("contact points: expected 1..12 points per face direction, found " + std::to_string(points));
+  if (!(std::isfinite(search_distance) && search_distance >= 0.0)) {
+    std::ostringstream os;
+    os << "contact search_distance: expected a length >= 0 (mm; 0 = default), found " << search_distance;
+    throw InputError(os.str());
+  }
+}
+
+SurfaceContact::SurfaceContact(std::string name, const Model& model, ContactSurface slave, ContactOptions options)
+    : name_(std::move(name)), slave_(std::move(slave)), options_(options) {
+  options_.validate();
+  rule_ = quadrature::gauss_2d(options_.points, options_.points);
+  const VecX X = model.reference_positions();
+  for (Index f = 0; f < slave_.n_faces(); ++f) {
+    const FaceBasis& fb = slave_.basis(f);
+    const MatX pos = slave_.positions(f, X);
+    std::vector<FaceBasisValues> values;
+    for (int q = 0; q < rule_.size(); ++q) {
+      const Vec2& st = rule_.points[static_cast<std::size_t>(q)];
+      const FaceBasisValues v = fb.evaluate(st[0], st[1], false);
+      Vec3 xs = Vec3::Zero(), xt = Vec3::Zero();
+      for (int a = 0; a < v.n; ++a) {
+        xs += v.ds[static_cast<std::size_t>(a)] * pos.row(a).transpose();
+        xt += v.dt[static_cast<std::size_t>(a)] * pos.row(a).transpose();
+      }
+      weight_.push_back(rule_.weights[static_cast<std::size_t>(q)] * xs.cross(xt).norm());
+      values.push_back(v);
+    }
+    point_basis_.push_back(std::move(values));
+  }
+  lambda_.assign(weight_.size(), 0.0);
+  slip_.assign(weight_.size(), Vec3::Zero());
+}
+
+double SurfaceContact::engage_gap() const {
+  return options_.friction.engage_gap >= 0.0 ? options_.friction.engage_gap : kEngage * slave_.thickness();
+}
+
+void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                              InteractionSums* sums, std::vector<ContactPointRecord>* records) const {
+  const bool tangent = sums && sums->stiffness;
+  const bool damping = sums && sums->damping && context.velocity;
+  // Rates: velocities, or finite differences from the previous state.
+  const VecX* rates = nullptr;
+  VecX rate_storage;
+  double inv_dt = 0.0;
+  if (context.velocity) {
+    rates = context.velocity;
+  } else if (context.previous && context.time > context.previous_time) {
+    inv_dt = 1.0 / (context.time - context.previous_time);
+    rate_storage = (x - *context.previous) * inv_dt;
+    rates = &rate_storage;
+  }
+  const bool friction = options_.friction.active() && rates;
+  const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
+  const double band = kBand * slave_.thickness();
+  const double engage = engage_gap();
+  std::vector<PairBlock> blocks;
+  for (Index f = 0; f < slave_.n_faces(); ++f) {
+    const SurfaceFace& sf = slave_.face(f);
+    const int ns = slave_.basis(f).n_active();
+    const MatX pos = slave_.positions(f, x);
+    MatX rate_pos, prev_pos;
+    if (rates) rate_pos = slave_.positions(f, *rates);
+    if (context.previous) prev_pos = slave_.positions(f, *context.previous);
+    blocks.clear();
+    for (int q = 0; q < points_per_face(); ++q) {
+      const std::size_t id = static_cast<std::size_t>(f * points_per_face() + q);
+      const FaceBasisValues& v = point_basis_[static_cast<std::size_t>(f)][static_cast<std::size_t>(q)];
+      PointKinematics k;
+      k.n = k.n_slave = ns;
+      Vec3 xs = Vec3::Zero(), vs = Vec3::Zero(), dxs = Vec3::Zero();
+      for (int a = 0; a < ns; ++a) {
+        const double na = v.value[static_cast<std::size_t>(a)];
+        k.phi[static_cast<std::size_t>(a)] = na;
+        xs += na * pos.row(a).transpose();
+        if (rates) vs += na * rate_pos.row(a).transpose();
+        if (context.previous) dxs += na * (pos.row(a) - prev_pos.row(a)).transpose();
+      }
+      ContactPointRecord rec;
+      rec.face = f;
+      rec.st = rule_.points[static_cast<std::size_t>(q)];
+      rec.position = xs;
+      rec.slip = slip_[id];
+      rec.weight = weight_[id];
+      Partner partner;
+      if (!find_partner(*prepared, xs, k, partner)) {
+        if (records) records->push_back(rec);
+        continue;
+      }
+      PointLaw law;
+      law.normal = normal_response(options_.normal, k.gap, lambda_[id], band);
+      law.viscous = k.gap <= engage ? options_.friction.viscous : 0.0;
+      law.coulomb = options_.friction.coulomb;
+      law.stick_velocity = options_.friction.stick_velocity;
+      PointRates pr;
+      if (friction) {
+        pr.have = true;
+        pr.relative = vs - partner.velocity;
+        pr.inv_dt = inv_dt;
+        pr.master_d1 = partner.velocity_d1;
+        pr.master_d2 = partner.velocity_d2;
+      }
+      rec.partner = true;
+      rec.gap = k.gap;
+      rec.normal = k.normal;
+      const bool contributes = law.normal.pressure > 0.0 || law.normal.stiffness > 0.0 ||
+                               (pr.have && (law.viscous > 0.0 || (law.coulomb > 0.0 && law.normal.pressure > 0.0)));
+      if (!contributes) {
+        if (records) records->push_back(rec);
+        continue;
+      }
+      PointState st;
+      if (sums) {
+        auto it = std::find_if(blocks.begin(), blocks.end(),
+                               [&](const PairBlock& b) { return b.master_face == partner.master_face; });
+        if (it == blocks.end()) {
+          PairBlock b;
+          b.master_face = partner.master_face;
+          b.master_dofs = partner.master_dofs;
+          const int m = 3 * k.n;
+          b.local.force = VecX::Zero(m);
+          if (tangent) b.local.stiffness = MatX::Zero(m, m);
+          if (damping) b.local.damping = MatX::Zero(m, m);
+          blocks.push_back(std::move(b));
+          it = blocks.end() - 1;
+        }
+        st = add_contact_point(k, law, pr, weight_[id], it->local);
+      } else {
+        LocalContribution scratch;
+        scratch.force = VecX::Zero(3 * k.n);
+        st = add_contact_point(k, law, pr, weight_[id], scratch);
+      }
+      if (records) {
+        rec.pressure = st.pressure;
+        rec.slip_rate = st.slip_rate;
+        rec.shear = st.shear;
+        // The tangential relative displacement since the previous state (commit).
+        if (context.previous) {
+          const Vec3 d = dxs - partner.displacement;
+          rec.slip = d - k.normal * k.normal.dot(d);  // the increment; commit() adds it
+        }
+        records->push_back(rec);
+      }
+    }
+    if (sums)
+      for (const PairBlock& b : blocks) {
+        sums->energy += b.local.energy;
+        scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, *sums);
+      }
+  }
+}
+
+void SurfaceContact::add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                            InteractionSums& sums) const {
+  evaluate(x, context, &sums, nullptr);
+}
+
+std::vector<ContactPointRecord> SurfaceContact::sample(const Eigen::Ref<const VecX>& x,
+                                                       const InteractionContext& context) const {
+  std::vector<ContactPointRecord> out;
+  out.reserve(static_cast<std::size_t>(n_points()));
+  evaluate(x, context, nullptr, &out);
+  // evaluate() leaves the step's slip increment in `slip` when a previous state is
+  // given; the output wants the accumulated slip.
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].slip = slip_[i];
+  return out;
+}
+
+void SurfaceContact::commit(const Eigen::Ref<const VecX>& x, const InteractionContext& context) {
+  if (!context.previous) return;
+  std::vector<ContactPointRecord> rec;
+  rec.reserve(static_cast<std::size_t>(n_points()));
+  evaluate(x, context, nullptr, &rec);
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    if (!rec[i].partner) continue;
+    slip_[i] += rec[i].slip;  // the increment over the step
+    dissipated_ += rec[i].weight * (-rec[i].shear).dot(rec[i].slip);
+  }
+}
+
+MultiplierUpdate SurfaceContact::update_multipliers(const Eigen::Ref<const VecX>& x,
+                                                    const InteractionContext& context) {
+  MultiplierUpdate out;
+  if (!options_.normal.augmented) return out;
+  out.tolerance = options_.normal.tolerance;
+  std::vector<ContactPointRecord> rec;
+  rec.reserve(static_cast<std::size_t>(n_points()));
+  evaluate(x, context, nullptr, &rec);
+  for (const ContactPointRecord& r : rec)
+    if (r.partner && r.pressure > 0.0) out.violation = std::max(out.violation, -r.gap);
+  out.converged = out.violation <= out.tolerance;
+  if (out.converged) return out;
+  for (std::size_t i = 0; i < rec.size(); ++i) lambda_[i] = rec[i].partner ? rec[i].pressure : 0.0;
+  ++updates_;
+  return out;
+}
+
+}  // namespace sf::forming

@@ -1,0 +1,130 @@
+#pragma once
+// Contact of a surface of a body against a partner (a rigid tool, forming/contact/
+// tool_contact.hpp, or a surface of another body, forming/contact/body_contact.hpp), as
+// an Interaction (forming/model/interaction.hpp): "a surface of a body" is the slave
+// side of every pair, so ply-ply, ply-tool and, with diaphragms as bodies, ply-diaphragm
+// and diaphragm-tool pairs are all the same two classes.
+//
+// Contact points: an n x n Gauss grid (default 6 x 6, Christie 1997) on every face of
+// the slave surface (forming/contact/contact_surface.hpp), with weights w = Gauss weight
+// x the reference area element |X,s x X,t|. At each point the partner gives the gap and
+// its derivatives (forming/contact/contact_kernel.hpp), the laws the pressure and the
+// friction traction (forming/contact/contact_law.hpp), and the point adds its energy,
+// force and (consistent) stiffness and damping. One-pass: the slave points are checked
+// against the master surface, not the other way round.
+//
+// State per contact point: the augmented-Lagrangian multiplier lambda (MPa) and the
+// accumulated slip (mm, a vector: the sum over committed steps of the tangential
+// relative displacement P J du over the step), and per pair the friction dissipation
+// (N mm: the sum over committed steps of w c v_T . du_T). Rates come from the context:
+// velocities in dynamic runs, finite differences from the previous converged state in
+// quasi-static runs with a process time; without either, friction adds nothing.
+//
+// Units: mm, N, s.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/quadrature/gauss.hpp"
+#include "forming/contact/contact_kernel.hpp"
+#include "forming/contact/contact_law.hpp"
+#include "forming/contact/contact_surface.hpp"
+#include "forming/model/interaction.hpp"
+#include "forming/model/model.hpp"
+
+namespace sf::forming {
+
+struct ContactOptions {
+  NormalLaw normal;
+  FrictionLaw friction;
+  int points = 6;                // contact points per face direction (Gauss), 1..12
+  double search_distance = 0.0;  // mm; 0: the default (the plies' thicknesses summed)
+  // Throws sf::InputError naming the field.
+  void validate() const;
+};
+
+// What one contact point carries, for outputs and reactions.
+struct ContactPointRecord {
+  Index face = 0;                  // slave face
+  Vec2 st = Vec2::Zero();          // its face coordinates
+  Vec3 position = Vec3::Zero();    // current, mm
+  bool partner = false;            // has a foot point on the partner within reach
+  double gap = 0.0;                // mm (partner only)
+  double pressure = 0.0;           // MPa
+  Vec3 normal = Vec3::Zero();      // the partner's outward normal there
+  Vec3 slip_rate = Vec3::Zero();   // mm/s
+  Vec3 shear = Vec3::Zero();       // friction traction on the slave, MPa
+  Vec3 slip = Vec3::Zero();        // accumulated (committed), mm
+  double weight = 0.0;             // mm^2
+};
+
+class SurfaceContact : public Interaction {
+ public:
+  // `model` gives the reference geometry of the slave surface (point weights). Throws
+  // sf::InputError for invalid options.
+  SurfaceContact(std::string name, const Model& model, ContactSurface slave, ContactOptions options);
+
+  std::string name() const override { return name_; }
+  bool needs_velocity() const override { return options_.friction.active(); }
+  void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+              InteractionSums& sums) const override;
+  void commit(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
+  MultiplierUpdate update_multipliers(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
+
+  // Every contact point at state x, in order (face-major, then the Gauss grid).
+  std::vector<ContactPointRecord> sample(const Eigen::Ref<const VecX>& x, const InteractionContext& context) const;
+  const ContactSurface& slave() const { return slave_; }
+  const ContactOptions& options() const { return options_; }
+  Index n_points() const { return slave_.n_faces() * points_per_face(); }
+  int points_per_face() const { return options_.points * options_.points; }
+  double dissipated() const { return dissipated_; }  // N mm, committed steps
+  int multiplier_updates() const { return updates_; }
+  // One line for summary.json, e.g. "body 0 top against tool 'punch'".
+  virtual std::string describe() const = 0;
+
+ protected:
+  // What the partner side prepares once per evaluation (search trees, tool position).
+  struct Prepared {
+    virtual ~Prepared() = default;
+  };
+  // The partner at a slave point: the master face's dofs (null for a tool) and, where
+  // rates are wanted, the master's velocity at the foot point and its derivatives along
+  // the face (zeta), and its displacement since the previous state (mm).
+  struct Partner {
+    const FaceDofs* master_dofs = nullptr;
+    Index master_face = -1;
+    Vec3 velocity = Vec3::Zero();
+    Vec3 velocity_d1 = Vec3::Zero(), velocity_d2 = Vec3::Zero();
+    Vec3 displacement = Vec3::Zero();
+  };
+  // Once per evaluation. rates: the model's velocities (or finite-difference rates), or
+  // null; previous: the previous state, or null; dt: its time step (quasi-static) or 0.
+  virtual std::unique_ptr<Prepared> prepare(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                                            const VecX* rates, const VecX* previous) const = 0;
+  // k arrives with the slave part filled (n = n_slave, phi, rho = 0); the partner sets
+  // the rest (master functions, gap, normal, derivatives). False: no partner (too far,
+  // beyond a free edge).
+  virtual bool find_partner(const Prepared& prepared, const Vec3& xs, PointKinematics& k, Partner& partner) const = 0;
+  // The engage gap of the viscous layer (mm).
+  double engage_gap() const;
+
+ private:
+  struct Evaluation;
+  // The one loop over the contact points behind add_to, sample, commit and updates.
+  void evaluate(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums* sums,
+                std::vector<ContactPointRecord>* records) const;
+
+  std::string name_;
+  ContactSurface slave_;
+  ContactOptions options_;
+  quadrature::TensorRule<2> rule_;
+  std::vector<std::vector<FaceBasisValues>> point_basis_;  // per face: the basis at each point
+  std::vector<double> weight_;                               // per point: Gauss weight x reference area
+  std::vector<double> lambda_;                               // per point, MPa
+  std::vector<Vec3> slip_;                                   // per point, mm
+  double dissipated_ = 0.0;
+  int updates_ = 0;
+};
+
+}  // namespace sf::forming

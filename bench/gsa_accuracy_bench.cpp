@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
         t += strain_error(g, rt, exact).rms();
         s3 += strain_error(g, rs, exact, 3).rms();
         gauge += rs.gauge_length / rs.mark_spacing;
-        gcv += rs.gcv_log10_delta;
+        gcv += rs.log10_delta_optimum;
         rule += std::log10(2e4 * std::max(rs.noise_estimate / rs.mark_spacing, 1e-6));
       }
       s /= ns;

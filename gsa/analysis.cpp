@@ -131,7 +131,7 @@ void record_parameters(AnalysisResult& r, FrameAndMesh& setup, const UndeformedF
   r.penalty_undeformed = und.penalty;
   r.penalty_deformed = def.fit.penalty;
   r.noise_estimate = und.noise_estimate;
-  r.gcv_log10_delta = def.choice.gcv_log10_delta;
+  r.log10_delta_optimum = def.choice.log10_delta_optimum;
   r.smoothing_criterion = def.choice.criterion;
   r.smoothing_criterion_value = def.choice.criterion_value;
   r.gauge_length = gauge_length(def.fit.penalty, setup.mark_spacing);
@@ -203,7 +203,7 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
                         &res.penalty_deformed.delta})
         *w *= *lo;
       res.gauge_length = gauge_length(res.penalty_deformed, res.mark_spacing);
-      res.gcv_log10_delta += std::log10(*lo);
+      res.log10_delta_optimum += std::log10(*lo);
       std::fill(res.element_multiplier.begin(), res.element_multiplier.end(), 1.0);
       res.relaxed_elements = 0;
       res.local_gauge_length = 0.0;

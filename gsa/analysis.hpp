@@ -98,7 +98,7 @@ struct AnalysisResult {
   double noise_estimate = 0.0;   // estimated digitisation noise (units), per coordinate
   double mark_spacing = 0.0;     // mean spacing of marks (units)
   double gauge_length = 0.0;     // effective smoothing length (units)
-  double gcv_log10_delta = std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
+  double log10_delta_optimum = std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
   std::string smoothing_criterion;  // "GCV", "Cp" (noise model) or empty (explicit weights)
   double smoothing_criterion_value = std::numeric_limits<double>::quiet_NaN();
   double rms_undeformed = 0, max_undeformed = 0, rms_deformed = 0, max_deformed = 0;

@@ -43,6 +43,11 @@ bool confirms(const NoiseEstimate& heavier, const NoiseEstimate& lighter, double
          std::abs(lh - ll) <= kLengthAgreement * std::max(lh, ll) + 0.5 * d;
 }
 
+// No smooth bias in the pilot's residuals: b r_max^2 below a fraction of the noise variance.
+bool unbiased(const NoiseEstimate& e, double max_lag) {
+  return e.bias_slope * max_lag * max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
+}
+
 }  // namespace
 
 NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks, const UndeformedFit& und) {
@@ -81,8 +86,7 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
     // The lighter pilots are only needed until one confirms its heavier neighbour.
     if (ladder.size() >= 2) {
       const NoiseEstimate& e = ladder[ladder.size() - 2];
-      const bool unbiased = e.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
-      if (unbiased && confirms(e, ladder.back(), d)) return e;
+      if (unbiased(e, vo.max_lag) && confirms(e, ladder.back(), d)) return e;
     }
   }
   if (ladder.empty()) return {};
@@ -134,9 +138,8 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
     // Lighter pilots only until one confirms its heavier neighbour.
     if (ladder.size() >= 2) {
       const NoiseEstimate& h = ladder[ladder.size() - 2];
-      const bool unbiased = h.bias_slope * vo.max_lag * vo.max_lag < kBiasFraction * h.sigma_total() * h.sigma_total();
       const double sh = h.sigma_total(), sl = ladder.back().sigma_total();
-      if (unbiased && std::abs(sh - sl) <= kSigmaAgreement * sl) return h;
+      if (unbiased(h, vo.max_lag) && std::abs(sh - sl) <= kSigmaAgreement * sl) return h;
     }
   }
   if (ladder.empty()) return {};

@@ -187,7 +187,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     params["projection_iterations"] = r.projection_iterations;
     params["outlier_sigma"] = r.outlier_sigma;
     nlohmann::json smoothing = {{"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
-                                {"log10_delta_optimum", json_number(r.gcv_log10_delta)},
+                                {"log10_delta_optimum", json_number(r.log10_delta_optimum)},
                                 {"criterion_value", json_number(r.smoothing_criterion_value)},
                                 {"gauge_length", r.gauge_length},
                                 {"relaxed_elements", r.relaxed_elements},

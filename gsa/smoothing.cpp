@@ -112,7 +112,7 @@ double weighted_rss(const FitResult& f, const VecX& w) {
 SmoothingChoice strain_choice(const BracketMinimum& best, const char* criterion, const SmoothingOptions& options,
                               double d) {
   SmoothingChoice choice;
-  choice.gcv_log10_delta = best.at;
+  choice.log10_delta_optimum = best.at;
   choice.criterion = criterion;
   choice.criterion_value = best.value;
   choice.penalty = jumps_penalty(best.at, d);

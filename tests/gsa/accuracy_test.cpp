@@ -143,7 +143,7 @@ std::string describe(const AnalysisResult& a) {
   for (const PointResult& p : a.points) flagged += p.flag ? 1 : 0;
   os << "noise und " << a.noise_undeformed.sigma_total() << " L " << a.noise_undeformed.effective_length()
      << ", def sc " << a.noise.sigma_correlated << " sw " << a.noise.sigma_white << ", log10 delta "
-     << a.gcv_log10_delta << ", gauge " << a.gauge_length << ", relaxed " << a.relaxed_elements << ", flagged "
+     << a.log10_delta_optimum << ", gauge " << a.gauge_length << ", relaxed " << a.relaxed_elements << ", flagged "
      << flagged;
   return os.str();
 }

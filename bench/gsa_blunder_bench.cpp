@@ -14,10 +14,21 @@ using namespace sf::gsa;
 
 int main(int argc, char** argv) {
   const int seeds = argc > 1 ? std::atoi(argv[1]) : 3;
-  struct Case { std::string name; Deformation d; PointLayout layout; double corr; };
-  PointLayout plate; plate.length_x = plate.length_y = 100; plate.spacing = 2.5;
-  PointLayout strip; strip.length_x = 30; strip.length_y = 12; strip.spacing = 0.3;
-  PointLayout scat = plate; scat.kind = PointLayout::Kind::kScattered;
+  struct Case {
+    std::string name;
+    Deformation d;
+    PointLayout layout;
+    double corr;
+  };
+  PointLayout plate;
+  plate.length_x = plate.length_y = 100;
+  plate.spacing = 2.5;
+  PointLayout strip;
+  strip.length_x = 30;
+  strip.length_y = 12;
+  strip.spacing = 0.3;
+  PointLayout scat = plate;
+  scat.kind = PointLayout::Kind::kScattered;
   std::vector<Case> cases;
   for (double corr : {0.0, 1.0, 2.5, 5.0}) {
     cases.push_back({"dome", deformation_of(synthetic_case("dome")), plate, corr});
@@ -36,7 +47,8 @@ int main(int argc, char** argv) {
       SyntheticMeasurementOptions o;
       o.layout = c.layout;
       const double sigma = 0.004 * c.layout.spacing;
-      o.deformed_noise = c.corr > 0 ? NoiseModel{sigma, c.corr * c.layout.spacing, 0.3 * sigma} : NoiseModel{0, 0, sigma};
+      o.deformed_noise =
+          c.corr > 0 ? NoiseModel{sigma, c.corr * c.layout.spacing, 0.3 * sigma} : NoiseModel{0, 0, sigma};
       o.undeformed_noise = o.deformed_noise;
       o.seed = static_cast<unsigned>(seed);
       SyntheticMeasurement m = make_measurement(c.d, o);
@@ -57,12 +69,14 @@ int main(int argc, char** argv) {
       for (Index p : m.blunder_points) {
         found += bb.flagged[static_cast<std::size_t>(p)] ? 1 : 0;
         if (!bb.flagged[static_cast<std::size_t>(p)] && std::getenv("DEBUG"))
-          std::printf("  missed %ld: deviation/threshold %.2f edge %.2f\n", static_cast<long>(p), bb.deviation[static_cast<std::size_t>(p)] / bb.threshold, m.edge_distance[static_cast<std::size_t>(p)] / c.layout.spacing);
+          std::printf("  missed %ld: deviation/threshold %.2f edge %.2f\n", static_cast<long>(p),
+                      bb.deviation[static_cast<std::size_t>(p)] / bb.threshold,
+                      m.edge_distance[static_cast<std::size_t>(p)] / c.layout.spacing);
       }
       total += static_cast<long>(m.blunder_points.size());
     }
-    std::printf("%-15s %5.1f %6ld | %8ld %8ld | %8.2e %8.2e | %6ld %6ld\n", c.name.c_str(), c.corr, static_cast<long>(npts), fu, fd,
-                noise / seeds, thr / seeds, found, total);
+    std::printf("%-15s %5.1f %6ld | %8ld %8ld | %8.2e %8.2e | %6ld %6ld\n", c.name.c_str(), c.corr,
+                static_cast<long>(npts), fu, fd, noise / seeds, thr / seeds, found, total);
   }
   return 0;
 }

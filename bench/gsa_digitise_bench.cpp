@@ -71,10 +71,11 @@ int main(int argc, char** argv) {
   }
   if (argc > 2) o.calibration_views = std::atoi(argv[2]);
   const int repeats = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
-  std::printf("gsa_digitise_bench: %d x %d pixels (%.2f megapixels), %d chessboard views per camera, noise %.1f grey "
-              "levels, blur %.1f px, uneven lighting\n\n",
-              o.width, o.height, o.width * o.height / 1e6, o.calibration_views, o.effects.noise_sigma * 255,
-              o.effects.blur_sigma);
+  std::printf(
+      "gsa_digitise_bench: %d x %d pixels (%.2f megapixels), %d chessboard views per camera, noise %.1f grey "
+      "levels, blur %.1f px, uneven lighting\n\n",
+      o.width, o.height, o.width * o.height / 1e6, o.calibration_views, o.effects.noise_sigma * 255,
+      o.effects.blur_sigma);
 
   // 1. Calibration.
   const std::vector<Camera> truth = synth::example_cameras(o);
@@ -85,7 +86,8 @@ int main(int argc, char** argv) {
     for (std::size_t b = 0; b < boards.size(); ++b) {
       synth::Effects fx = o.effects;
       fx.seed = static_cast<unsigned>(1000 + 10 * b + c);
-      calib[c].push_back({"cam" + std::to_string(c) + "/view_" + std::to_string(b), synth::render(truth[c], boards[b], fx)});
+      calib[c].push_back(
+          {"cam" + std::to_string(c) + "/view_" + std::to_string(b), synth::render(truth[c], boards[b], fx)});
     }
   const double t_render = since(t0);
   const synth::BoardSpec bs = synth::example_board(o);
@@ -94,8 +96,8 @@ int main(int argc, char** argv) {
   t0 = Clock::now();
   const CalibrationResult cal = calibrate_rig(calib, co);
   const double t_cal = since(t0);
-  std::printf("1. Calibration (%zu x %zu views rendered in %.1f s, calibrated in %.1f s)\n", truth.size(), boards.size(),
-              t_render, t_cal);
+  std::printf("1. Calibration (%zu x %zu views rendered in %.1f s, calibrated in %.1f s)\n", truth.size(),
+              boards.size(), t_render, t_cal);
   std::printf("   camera  fx err %%   fy err %%   cx err px  cy err px   RMS px   worst image px\n");
   for (std::size_t c = 0; c < truth.size(); ++c) {
     const Camera &e = cal.rig.cameras[c], &t = truth[c];
@@ -112,8 +114,9 @@ int main(int argc, char** argv) {
   }
 
   // 2. 3-D marks.
-  std::printf("\n2. 3-D marks (mm)                   on part labelled mislabelled | exact cameras: RMS    max "
-              "| calibrated rig: RMS in cam0 frame, rigidly aligned: RMS    max\n");
+  std::printf(
+      "\n2. 3-D marks (mm)                   on part labelled mislabelled | exact cameras: RMS    max "
+      "| calibrated rig: RMS in cam0 frame, rigidly aligned: RMS    max\n");
   Rig exact_rig;
   exact_rig.cameras = truth;
   struct Case {
@@ -145,10 +148,11 @@ int main(int argc, char** argv) {
     const SetResult sc_cal = digitise_set(cal.rig, images, d);
     const synth::Comparison ce = synth::compare_marks(se.marks, sc, k.marks);
     const synth::Comparison cc = synth::compare_marks(sc_cal.marks, sc, k.marks, pose(truth[0]));
-    std::printf("   %-34s %6zu  %6ld   %6ld     |            %7.4f %7.4f |              %7.4f                %7.4f "
-                "%7.4f\n",
-                k.name, synth::true_marks(sc).size(), static_cast<long>(ce.n),
-                static_cast<long>(ce.mislabelled + cc.mislabelled), ce.rms, ce.max, cc.rms, cc.rms_rigid, cc.max_rigid);
+    std::printf(
+        "   %-34s %6zu  %6ld   %6ld     |            %7.4f %7.4f |              %7.4f                %7.4f "
+        "%7.4f\n",
+        k.name, synth::true_marks(sc).size(), static_cast<long>(ce.n),
+        static_cast<long>(ce.mislabelled + cc.mislabelled), ce.rms, ce.max, cc.rms, cc.rms_rigid, cc.max_rigid);
   }
   {
     synth::ExampleOptions ko = o;
@@ -193,10 +197,10 @@ int main(int argc, char** argv) {
       if (s.marks.empty()) return 1;
     }
     std::sort(times.begin(), times.end());
-    std::printf("\n3. Digitising one %.1f-megapixel image pair read from PNG (dome, %u threads): best %.2f s, median "
-                "%.2f s of %d\n",
-                o.width * o.height / 1e6, std::thread::hardware_concurrency(), times.front(), times[times.size() / 2],
-                repeats);
+    std::printf(
+        "\n3. Digitising one %.1f-megapixel image pair read from PNG (dome, %u threads): best %.2f s, median "
+        "%.2f s of %d\n",
+        o.width * o.height / 1e6, std::thread::hardware_concurrency(), times.front(), times[times.size() / 2], repeats);
     std::filesystem::remove_all(dir);
   }
 
@@ -206,9 +210,11 @@ int main(int argc, char** argv) {
     const synth::Scene dome = synth::example_part(o, synth::SheetShape::kDome);
     const auto flat_images = synth::render_views(truth, flat, o.effects, 13);
     const auto dome_images = synth::render_views(truth, dome, o.effects, 17);
-    std::printf("\n4. Images to strains (dome; RMS error of E1 and E2 against the exact strains, marks inside the "
-                "outer ring)\n");
-    for (const auto& [label, rig] : {std::pair<const char*, const Rig*>{"calibrated rig", &cal.rig}, {"exact cameras", &exact_rig}}) {
+    std::printf(
+        "\n4. Images to strains (dome; RMS error of E1 and E2 against the exact strains, marks inside the "
+        "outer ring)\n");
+    for (const auto& [label, rig] :
+         {std::pair<const char*, const Rig*>{"calibrated rig", &cal.rig}, {"exact cameras", &exact_rig}}) {
       const SetResult u = digitise_set(*rig, flat_images, DigitiseOptions{});
       const SetResult d = digitise_set(*rig, dome_images, DigitiseOptions{});
       const Vec3 eye = rig->cameras[0].centre();
@@ -229,10 +235,11 @@ int main(int argc, char** argv) {
         }
       }
       const StrainError er = strains_of(ref, exact_strains(rows, dome, o.marks));
-      std::printf("   %-15s digitised: E1 %.2e  E2 %.2e (RMS %.2e, %ld marks) | exact + 0.01 mm noise: E1 %.2e  E2 "
-                  "%.2e (RMS %.2e) | ratio %.2f\n",
-                  label, e.rms_e1, e.rms_e2, e.rms(), static_cast<long>(e.n), er.rms_e1, er.rms_e2, er.rms(),
-                  e.rms() / er.rms());
+      std::printf(
+          "   %-15s digitised: E1 %.2e  E2 %.2e (RMS %.2e, %ld marks) | exact + 0.01 mm noise: E1 %.2e  E2 "
+          "%.2e (RMS %.2e) | ratio %.2f\n",
+          label, e.rms_e1, e.rms_e2, e.rms(), static_cast<long>(e.n), er.rms_e1, er.rms_e2, er.rms(),
+          e.rms() / er.rms());
     }
   }
   return 0;

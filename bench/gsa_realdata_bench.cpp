@@ -30,7 +30,7 @@ struct Study {
 };
 
 struct Errors {
-  double interior = 0.0, edge = 0.0;  // RMS of (E1, E2) errors
+  double interior = 0.0, edge = 0.0;    // RMS of (E1, E2) errors
   double peak = 0.0, peak_exact = 0.0;  // largest E1
   Index without = 0, flagged = 0;
 };
@@ -124,12 +124,13 @@ std::vector<Study> studies() {
 int main(int argc, char** argv) {
   const int seeds = argc > 1 ? std::atoi(argv[1]) : 2;
   const std::string filter = argc > 2 ? argv[2] : "";
-  std::printf("%-16s %6s | %9s %9s %5s | %9s %6s | %9s %9s | %7s %7s | %6s %6s %6s | %5s %5s | %5s %5s %5s %5s\n", "case", "points",
-              "auto", "auto_edge", "gauge", "oracle", "lg_opt", "nn24", "nn24_edge", "a/orac", "a/nn24", "peak_a",
-              "peak_o", "exact", "flag", "none", "sc/t", "L/h", "sw/t", "relax");
+  std::printf("%-16s %6s | %9s %9s %5s | %9s %6s | %9s %9s | %7s %7s | %6s %6s %6s | %5s %5s | %5s %5s %5s %5s\n",
+              "case", "points", "auto", "auto_edge", "gauge", "oracle", "lg_opt", "nn24", "nn24_edge", "a/orac",
+              "a/nn24", "peak_a", "peak_o", "exact", "flag", "none", "sc/t", "L/h", "sw/t", "relax");
   for (const Study& s : studies()) {
     if (!filter.empty() && s.name.find(filter) == std::string::npos) continue;
-    double est_sc = 0, est_L = 0, est_sw = 0, relaxed = 0, a = 0, ae = 0, o = 0, nn = 0, nne = 0, gauge = 0, lg = 0, pa = 0, po = 0, pe = 0;
+    double est_sc = 0, est_L = 0, est_sw = 0, relaxed = 0, a = 0, ae = 0, o = 0, nn = 0, nne = 0, gauge = 0, lg = 0,
+           pa = 0, po = 0, pe = 0;
     Index flagged = 0, none = 0, npts = 0;
     for (int seed = 1; seed <= seeds; ++seed) {
       SyntheticMeasurementOptions opt = s.options;
@@ -138,7 +139,8 @@ int main(int argc, char** argv) {
       npts = m.grid.n_points();
       const double h = opt.layout.spacing;
       AnalyseOptions ao;
-      if (std::getenv("ELEM1")) ao.mesh.elements1 = std::atoi(std::getenv("ELEM1")), ao.mesh.elements2 = std::atoi(std::getenv("ELEM2"));
+      if (std::getenv("ELEM1"))
+        ao.mesh.elements1 = std::atoi(std::getenv("ELEM1")), ao.mesh.elements2 = std::atoi(std::getenv("ELEM2"));
       if (std::getenv("GCV")) ao.smoothing.rule = SmoothingRule::kGcv;
       if (std::getenv("NOLOCAL")) ao.smoothing.local = false;
       const AnalysisResult ra = analyse(m.grid, ao);
@@ -180,9 +182,12 @@ int main(int argc, char** argv) {
       nne += en.edge;
     }
     const double k = 1.0 / seeds;
-    std::printf("%-16s %6ld | %9.2e %9.2e %5.2f | %9.2e %6.1f | %9.2e %9.2e | %7.2f %7.2f | %6.3f %6.3f %6.3f | %5ld %5ld | %5.2f %5.2f %5.2f %5.0f\n",
-                s.name.c_str(), static_cast<long>(npts), a * k, ae * k, gauge * k, o * k, lg * k, nn * k, nne * k,
-                a / o, a / nn, pa * k, po * k, pe * k, static_cast<long>(flagged), static_cast<long>(none), est_sc * k, est_L * k, est_sw * k, relaxed * k);
+    std::printf(
+        "%-16s %6ld | %9.2e %9.2e %5.2f | %9.2e %6.1f | %9.2e %9.2e | %7.2f %7.2f | %6.3f %6.3f %6.3f | %5ld %5ld | "
+        "%5.2f %5.2f %5.2f %5.0f\n",
+        s.name.c_str(), static_cast<long>(npts), a * k, ae * k, gauge * k, o * k, lg * k, nn * k, nne * k, a / o,
+        a / nn, pa * k, po * k, pe * k, static_cast<long>(flagged), static_cast<long>(none), est_sc * k, est_L * k,
+        est_sw * k, relaxed * k);
     std::fflush(stdout);
   }
   return 0;

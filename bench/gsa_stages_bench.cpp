@@ -61,9 +61,9 @@ int main(int argc, char** argv) {
     const auto& t = r.times;
     // Marks are read back in file order, so the exact strains still line up.
     const StrainError err = strain_error(g, r, exact);
-    std::printf("%9ld %3dx%-3d %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %9.1f %9.2e\n", static_cast<long>(g.n_points()),
-                r.elements1, r.elements2, t.read, t.mesh, t.project, t.fit, t.strain, t.write,
-                t.read + t.mesh + t.project + t.fit + t.strain + t.write, peak_mb(), err.rms());
+    std::printf("%9ld %3dx%-3d %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %9.1f %9.2e\n",
+                static_cast<long>(g.n_points()), r.elements1, r.elements2, t.read, t.mesh, t.project, t.fit, t.strain,
+                t.write, t.read + t.mesh + t.project + t.fit + t.strain + t.write, peak_mb(), err.rms());
     std::fflush(stdout);
   }
   std::filesystem::remove_all(tmp);

@@ -36,14 +36,11 @@ constexpr double kSize = 200.0;     // mm
 constexpr double kBump = 6.0;       // mm
 constexpr double kMaxOffset = 0.5;  // mm
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 sf::mesh::SurfaceMesh sheet(int n) {
   using sf::mesh::SurfaceMesh;
-  SurfaceMesh mesh =
-      sf::mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), kSize, kSize, n, n);
+  SurfaceMesh mesh = sf::mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), kSize, kSize, n, n);
   const double k = kPi / kSize;
   for (Index node = 0; node < mesh.n_nodes(); ++node) {
     const Vec3 q = mesh.node_position(node);
@@ -52,10 +49,8 @@ sf::mesh::SurfaceMesh sheet(int n) {
     const double zx = kBump * k * std::cos(k * x) * std::sin(k * y);
     const double zy = kBump * k * std::sin(k * x) * std::cos(k * y);
     mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kValue)) = Vec3(x, y, z).transpose();
-    mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kD1)) =
-        Vec3(1, 0, zx).normalized().transpose();
-    mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kD2)) =
-        Vec3(0, 1, zy).normalized().transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kD1)) = Vec3(1, 0, zx).normalized().transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kD2)) = Vec3(0, 1, zy).normalized().transpose();
     mesh.geometry().row(SurfaceMesh::dof(node, sf::mesh::kD12)).setZero();
   }
   mesh.compute_arc_length_scale_factors();
@@ -94,8 +89,7 @@ void run(int n_elements_per_side, const std::vector<Index>& sizes, int threads) 
   const auto t_build = Clock::now();
   const sf::mesh::SurfaceProjector projector(mesh, mesh.geometry(), options);
   const double build = seconds_since(t_build);
-  const int used_threads =
-      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int used_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   for (Index n : sizes) {
     const Cloud cloud = make_cloud(mesh, n, 20240611u + static_cast<unsigned>(n));
     const auto t0 = Clock::now();
@@ -112,14 +106,13 @@ void run(int n_elements_per_side, const std::vector<Index>& sizes, int threads) 
       iterations += result[i].iterations;
       ++counts[static_cast<int>(result[i].status)];
     }
-    std::printf("%2dx%-2d %8lld %7lld %3d %7.3f %8.3f %8.3f %10.0f %10.2e %10.2e %6.2f "
-                "%lld/%lld/%lld/%lld\n",
-                n_elements_per_side, n_elements_per_side, static_cast<long long>(n),
-                static_cast<long long>(projector.n_samples()), used_threads, build, time, cpu,
-                static_cast<double>(n) / time, sum / static_cast<double>(n), worst,
-                iterations / static_cast<double>(n), static_cast<long long>(counts[0]),
-                static_cast<long long>(counts[1]), static_cast<long long>(counts[2]),
-                static_cast<long long>(counts[3]));
+    std::printf(
+        "%2dx%-2d %8lld %7lld %3d %7.3f %8.3f %8.3f %10.0f %10.2e %10.2e %6.2f "
+        "%lld/%lld/%lld/%lld\n",
+        n_elements_per_side, n_elements_per_side, static_cast<long long>(n),
+        static_cast<long long>(projector.n_samples()), used_threads, build, time, cpu, static_cast<double>(n) / time,
+        sum / static_cast<double>(n), worst, iterations / static_cast<double>(n), static_cast<long long>(counts[0]),
+        static_cast<long long>(counts[1]), static_cast<long long>(counts[2]), static_cast<long long>(counts[3]));
     std::fflush(stdout);
   }
 }
@@ -129,18 +122,18 @@ void run(int n_elements_per_side, const std::vector<Index>& sizes, int threads) 
 int main() {
   try {
     const auto t0 = Clock::now();
-    std::printf("nearest-point projection: %g x %g mm sheet, bump %g mm, offsets within +-%g mm\n",
-                kSize, kSize, kBump, kMaxOffset);
+    std::printf("nearest-point projection: %g x %g mm sheet, bump %g mm, offsets within +-%g mm\n", kSize, kSize, kBump,
+                kMaxOffset);
     std::printf("hardware threads: %u; options: candidates 8, samples 6x6 per element\n",
                 std::thread::hardware_concurrency());
-    std::printf("build = element data + kd-tree (s); project = batch projection, wall clock (s);\n"
-                "cpu = process CPU time of the projection, all threads (s);\n"
-                "points/s = points / project;\n"
-                "err = |distance - |offset|| (mm); iters = mean Newton iterations\n");
+    std::printf(
+        "build = element data + kd-tree (s); project = batch projection, wall clock (s);\n"
+        "cpu = process CPU time of the projection, all threads (s);\n"
+        "points/s = points / project;\n"
+        "err = |distance - |offset|| (mm); iters = mean Newton iterations\n");
     std::printf("status = converged/on_free_edge/not_converged/failed\n\n");
-    std::printf("%-5s %8s %7s %3s %7s %8s %8s %10s %10s %10s %6s %s\n", "mesh", "points", "samples",
-                "thr", "build", "project", "cpu", "points/s", "mean err", "max err", "iters",
-                "status");
+    std::printf("%-5s %8s %7s %3s %7s %8s %8s %10s %10s %10s %6s %s\n", "mesh", "points", "samples", "thr", "build",
+                "project", "cpu", "points/s", "mean err", "max err", "iters", "status");
     const std::vector<Index> sizes = {10000, 100000, 1000000};
     run(20, sizes, 0);
     run(60, sizes, 0);

@@ -219,8 +219,7 @@ int run_shear_stretch(const std::string& path) {
   const auto t0 = std::chrono::steady_clock::now();
   const SteppingReport report = stepper->run(state, recorder);
   const double total_s = seconds_since(t0);
-  std::printf("# shear-and-stretch ply (%s): %ld dofs, %s\n", path.c_str(),
-              static_cast<long>(problem.model.n_dofs()),
+  std::printf("# shear-and-stretch ply (%s): %ld dofs, %s\n", path.c_str(), static_cast<long>(problem.model.n_dofs()),
               report.status == SteppingReport::Status::kFinished ? "finished" : report.message.c_str());
   int iterations = 0;
   for (const StepInfo& s : recorder.steps) {
@@ -244,15 +243,18 @@ int main(int argc, char** argv) {
     const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
     const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
     const TransverselyIsotropicParams tp = ply_law();
-    std::printf("# simform_bench: flat plies %g x %g x %g mm, compressible TI (mu_T %g, mu_L %g, kappa_f %g, lambda %g "
-                "MPa), fibres 0/90/0/90; plies are independent bodies (no contact yet)\n",
-                kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
-    std::printf("# element loop on %d threads (OpenMP), kernel vector instructions: %s (processor's best: %s); "
-                "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n",
-                omp_get_max_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
-                linalg::to_string(linalg::best_kernel_isa()).c_str());
-    std::printf("# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
-                repeats);
+    std::printf(
+        "# simform_bench: flat plies %g x %g x %g mm, compressible TI (mu_T %g, mu_L %g, kappa_f %g, lambda %g "
+        "MPa), fibres 0/90/0/90; plies are independent bodies (no contact yet)\n",
+        kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
+    std::printf(
+        "# element loop on %d threads (OpenMP), kernel vector instructions: %s (processor's best: %s); "
+        "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n",
+        omp_get_max_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
+        linalg::to_string(linalg::best_kernel_isa()).c_str());
+    std::printf(
+        "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
+        repeats);
     std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %8s %8s\n", "n x n", "plies", "n_dofs",
                 "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s", "iter_s",
                 "kern_GF", "fact_GF", "newton", "static_s", "peak_MB");

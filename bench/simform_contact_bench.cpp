@@ -55,18 +55,18 @@ static double seconds(F&& f, int repeat) {
 
 int main(int argc, char** argv) {
   const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
-  std::printf("%4s %6s %8s %8s %10s %9s %6s %10s %11s %8s\n", "n", "plies", "points", "active", "search_s",
-              "us/point", "cand", "force_s", "assembly_s", "peak_MB");
+  std::printf("%4s %6s %8s %8s %10s %9s %6s %10s %11s %8s\n", "n", "plies", "points", "active", "search_s", "us/point",
+              "cand", "force_s", "assembly_s", "peak_MB");
   for (int n : {10, 20, 40}) {
     if (n > max_n) break;
     for (int plies : {2, 4}) {
       Model model;
       const auto law = std::make_shared<NeoHookean>(NeoHookeanParams{100.0, 100.0});
       for (int k = 0; k < plies; ++k)
-        model.add_ply(PlyMesh(mesh::make_rectangle_mesh(Vec3(0, 0, 0.5 * k), Vec3::UnitX(), Vec3::UnitY(), 100.0,
-                                                        100.0, n, n),
-                              0.5, k % 2 ? 90.0 : 0.0),
-                      law);
+        model.add_ply(
+            PlyMesh(mesh::make_rectangle_mesh(Vec3(0, 0, 0.5 * k), Vec3::UnitX(), Vec3::UnitY(), 100.0, 100.0, n, n),
+                    0.5, k % 2 ? 90.0 : 0.0),
+            law);
       ContactOptions o;
       o.normal.stiffness = 100.0;
       o.friction.viscous = 0.02;

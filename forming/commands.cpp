@@ -69,7 +69,9 @@ void register_commands(sf::cli::Program& program) {
   auto check_file = std::make_shared<std::string>();
   program.add_command(
       "check", "Validate a case file and list every problem with its place (file:line:column)",
-      [check_file](CLI::App& app) { app.add_option("case", *check_file, "Case file (YAML, see docs/forming.md)")->required(); },
+      [check_file](CLI::App& app) {
+        app.add_option("case", *check_file, "Case file (YAML, see docs/forming.md)")->required();
+      },
       [check_file, prog] { return run_check(*check_file, prog->common().quiet); });
 
   auto args = std::make_shared<RunArgs>();

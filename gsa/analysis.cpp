@@ -29,8 +29,8 @@ void tell(const ProgressCallback& progress, AnalysisStage stage, const FrameAndM
 struct DeformedStages {
   DeformedFit fit;
   SmoothingChoice choice;
-  NoiseEstimate noise;         // of the deformed data (noise-model rule)
-  LocalSmoothing local;        // element multipliers (noise-model rule with local smoothing)
+  NoiseEstimate noise;   // of the deformed data (noise-model rule)
+  LocalSmoothing local;  // element multipliers (noise-model rule with local smoothing)
 };
 DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const FitMarks& marks,
                                    const UndeformedFit& und, const NoiseEstimate& undeformed_noise,
@@ -84,17 +84,21 @@ void fill_point_results(std::vector<PointResult>& points, const GridData& grid, 
   for (const OutlierFlag& f : def.flags) flag_d[static_cast<std::size_t>(f.mark)] = &f;
   std::size_t next = 0;  // marks.point is ascending: the points between marks have no undeformed position
   for (std::size_t p = 0; p < points.size(); ++p) {
-    if (next < marks.point.size() && marks.point[next] == static_cast<Index>(p)) ++next;
-    else points[p].status = grid.not_measured_undeformed(static_cast<Index>(p)) ? kStatusNotMeasured : kStatusMissingUndeformed;
+    if (next < marks.point.size() && marks.point[next] == static_cast<Index>(p))
+      ++next;
+    else
+      points[p].status =
+          grid.not_measured_undeformed(static_cast<Index>(p)) ? kStatusNotMeasured : kStatusMissingUndeformed;
   }
   for (Index k = 0; k < marks.size(); ++k) {
     const auto kk = static_cast<std::size_t>(k);
     PointResult& pr = points[static_cast<std::size_t>(marks.point[kk])];
     const bool has_deformed = grid.has_deformed(marks.point[kk]);
-    pr.status = flag_u[kk]      ? kStatusOutlierUndeformed
-                : !has_deformed ? (grid.not_measured_deformed(marks.point[kk]) ? kStatusNotMeasured : kStatusMissingDeformed)
-                : flag_d[kk]    ? kStatusOutlierDeformed
-                                : kStatusOk;
+    pr.status = flag_u[kk] ? kStatusOutlierUndeformed
+                : !has_deformed
+                    ? (grid.not_measured_deformed(marks.point[kk]) ? kStatusNotMeasured : kStatusMissingDeformed)
+                : flag_d[kk] ? kStatusOutlierDeformed
+                             : kStatusOk;
     if (const OutlierFlag* f = flag_u[kk] ? flag_u[kk] : flag_d[kk]) pr.flag = *f;
     pr.element = und.location[kk].element;
     pr.xi = und.location[kk].xi;
@@ -156,12 +160,13 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
 
   tell(progress, AnalysisStage::kOutliers, &setup);
   Points3 deformed_at_marks(marks.size(), 3);
-  for (Index k = 0; k < marks.size(); ++k) deformed_at_marks.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  for (Index k = 0; k < marks.size(); ++k)
+    deformed_at_marks.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
   MarkOutliers outliers = find_outliers(marks, deformed_at_marks, setup.mark_spacing, options.outliers);
 
   tell(progress, AnalysisStage::kUndeformedFit, &setup);
-  const UndeformedFit und = fit_undeformed(setup, marks, {options.smoothing, std::move(outliers.undeformed),
-                                                          options.max_projection_iterations});
+  const UndeformedFit und = fit_undeformed(
+      setup, marks, {options.smoothing, std::move(outliers.undeformed), options.max_projection_iterations});
   const DeformedMarks deformed = deformed_marks(grid, marks, und);
   NoiseEstimate undeformed_noise;
   if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel)
@@ -171,8 +176,8 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   const auto tf = Clock::now();
   DeformedProblem problem(setup, marks, und, deformed);
   // Deformed flags of marks the undeformed fit readmitted or that lack a deformed position stay as found.
-  DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise,
-                                           std::move(outliers.deformed), options, progress);
+  DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise, std::move(outliers.deformed),
+                                           options, progress);
   res.times.fit = und.fit_seconds + seconds_since(tf);
   res.times.project = und.project_seconds;
   const DeformedResiduals residuals = deformed_residuals(problem, def.fit);
@@ -219,17 +224,18 @@ void AnalyseOptions::validate() const {
   if (mesh.elements2 < 0) throw OptionError("mesh.elements2", "expected a count >= 0" + found(mesh.elements2));
   if (!mesh.file.empty() && (mesh.elements1 > 0 || mesh.elements2 > 0))
     throw OptionError("mesh.file", "give either a mesh file or element counts, not both");
-  const std::pair<const char*, const std::optional<double>*> weights[] = {
-      {"smoothing.alpha", &smoothing.alpha}, {"smoothing.beta", &smoothing.beta},
-      {"smoothing.gamma", &smoothing.gamma}, {"smoothing.delta", &smoothing.delta}};
+  const std::pair<const char*, const std::optional<double>*> weights[] = {{"smoothing.alpha", &smoothing.alpha},
+                                                                          {"smoothing.beta", &smoothing.beta},
+                                                                          {"smoothing.gamma", &smoothing.gamma},
+                                                                          {"smoothing.delta", &smoothing.delta}};
   for (const auto& [field, value] : weights)
     if (*value && !(**value >= 0.0)) throw OptionError(field, "a smoothing weight must be >= 0" + found(**value));
   if (!(smoothing.scale > 0.0)) throw OptionError("smoothing.scale", "must be > 0" + found(smoothing.scale));
   if (!(outliers.sigma > 0.0) || !std::isfinite(outliers.sigma))
     throw OptionError("outliers.sigma", "must be a number > 0" + found(outliers.sigma));
   if (!fibre_angles.empty() && fibre_angles.size() != 2)
-    throw OptionError("fibre_angles", "expected two angles in degrees, e.g. 0,90; found " +
-                                          std::to_string(fibre_angles.size()));
+    throw OptionError("fibre_angles",
+                      "expected two angles in degrees, e.g. 0,90; found " + std::to_string(fibre_angles.size()));
   for (double a : fibre_angles)
     if (!std::isfinite(a)) throw OptionError("fibre_angles", "expected finite angles in degrees" + found(a));
 }

@@ -71,8 +71,8 @@ struct PointResult {
   std::optional<SurfaceStrain> strain;
   double residual = std::numeric_limits<double>::quiet_NaN();             // deformed fit
   double residual_undeformed = std::numeric_limits<double>::quiet_NaN();  // undeformed fit
-  std::vector<FibreResult> fibres;  // one per fibre family
-  double shear_angle_deg = std::numeric_limits<double>::quiet_NaN();  // first two families
+  std::vector<FibreResult> fibres;                                        // one per fibre family
+  double shear_angle_deg = std::numeric_limits<double>::quiet_NaN();      // first two families
   std::optional<OutlierFlag> flag;  // why the point was flagged (outlier statuses), with its numbers
 };
 
@@ -95,11 +95,12 @@ struct AnalysisResult {
   Penalty penalty_undeformed, penalty_deformed;
   PenaltyKind penalty_kind = PenaltyKind::kThirdOrder;
   bool smoothing_automatic = false;
-  double noise_estimate = 0.0;   // estimated digitisation noise (units), per coordinate
-  double mark_spacing = 0.0;     // mean spacing of marks (units)
-  double gauge_length = 0.0;     // effective smoothing length (units)
-  double log10_delta_optimum = std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
-  std::string smoothing_criterion;  // "GCV", "Cp" (noise model) or empty (explicit weights)
+  double noise_estimate = 0.0;  // estimated digitisation noise (units), per coordinate
+  double mark_spacing = 0.0;    // mean spacing of marks (units)
+  double gauge_length = 0.0;    // effective smoothing length (units)
+  double log10_delta_optimum =
+      std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
+  std::string smoothing_criterion;               // "GCV", "Cp" (noise model) or empty (explicit weights)
   double smoothing_criterion_value = std::numeric_limits<double>::quiet_NaN();
   double rms_undeformed = 0, max_undeformed = 0, rms_deformed = 0, max_deformed = 0;
   int projection_iterations = 0;

@@ -75,9 +75,12 @@ double deviation(const Points3& X, const Points3& v, Index p, const std::vector<
 }  // namespace
 
 void BlunderOptions::validate() const {
-  if (neighbours < 8) throw UsageError("blunder check: at least 8 neighbours are needed, found " + std::to_string(neighbours));
-  if (!(threshold > 0.0) || !std::isfinite(threshold)) throw UsageError("blunder check: the threshold must be a positive number");
-  if (!(isolation >= 1.0) || !std::isfinite(isolation)) throw UsageError("blunder check: the isolation factor must be >= 1");
+  if (neighbours < 8)
+    throw UsageError("blunder check: at least 8 neighbours are needed, found " + std::to_string(neighbours));
+  if (!(threshold > 0.0) || !std::isfinite(threshold))
+    throw UsageError("blunder check: the threshold must be a positive number");
+  if (!(isolation >= 1.0) || !std::isfinite(isolation))
+    throw UsageError("blunder check: the isolation factor must be >= 1");
   if (passes < 1) throw UsageError("blunder check: at least one pass");
 }
 
@@ -101,12 +104,14 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
     std::vector<std::vector<Index>> nb(static_cast<std::size_t>(n));
     for (Index p = 0; p < n; ++p) {
       for (Index q : candidates[static_cast<std::size_t>(p)])
-        if (!out.flagged[static_cast<std::size_t>(q)] && static_cast<int>(nb[static_cast<std::size_t>(p)].size()) < o.neighbours)
+        if (!out.flagged[static_cast<std::size_t>(q)] &&
+            static_cast<int>(nb[static_cast<std::size_t>(p)].size()) < o.neighbours)
           nb[static_cast<std::size_t>(p)].push_back(q);
     }
     std::vector<double> clean;
     for (Index p = 0; p < n; ++p)
-      if (!out.flagged[static_cast<std::size_t>(p)]) out.deviation[static_cast<std::size_t>(p)] = std::numeric_limits<double>::quiet_NaN();
+      if (!out.flagged[static_cast<std::size_t>(p)])
+        out.deviation[static_cast<std::size_t>(p)] = std::numeric_limits<double>::quiet_NaN();
     for (Index p = 0; p < n; ++p) {
       // A flagged point keeps the deviation it was flagged with.
       if (!X.row(p).allFinite() || out.flagged[static_cast<std::size_t>(p)]) continue;

@@ -40,8 +40,8 @@ struct BlunderOptions {
   double threshold = 4.5;  // deviation in noise levels
   double isolation = 2.5;  // deviation over the second largest deviation of the 8 nearest neighbours
   int passes = 6;
-  double floor = 0.0;      // the threshold is at least this (mm): round-off and the local fit's own
-                           // misfit set the noise level of noise-free data
+  double floor = 0.0;  // the threshold is at least this (mm): round-off and the local fit's own
+                       // misfit set the noise level of noise-free data
   void validate() const;
 };
 

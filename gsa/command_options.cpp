@@ -78,12 +78,18 @@ void validate_for_the_command_line(const Options& options) {
 
 std::string flag_of_field(const std::string& field) {
   static const std::map<std::string, std::string> flags = {
-      {"mesh.elements1", "--elements"},    {"mesh.elements2", "--elements"},
-      {"mesh.file", "--mesh"},             {"smoothing.alpha", "--alpha"},
-      {"smoothing.beta", "--beta"},        {"smoothing.gamma", "--gamma"},
-      {"smoothing.delta", "--delta"},      {"smoothing.scale", "--smoothing-scale"},
-      {"outliers.sigma", "--outlier-sigma"}, {"fibre_angles", "--fibres"},
-      {"sample", "--sample"},              {"units", "--units"},
+      {"mesh.elements1", "--elements"},
+      {"mesh.elements2", "--elements"},
+      {"mesh.file", "--mesh"},
+      {"smoothing.alpha", "--alpha"},
+      {"smoothing.beta", "--beta"},
+      {"smoothing.gamma", "--gamma"},
+      {"smoothing.delta", "--delta"},
+      {"smoothing.scale", "--smoothing-scale"},
+      {"outliers.sigma", "--outlier-sigma"},
+      {"fibre_angles", "--fibres"},
+      {"sample", "--sample"},
+      {"units", "--units"},
   };
   const auto it = flags.find(field);
   return it == flags.end() ? field : it->second;
@@ -147,19 +153,27 @@ GridReadOptions grid_read_options(const AnalyseFlags& a) {
   }
   if (!a.id.empty() && o.columns.count("id"))
     throw UsageError("--id: the id is given twice, also as --columns id=" + o.columns.at("id") + "; give one");
-  if (a.positions == "reference") o.positions = io::Positions::kReference;
-  else if (a.positions == "current") o.positions = io::Positions::kCurrent;
+  if (a.positions == "reference")
+    o.positions = io::Positions::kReference;
+  else if (a.positions == "current")
+    o.positions = io::Positions::kCurrent;
   else if (!a.positions.empty())
     throw UsageError("--positions: expected 'reference' or 'current', found '" + a.positions + "'");
   if (o.positions != io::Positions::kAsFormat && o.format == io::MeasurementFormat::kPlain)
-    throw UsageError("--positions: applies to --format gom, matchid, vic3d or dice; with a plain file, name the "
-                     "position columns X,Y,Z (reference) or x,y,z (current) in --columns");
-  if (a.decimal == "auto") o.decimal = io::kDetectDecimal;
-  else if (a.decimal == "point" || a.decimal == ".") o.decimal = '.';
-  else if (a.decimal == "comma" || a.decimal == ",") o.decimal = ',';
-  else throw UsageError("--decimal: expected 'auto', 'point' or 'comma', found '" + a.decimal + "'");
+    throw UsageError(
+        "--positions: applies to --format gom, matchid, vic3d or dice; with a plain file, name the "
+        "position columns X,Y,Z (reference) or x,y,z (current) in --columns");
+  if (a.decimal == "auto")
+    o.decimal = io::kDetectDecimal;
+  else if (a.decimal == "point" || a.decimal == ".")
+    o.decimal = '.';
+  else if (a.decimal == "comma" || a.decimal == ",")
+    o.decimal = ',';
+  else
+    throw UsageError("--decimal: expected 'auto', 'point' or 'comma', found '" + a.decimal + "'");
   if (o.decimal == ',' && o.delimiter == ',')
-    throw UsageError("--decimal comma: the delimiter cannot be a comma too (give --delimiter semicolon, or leave it auto)");
+    throw UsageError(
+        "--decimal comma: the delimiter cannot be a comma too (give --delimiter semicolon, or leave it auto)");
   if (a.skip_lines < 0) throw UsageError("--skip-lines: must be >= 0, found " + std::to_string(a.skip_lines));
   if (a.header_line < 0) throw UsageError("--header-line: must be >= 1, found " + std::to_string(a.header_line));
   if (a.header_line > 0 && a.skip_lines > 0) throw UsageError("give either --skip-lines or --header-line, not both");
@@ -200,9 +214,12 @@ std::vector<std::string> split_outside_quotes(const std::string& text) {
   std::vector<std::string> items(1);
   bool quoted = false;
   for (const char c : text) {
-    if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) items.emplace_back();
-    else items.back() += c;
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      items.emplace_back();
+    else
+      items.back() += c;
   }
   return items;
 }
@@ -213,7 +230,8 @@ std::vector<std::string> parse_id_columns(const std::string& text) {
   std::vector<std::string> out = split_outside_quotes(text);
   for (const std::string& name : out)
     if (name.empty())
-      throw UsageError("--id: expected column names separated by commas (e.g. x_pic,y_pic) or 'row', found '" + text + "'");
+      throw UsageError("--id: expected column names separated by commas (e.g. x_pic,y_pic) or 'row', found '" + text +
+                       "'");
   return out;
 }
 

@@ -21,7 +21,7 @@ namespace sf::gsa {
 struct AnalyseFlags {
   std::string grid, undeformed, deformed, out;
   std::string method = "surface", penalty = "jumps", smoothing_rule = "noise-model", elements, mesh, columns,
-      delimiter = "auto", fibres, units = "mm";
+              delimiter = "auto", fibres, units = "mm";
   // Reading (docs/usage.md "Input formats"); NaN: not given.
   std::string format = "auto", id, positions, decimal = "auto";
   int skip_lines = 0, header_line = 0;

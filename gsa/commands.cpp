@@ -30,8 +30,7 @@ namespace sf::gsa {
 
 namespace {
 
-void add_plot_options(CLI::App& app, std::string& measure, std::string& size, std::string& view,
-                      std::string& flc) {
+void add_plot_options(CLI::App& app, std::string& measure, std::string& size, std::string& view, std::string& flc) {
   app.add_option("--measure", measure, "Strain measure of the pictures: true (default), engineering or lagrangian");
   app.add_option("--size", size, "Picture size WxH in pixels (default 1200x900)");
   app.add_option("--view", view,
@@ -79,20 +78,25 @@ ProgressCallback stage_status_lines(bool quiet) {
         cli::status(quiet, "gsa: mesh " + s.mesh->layout + " (" + std::to_string(s.mesh->mesh.n_elements()) +
                                " elements); fitting the undeformed surface");
         break;
-      case AnalysisStage::kDeformedFit: cli::status(quiet, "gsa: fitting the deformed surface"); break;
+      case AnalysisStage::kDeformedFit:
+        cli::status(quiet, "gsa: fitting the deformed surface");
+        break;
       case AnalysisStage::kSmoothingChoice:
         cli::status(quiet, "gsa: estimating the noise and choosing the smoothing");
         break;
-      case AnalysisStage::kOutliers: cli::status(quiet, "gsa: checking the marks against their neighbours"); break;
+      case AnalysisStage::kOutliers:
+        cli::status(quiet, "gsa: checking the marks against their neighbours");
+        break;
       case AnalysisStage::kFrameAndMesh:
-      case AnalysisStage::kStrains: break;
+      case AnalysisStage::kStrains:
+        break;
     }
   };
 }
 
 // "gsa: 441 of 441 points analysed; results in DIR (mesh 7x7, ...)".
-std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out,
-                         const std::string& units, const std::optional<FlcMargins>& margins) {
+std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out, const std::string& units,
+                         const std::optional<FlcMargins>& margins) {
   Index ok = 0;
   for (const auto& p : result.points) ok += p.strain ? 1 : 0;
   std::ostringstream msg;
@@ -148,7 +152,8 @@ int run_analyse(const AnalyseFlags& a, bool quiet) {
                               a.out, output.measure);
     data.flc = output.flc;
     data.margins = written.margins;
-    write_pictures(data, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
+    write_pictures(
+        data, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
   }
   out.commit();
   cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, written.margins));
@@ -167,8 +172,8 @@ int run_plot(const PlotArgs& a, bool quiet) {
   if (!std::filesystem::is_directory(a.dir))
     throw InputError(a.dir + ": no such folder; give a results folder written by `gsa analyse`");
   io::AtomicOutputDir out(a.dir);
-  const Redrawn r = redraw_results_folder(a.dir, measure, flc, po, [&out](const std::string& name) { return out.path(name); },
-                                          picture_bar(quiet));
+  const Redrawn r = redraw_results_folder(
+      a.dir, measure, flc, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
   out.commit();
   std::ostringstream msg;
   msg << "gsa: " << r.pictures.pictures.size() << " pictures and report.html in " << a.dir;
@@ -209,8 +214,13 @@ int run_synth(const SynthArgs& a, bool quiet) {
       io::CsvWriter w(os, {"id", "lambda1", "lambda2", "E1", "E2", "shear_angle_deg"});
       for (Index p = 0; p < g.n_points(); ++p) {
         const ExactStrain& e = exact[p];
-        w.begin_row().add(g.ids[p]).add(e.lambda1).add(e.lambda2).add(0.5 * (e.lambda1 * e.lambda1 - 1))
-            .add(0.5 * (e.lambda2 * e.lambda2 - 1)).add(e.shear_angle_deg);
+        w.begin_row()
+            .add(g.ids[p])
+            .add(e.lambda1)
+            .add(e.lambda2)
+            .add(0.5 * (e.lambda1 * e.lambda1 - 1))
+            .add(0.5 * (e.lambda2 * e.lambda2 - 1))
+            .add(e.shear_angle_deg);
         w.end_row();
       }
     });
@@ -219,26 +229,33 @@ int run_synth(const SynthArgs& a, bool quiet) {
   return cli::kExitOk;
 }
 
-
 void add_analyse_command(sf::cli::Program& program) {
   const sf::cli::Program* prog = &program;
   auto args = std::make_shared<AnalyseFlags>();
   program.add_command(
       "analyse", "Grid strain analysis of a digitised part (surface fit or classical triangles)",
       [args](CLI::App& app) {
-        app.add_option("grid", args->grid, "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j]), or a measuring system's export with --format; - reads it from stdin");
+        app.add_option("grid", args->grid,
+                       "Grid file (CSV: id,X,Y,Z,x,y,z[,i,j]), or a measuring system's export with --format; - reads "
+                       "it from stdin");
         app.add_option("--undeformed", args->undeformed, "Undeformed grid file (id,x,y,z), with --deformed");
         app.add_option("--deformed", args->deformed, "Deformed grid file (id,x,y,z), with --undeformed");
         app.add_option("-o,--out", args->out, "Output folder (created; files replaced only on success)")->required();
         app.add_option("--method", args->method, "surface (default) or triangles (classical, for comparison)");
-        app.add_option("--penalty", args->penalty, "Smoothing: jumps (default; fourth order, C3 edge jumps, weight by cross-validation), third (third-order + edge jumps) or sobolev (alpha/beta of the brief)");
-        app.add_option("--mesh", args->mesh, "Your own mesh (JSON: nodes and elements, see docs/usage.md) instead of the automatic one");
+        app.add_option("--penalty", args->penalty,
+                       "Smoothing: jumps (default; fourth order, C3 edge jumps, weight by cross-validation), third "
+                       "(third-order + edge jumps) or sobolev (alpha/beta of the brief)");
+        app.add_option("--mesh", args->mesh,
+                       "Your own mesh (JSON: nodes and elements, see docs/usage.md) instead of the automatic one");
         app.add_option("--elements", args->elements, "Mesh size NxM (default: from the number of marks)");
         app.add_option("--alpha", args->alpha, "First-derivative smoothing weight (default 0)");
-        app.add_option("--beta", args->beta, "Second-derivative (curvature) smoothing weight, units^2 (default: automatic)");
+        app.add_option("--beta", args->beta,
+                       "Second-derivative (curvature) smoothing weight, units^2 (default: automatic)");
         app.add_option("--gamma", args->gamma, "Third-derivative smoothing weight, units^4 (default: automatic)");
-        app.add_option("--delta", args->delta, "Fourth-order (edge-jump) smoothing weight, units^6, with --penalty jumps");
-        app.add_option("--fibres", args->fibres, "Fibre mode: two fibre angles in degrees from the X axis on the undeformed sheet, e.g. 0,90");
+        app.add_option("--delta", args->delta,
+                       "Fourth-order (edge-jump) smoothing weight, units^6, with --penalty jumps");
+        app.add_option("--fibres", args->fibres,
+                       "Fibre mode: two fibre angles in degrees from the X axis on the undeformed sheet, e.g. 0,90");
         app.add_option("--units", args->units,
                        "Length unit to read the coordinates in and to write into every output (default mm); columns "
                        "in other units ([m], [in], '# units: m') are converted");
@@ -249,24 +266,35 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_option("--columns", args->columns,
                        "Map column names, e.g. X=x0,Y=y0,Z=z0,u=ux,v=uy,w=uz: X,Y,Z reference and x,y,z current "
                        "positions, u,v,w displacements (any two of the three), id, i, j, sigma");
-        app.add_option("--id", args->id, "Columns whose cells together make the id, e.g. x_pic,y_pic; or 'row' (the row number)");
+        app.add_option("--id", args->id,
+                       "Columns whose cells together make the id, e.g. x_pic,y_pic; or 'row' (the row number)");
         app.add_option("--positions", args->positions,
                        "reference or current: what the position columns of a --format with displacements hold "
                        "(x = X + u, or X = x - u)");
         app.add_option("--delimiter", args->delimiter,
                        "Field separator: auto (default, found from the header), one character, or "
                        "tab/comma/semicolon/space (runs of blanks)");
-        app.add_option("--decimal", args->decimal, "Decimal separator of the numbers: auto (default: comma when the numbers are written so and the delimiter is not a comma), point or comma");
-        app.add_option("--skip-lines", args->skip_lines, "Skip the first N lines of each file, then look for the header");
+        app.add_option("--decimal", args->decimal,
+                       "Decimal separator of the numbers: auto (default: comma when the numbers are written so and the "
+                       "delimiter is not a comma), point or comma");
+        app.add_option("--skip-lines", args->skip_lines,
+                       "Skip the first N lines of each file, then look for the header");
         app.add_option("--header-line", args->header_line, "The header is line N of each file (1-based)");
         app.add_option("--pixel-size", args->pixel_size,
                        "Length units per image pixel, for columns in pixels (DICe 2-D positions, VIC-3D/DICe sigma)");
         app.add_option("--pitch", args->pitch,
                        "Grid pitch: undeformed positions from the grid indices, X = j * pitch, Y = i * pitch, Z = 0");
-        app.add_option("--smoothing-scale", args->smoothing_scale, "Multiply the automatic smoothing weights (default 1; >1 smoother)");
-        app.add_option("--outlier-sigma", args->outlier_sigma, "Flag a mark as an isolated blunder when it is this many noise levels off its neighbours' local fit and far more than they are (default 4.5); flagged marks still get a strain");
-        app.add_option("--smoothing-rule", args->smoothing_rule, "How the automatic smoothing is chosen: noise-model (default; Cp with the estimated noise, spatial correlation included) or gcv (cross-validation, assumes independent errors)");
-        app.add_flag("--no-local-smoothing", args->no_local_smoothing, "Keep one smoothing weight everywhere (by default it is relaxed where the fit cannot follow a localised feature such as a neck)");
+        app.add_option("--smoothing-scale", args->smoothing_scale,
+                       "Multiply the automatic smoothing weights (default 1; >1 smoother)");
+        app.add_option("--outlier-sigma", args->outlier_sigma,
+                       "Flag a mark as an isolated blunder when it is this many noise levels off its neighbours' local "
+                       "fit and far more than they are (default 4.5); flagged marks still get a strain");
+        app.add_option("--smoothing-rule", args->smoothing_rule,
+                       "How the automatic smoothing is chosen: noise-model (default; Cp with the estimated noise, "
+                       "spatial correlation included) or gcv (cross-validation, assumes independent errors)");
+        app.add_flag("--no-local-smoothing", args->no_local_smoothing,
+                     "Keep one smoothing weight everywhere (by default it is relaxed where the fit cannot follow a "
+                     "localised feature such as a neck)");
         app.add_option("--sample", args->sample, "Also write samples.csv with fields on N x N points per element");
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);

@@ -100,8 +100,8 @@ void DeformedProblem::set_weight(Index k, double weight) {
 FitSystem& DeformedProblem::system() {
   // One system per set of weights: rebuilt only when marks are flagged or readmitted.
   if (rebuild_ || !system_) {
-    system_ = std::make_unique<FitSystem>(setup_.mesh, relaxed_ ? *relaxed_ : setup_.penalties,
-                                          undeformed_.location, weight_);
+    system_ = std::make_unique<FitSystem>(setup_.mesh, relaxed_ ? *relaxed_ : setup_.penalties, undeformed_.location,
+                                          weight_);
     system_->set_values(data_);
     if (probes_.size() > 0) system_->set_probes(probes_);
     rebuild_ = false;
@@ -140,7 +140,7 @@ FitResult DeformedProblem::fit(const Penalty& penalty, int passes) {
 }
 
 std::array<FitResult, 2> DeformedProblem::fit_pair(const std::array<Penalty, 2>& penalties, int trace_probes,
-                                                    int passes) {
+                                                   int passes) {
   return system().solve_pair(penalties, reference_, trace_probes, passes);
 }
 

@@ -76,7 +76,7 @@ class DeformedProblem {
   const std::vector<double>& element_multipliers() const { return multipliers_; }
 
   const VecX& weight() const { return weight_; }
-  const Points3& data() const { return data_; }  // x - Q r, what is fitted
+  const Points3& data() const { return data_; }                   // x - Q r, what is fitted
   const Points3& position() const { return deformed_.position; }  // the marks as digitised
   const RigidMotion& rigid() const { return rigid_; }
   const MatX& reference() const { return reference_; }  // U_ref: the undeformed surface moved rigidly
@@ -102,8 +102,8 @@ class DeformedProblem {
 };
 
 struct DeformedFit {
-  FitResult fit;                   // the last solve (residuals of the carried data)
-  Penalty penalty;                 // its weights
+  FitResult fit;    // the last solve (residuals of the carried data)
+  Penalty penalty;  // its weights
   int passes = 1;
   std::vector<OutlierFlag> flags;  // marks left out, with reasons
 };

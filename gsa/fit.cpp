@@ -49,7 +49,6 @@ void add_element_block(linalg::TripletAssembler& asm_, const fe::ElementDofMap& 
   asm_.add_block(dm.dofs, dm.dofs, kg);
 }
 
-
 // Values of `a` at the entries of `pattern` (zero where `a` has none). Both are
 // compressed column-major with sorted row indices, and a's pattern lies in pattern's.
 VecX values_on(const linalg::SparseMatrix& pattern, const linalg::SparseMatrix& a) {
@@ -64,7 +63,6 @@ VecX values_on(const linalg::SparseMatrix& pattern, const linalg::SparseMatrix& 
   }
   return out;
 }
-
 
 std::vector<fe::ElementDofMap> element_dof_maps(const mesh::SurfaceMesh& mesh) {
   std::vector<fe::ElementDofMap> maps(mesh.n_elements());
@@ -108,15 +106,18 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
       const Vec2& xi = rule.points[g];
       const double w = rule.weights[g] * area;
       for (const auto& o : first) {
-        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v =
+            basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a1.noalias() += (w * o.w) * v * v.transpose();
       }
       for (const auto& o : second) {
-        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v =
+            basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a2.noalias() += (w * o.w) * v * v.transpose();
       }
       for (const auto& o : third) {
-        const Eigen::Matrix<double, 16, 1> v = basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
+        const Eigen::Matrix<double, 16, 1> v =
+            basis::BicubicHermite::derivative(xi, o.o1, o.o2) / (std::pow(h[0], o.o1) * std::pow(h[1], o.o2));
         a3.noalias() += (w * o.w) * v * v.transpose();
       }
     }
@@ -134,7 +135,7 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
       if (nb.element < 0 || nb.element < e) continue;  // each interior edge once
       const auto he = element_size(mesh.element(e));
       const auto hn = element_size(mesh.element(nb.element));
-      const int dir_e = (edge == 1 || edge == 3) ? 0 : 1;      // normal xi direction in e
+      const int dir_e = (edge == 1 || edge == 3) ? 0 : 1;        // normal xi direction in e
       const int dir_n = (nb.edge == 1 || nb.edge == 3) ? 0 : 1;  // ... in the neighbour
       const double edge_len = he[1 - dir_e];
       const double h_normal = 0.5 * (he[dir_e] + hn[dir_n]);
@@ -165,8 +166,10 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
         const double t = line.points[g];
         const double tn_ = nb.reversed ? 1.0 - t : t;
         const Vec2 xe = mesh::edge_point(edge, t), xn = mesh::edge_point(nb.edge, tn_);
-        const Eigen::Matrix<double, 16, 1> ve = basis::BicubicHermite::derivative(xe, dir_e == 0 ? 2 : 0, dir_e == 0 ? 0 : 2) / (he[dir_e] * he[dir_e]);
-        const Eigen::Matrix<double, 16, 1> vn = basis::BicubicHermite::derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
+        const Eigen::Matrix<double, 16, 1> ve =
+            basis::BicubicHermite::derivative(xe, dir_e == 0 ? 2 : 0, dir_e == 0 ? 0 : 2) / (he[dir_e] * he[dir_e]);
+        const Eigen::Matrix<double, 16, 1> vn =
+            basis::BicubicHermite::derivative(xn, dir_n == 0 ? 2 : 0, dir_n == 0 ? 0 : 2) / (hn[dir_n] * hn[dir_n]);
         const Eigen::VectorXd j = te.transpose() * ve - tn.transpose() * vn;
         kj.noalias() += (line.weights[g] * edge_len / h_normal) * j * j.transpose();
         k4j.noalias() += (w4 * kJumpCurvatureWeight * line.weights[g] * edge_len / (h_normal * h_normal * h_normal)) *
@@ -176,9 +179,11 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
         const double se = (edge == 1 || edge == 2) ? 1.0 : -1.0;
         const double sn = (nb.edge == 1 || nb.edge == 2) ? -1.0 : 1.0;  // same physical direction
         const Eigen::Matrix<double, 16, 1> we =
-            basis::BicubicHermite::derivative(xe, dir_e == 0 ? 3 : 0, dir_e == 0 ? 0 : 3) * (se / std::pow(he[dir_e], 3));
+            basis::BicubicHermite::derivative(xe, dir_e == 0 ? 3 : 0, dir_e == 0 ? 0 : 3) *
+            (se / std::pow(he[dir_e], 3));
         const Eigen::Matrix<double, 16, 1> wn =
-            basis::BicubicHermite::derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) * (sn / std::pow(hn[dir_n], 3));
+            basis::BicubicHermite::derivative(xn, dir_n == 0 ? 3 : 0, dir_n == 0 ? 0 : 3) *
+            (sn / std::pow(hn[dir_n], 3));
         const Eigen::VectorXd j3 = te.transpose() * we - tn.transpose() * wn;
         k4j.noalias() += (w4 * line.weights[g] * edge_len / h_normal) * j3 * j3.transpose();
       }
@@ -206,7 +211,6 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
   }
   return out;
 }
-
 
 namespace {
 
@@ -252,7 +256,6 @@ RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
 
 }  // namespace
 
-
 // What one solve changes: K and the penalty on the common pattern, the
 // factorisation. Two of them let two penalties be solved at once. Both use
 // CHOLMOD's simplicial Cholesky, which calls no BLAS: two supernodal
@@ -262,7 +265,8 @@ RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
 struct FitWorkspace {
   linalg::SparseMatrix k, pen;
   VecX factored;  // values of the K last factorised
-  linalg::LinearSolver solver{linalg::SolverKind::kCholmodSimplicial, linalg::MatrixProperty::kSymmetricPositiveDefinite};
+  linalg::LinearSolver solver{linalg::SolverKind::kCholmodSimplicial,
+                              linalg::MatrixProperty::kSymmetricPositiveDefinite};
 };
 
 struct FitSystem::Impl {
@@ -286,8 +290,8 @@ struct FitSystem::Impl {
     return *work[i];
   }
   void draw_probes(int count);
-  FitResult solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
-                  int trace_probes, int passes) const;
+  FitResult solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes,
+                  int passes) const;
 };
 
 FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties,
@@ -433,8 +437,7 @@ FitResult FitSystem::solve(const Penalty& penalty, const Eigen::Ref<const MatX>&
 }
 
 std::array<FitResult, 2> FitSystem::solve_pair(const std::array<Penalty, 2>& penalties,
-                                               const Eigen::Ref<const MatX>& reference, int trace_probes,
-                                               int passes) {
+                                               const Eigen::Ref<const MatX>& reference, int trace_probes, int passes) {
   Impl& s = *impl_;
   if (trace_probes > 0) s.draw_probes(trace_probes);
   FitWorkspace& first = s.workspace(0);

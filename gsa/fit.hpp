@@ -79,7 +79,6 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh);
 // smoothing where the field varies sharply, gsa/local_smoothing.hpp).
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vector<double>& element_multiplier);
 
-
 struct FitResult {
   MatX parameters;   // n_dofs x n_components
   MatX fitted;       // n_points x n_components: u(xi_d)
@@ -101,8 +100,8 @@ class FitSystem {
  public:
   // `weights` (n_points, >= 0; 0 excludes a point) may be empty (all 1).
   // `penalties` must outlive the system.
-  FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties,
-            const std::vector<MeshLocation>& locations, const VecX& weights);
+  FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penalties, const std::vector<MeshLocation>& locations,
+            const VecX& weights);
   ~FitSystem();
   FitSystem(const FitSystem&) = delete;
   FitSystem& operator=(const FitSystem&) = delete;

@@ -20,7 +20,7 @@
 namespace sf::gsa {
 
 struct FormingLimitCurve {
-  std::string source;               // the file it was read from
+  std::string source;                // the file it was read from
   std::vector<double> minor, major;  // ascending minor strain
   // Linear interpolation at `minor`; NaN outside the curve's minor range.
   double major_at(double minor_strain) const;
@@ -31,9 +31,9 @@ FormingLimitCurve read_flc(const std::string& path);
 struct FlcMargins {
   std::string source;  // the curve's file
   StrainMeasure measure = StrainMeasure::kTrue;
-  std::vector<double> margin;  // per mark (NaN: no strain, or outside the curve)
-  Index n_marks = 0;           // marks with a strain
-  Index n_beyond = 0;          // marks beyond the curve (margin < 0)
+  std::vector<double> margin;                                    // per mark (NaN: no strain, or outside the curve)
+  Index n_marks = 0;                                             // marks with a strain
+  Index n_beyond = 0;                                            // marks beyond the curve (margin < 0)
   double min_margin = std::numeric_limits<double>::quiet_NaN();  // smallest margin (NaN: none)
 };
 // `marks` must be in the curve's measure `measure`.

@@ -34,17 +34,17 @@ FitMarks fit_marks(const GridData& grid);
 
 struct MeshOptions {
   int elements1 = 0, elements2 = 0;  // automatic mesh of n1 x n2 elements; 0 = from the number of marks
-  std::string file;                   // the user's own mesh instead (JSON, gsa/mesh_file.hpp)
+  std::string file;                  // the user's own mesh instead (JSON, gsa/mesh_file.hpp)
 };
 
 struct FrameAndMesh {
-  PlaneFrame frame;                   // best-fit plane of the undeformed marks
-  mesh::SurfaceMesh mesh;             // the fitting mesh, in the grid's units
-  std::vector<MeshLocation> start;    // m: each mark's starting location on it
-  int elements1 = 0, elements2 = 0;   // automatic mesh: its size before empty elements were dropped
-  std::string layout;                 // "7x7", or "from FILE"
-  double mark_spacing = 0.0;          // d = sqrt(mesh area / marks), units
-  PenaltyMatrices penalties;          // the smoothing penalties of `mesh`, assembled once
+  PlaneFrame frame;                  // best-fit plane of the undeformed marks
+  mesh::SurfaceMesh mesh;            // the fitting mesh, in the grid's units
+  std::vector<MeshLocation> start;   // m: each mark's starting location on it
+  int elements1 = 0, elements2 = 0;  // automatic mesh: its size before empty elements were dropped
+  std::string layout;                // "7x7", or "from FILE"
+  double mark_spacing = 0.0;         // d = sqrt(mesh area / marks), units
+  PenaltyMatrices penalties;         // the smoothing penalties of `mesh`, assembled once
 };
 // Throws sf::InputError naming the file when the marks lie on a line, and naming the mark
 // (file:line) when it cannot be located on a user mesh. Fit systems built on the result

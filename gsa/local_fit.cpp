@@ -32,7 +32,7 @@ std::vector<std::optional<LocalStretch>> local_fit_stretches(const GridData& gri
     const MatX a = A.rowwise() - ca, b = B.rowwise() - cb;
     const Eigen::SelfAdjointEigenSolver<Mat3> pca(a.transpose() * a);
     const Mat32 axes = pca.eigenvectors().rightCols<2>();  // the two largest: tangent plane
-    const MatX st = a * axes;                               // m x 2 in-plane coordinates
+    const MatX st = a * axes;                              // m x 2 in-plane coordinates
     const Mat2 ata = st.transpose() * st;
     if (!(std::abs(ata.determinant()) > 1e-12 * ata.squaredNorm())) continue;
     const Mat32 F = (b.transpose() * st) * ata.inverse();  // 3 x 2

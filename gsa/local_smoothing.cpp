@@ -31,7 +31,8 @@ LocalSmoothing relax_smoothing(DeformedProblem& problem, SmoothingChoice& choice
     const VecX& w = problem.weight();
     std::vector<std::vector<Index>> marks_of(static_cast<std::size_t>(mesh.n_elements()));
     for (Index k = 0; k < m; ++k)
-      if (w[k] > 0) marks_of[static_cast<std::size_t>(undeformed.location[static_cast<std::size_t>(k)].element)].push_back(k);
+      if (w[k] > 0)
+        marks_of[static_cast<std::size_t>(undeformed.location[static_cast<std::size_t>(k)].element)].push_back(k);
     Penalty heavy = choice.penalty;
     heavy.delta *= kHeavyFactor;
     const FitResult fh = problem.fit(heavy, choice.passes);
@@ -43,7 +44,9 @@ LocalSmoothing relax_smoothing(DeformedProblem& problem, SmoothingChoice& choice
       std::vector<Index> ks = marks_of[static_cast<std::size_t>(e)];
       for (int edge = 0; edge < 4; ++edge) {
         const Index nb = mesh.neighbour(e, edge).element;
-        if (nb >= 0) ks.insert(ks.end(), marks_of[static_cast<std::size_t>(nb)].begin(), marks_of[static_cast<std::size_t>(nb)].end());
+        if (nb >= 0)
+          ks.insert(ks.end(), marks_of[static_cast<std::size_t>(nb)].begin(),
+                    marks_of[static_cast<std::size_t>(nb)].end());
       }
       if (ks.size() < 4) continue;
       Points3 at(static_cast<Index>(ks.size()), 3);

@@ -28,10 +28,10 @@
 namespace sf::gsa {
 
 struct NoiseEstimate {
-  double sigma_correlated = 0.0;   // mm, per coordinate
-  double correlation_length = 0.0; // mm (0: no correlated part found)
-  double sigma_white = 0.0;        // mm, per coordinate
-  double bias_slope = 0.0;         // b of the model, 1 (mm^2 / mm^2)
+  double sigma_correlated = 0.0;    // mm, per coordinate
+  double correlation_length = 0.0;  // mm (0: no correlated part found)
+  double sigma_white = 0.0;         // mm, per coordinate
+  double bias_slope = 0.0;          // b of the model, 1 (mm^2 / mm^2)
   double sigma_total() const;
   // The correlation length when the correlated part matters (> 30 % of the total
   // sigma), else 0: the noise counts as independent.
@@ -44,10 +44,10 @@ struct NoiseEstimate {
 };
 
 struct VariogramOptions {
-  double max_lag = 0.0;         // mm; 0 = 12 spacings
-  double bin_width = 0.0;       // mm; 0 = half a spacing
-  int max_query_points = 3000;  // points whose neighbourhoods are sampled (a random subset, fixed seed)
-  int max_pairs_per_bin = 6000; // pairs kept per distance bin (a random subset, fixed seed)
+  double max_lag = 0.0;          // mm; 0 = 12 spacings
+  double bin_width = 0.0;        // mm; 0 = half a spacing
+  int max_query_points = 3000;   // points whose neighbourhoods are sampled (a random subset, fixed seed)
+  int max_pairs_per_bin = 6000;  // pairs kept per distance bin (a random subset, fixed seed)
 };
 
 // One realisation of Gaussian noise with covariance sigma^2 exp(-r^2 / (2 L^2)): a

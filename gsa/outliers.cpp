@@ -8,23 +8,27 @@ namespace sf::gsa {
 
 const char* to_string(OutlierReason reason) {
   switch (reason) {
-    case OutlierReason::kUndeformedOffNeighbours: return "undeformed position off its neighbours' surface";
-    case OutlierReason::kDeformedOffNeighbours: return "deformed position off its neighbours' deformation";
+    case OutlierReason::kUndeformedOffNeighbours:
+      return "undeformed position off its neighbours' surface";
+    case OutlierReason::kDeformedOffNeighbours:
+      return "deformed position off its neighbours' deformation";
   }
   return "";
 }
 
 const char* code(OutlierReason reason) {
   switch (reason) {
-    case OutlierReason::kUndeformedOffNeighbours: return "undeformed_off_neighbours";
-    case OutlierReason::kDeformedOffNeighbours: return "deformed_off_neighbours";
+    case OutlierReason::kUndeformedOffNeighbours:
+      return "undeformed_off_neighbours";
+    case OutlierReason::kDeformedOffNeighbours:
+      return "deformed_off_neighbours";
   }
   return "";
 }
 
 std::string describe(const OutlierFlag& f, double sigma, const std::string& units) {
-  return fmt::format("{} by {:.4g} {} (threshold {:.4g} {} = {:g} x noise {:.4g} {})", to_string(f.reason),
-                     f.deviation, units, f.threshold, units, sigma, f.noise, units);
+  return fmt::format("{} by {:.4g} {} (threshold {:.4g} {} = {:g} x noise {:.4g} {})", to_string(f.reason), f.deviation,
+                     units, f.threshold, units, sigma, f.noise, units);
 }
 
 MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,

@@ -24,8 +24,8 @@ const char* method_name(Method m) { return m == Method::kSurface ? "surface" : "
 
 // All per-point scalar fields derived from a strain (NaN when absent).
 struct Fields {
-  double lambda1 = kNaN, lambda2 = kNaN, e1 = kNaN, e2 = kNaN, eng1 = kNaN, eng2 = kNaN, true1 = kNaN,
-         true2 = kNaN, thick = kNaN;
+  double lambda1 = kNaN, lambda2 = kNaN, e1 = kNaN, e2 = kNaN, eng1 = kNaN, eng2 = kNaN, true1 = kNaN, true2 = kNaN,
+         thick = kNaN;
   Vec3 dir1 = Vec3::Constant(kNaN), dir2 = Vec3::Constant(kNaN), dir1u = Vec3::Constant(kNaN),
        dir2u = Vec3::Constant(kNaN);
 };
@@ -60,15 +60,42 @@ nlohmann::json range_of(const std::vector<double>& v) {
 }  // namespace
 
 void OutputOptions::validate() const {
-  if (sample < 0 || sample > 50) throw OptionError("sample", "expected 0..50 points per element side, found " + std::to_string(sample));
+  if (sample < 0 || sample > 50)
+    throw OptionError("sample", "expected 0..50 points per element side, found " + std::to_string(sample));
 }
 
 std::vector<std::string> strain_columns(const AnalysisResult& result) {
-  std::vector<std::string> c = {"id",      "status",  "element", "xi1",    "xi2",    "lambda1", "lambda2",
-                                "E1",      "E2",      "eng1",    "eng2",   "true1",  "true2",
-                                "thickness_change_pct", "dir1_x", "dir1_y", "dir1_z", "dir2_x", "dir2_y",
-                                "dir2_z",  "dir1u_x", "dir1u_y", "dir1u_z", "residual", "residual_undeformed",
-                                "X_fit",   "Y_fit",   "Z_fit",   "flag_reason", "flag_deviation", "flag_threshold",
+  std::vector<std::string> c = {"id",
+                                "status",
+                                "element",
+                                "xi1",
+                                "xi2",
+                                "lambda1",
+                                "lambda2",
+                                "E1",
+                                "E2",
+                                "eng1",
+                                "eng2",
+                                "true1",
+                                "true2",
+                                "thickness_change_pct",
+                                "dir1_x",
+                                "dir1_y",
+                                "dir1_z",
+                                "dir2_x",
+                                "dir2_y",
+                                "dir2_z",
+                                "dir1u_x",
+                                "dir1u_y",
+                                "dir1u_z",
+                                "residual",
+                                "residual_undeformed",
+                                "X_fit",
+                                "Y_fit",
+                                "Z_fit",
+                                "flag_reason",
+                                "flag_deviation",
+                                "flag_threshold",
                                 "flag_noise"};
   if (result.fibre_angles.size() == 2) {
     for (const char* f : {"fibre1", "fibre2"})
@@ -85,14 +112,16 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
   out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
       << "eng = engineering, true = logarithmic); E1 >= E2; dir1 = major direction on the deformed surface, "
       << "dir1u on the undeformed; residual = distance of the deformed mark from the fitted deformed surface ("
-      << options.units << "); flag_* = why a point was flagged (its deviation from its neighbours' local fit, the threshold "
+      << options.units
+      << "); flag_* = why a point was flagged (its deviation from its neighbours' local fit, the threshold "
       << "it exceeded, the noise level; " << options.units << "), flagged points keep the fitted surfaces' strain"
       << "; thickness by incompressibility; method " << method_name(result.method) << "\n";
   if (margins) out << flc_margin_comment(*margins) << "\n";
   std::vector<std::string> columns = strain_columns(result);
   if (margins) columns.push_back("flc_margin");
   std::unique_ptr<fe::SurfaceField> fu;
-  if (result.method == Method::kSurface) fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
+  if (result.method == Method::kSurface)
+    fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
   // Rows [begin, end) as text (formatting numbers is most of the time: large
   // tables are formatted in two halves at once).
   auto rows = [&](Index begin, Index end, bool header) {
@@ -102,20 +131,28 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
       const PointResult& pr = result.points[p];
       const Fields f = fields_of(pr.strain);
       w.begin_row().add(grid.ids[p]).add(pr.status);
-      if (pr.element >= 0) w.add(pr.element).add(pr.xi[0]).add(pr.xi[1]);
-      else w.add(kNaN).add(kNaN).add(kNaN);
-      w.add(f.lambda1).add(f.lambda2).add(f.e1).add(f.e2).add(f.eng1).add(f.eng2).add(f.true1).add(f.true2).add(f.thick);
+      if (pr.element >= 0)
+        w.add(pr.element).add(pr.xi[0]).add(pr.xi[1]);
+      else
+        w.add(kNaN).add(kNaN).add(kNaN);
+      w.add(f.lambda1).add(f.lambda2).add(f.e1).add(f.e2).add(f.eng1).add(f.eng2).add(f.true1).add(f.true2).add(
+          f.thick);
       for (const Vec3* v : {&f.dir1, &f.dir2, &f.dir1u}) w.add((*v)[0]).add((*v)[1]).add((*v)[2]);
       w.add(pr.residual).add(pr.residual_undeformed);
       Vec3 xf = Vec3::Constant(kNaN);
       if (fu && pr.element >= 0) xf = fu->evaluate3(pr.element, pr.xi, basis::kValues).x;
       w.add(xf[0]).add(xf[1]).add(xf[2]);
-      if (pr.flag) w.add(std::string(code(pr.flag->reason))).add(pr.flag->deviation).add(pr.flag->threshold).add(pr.flag->noise);
-      else w.add(std::string()).add(kNaN).add(kNaN).add(kNaN);
+      if (pr.flag)
+        w.add(std::string(code(pr.flag->reason))).add(pr.flag->deviation).add(pr.flag->threshold).add(pr.flag->noise);
+      else
+        w.add(std::string()).add(kNaN).add(kNaN).add(kNaN);
       if (result.fibre_angles.size() == 2) {
         for (int k = 0; k < 2; ++k) {
           if (pr.fibres.size() == 2 && pr.strain)
-            w.add(pr.fibres[k].direction[0]).add(pr.fibres[k].direction[1]).add(pr.fibres[k].direction[2]).add(pr.fibres[k].stretch);
+            w.add(pr.fibres[k].direction[0])
+                .add(pr.fibres[k].direction[1])
+                .add(pr.fibres[k].direction[2])
+                .add(pr.fibres[k].stretch);
           else
             w.add(kNaN).add(kNaN).add(kNaN).add(kNaN);
         }
@@ -140,8 +177,8 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   j["version"] = SF_VERSION;
   j["command_line"] = info.command_line;
   j["inputs"] = info.inputs;
-  j["units"] = {{"length", options.units}, {"strain", "dimensionless"}, {"thickness_change", "percent"},
-                {"angles", "degrees"}};
+  j["units"] = {
+      {"length", options.units}, {"strain", "dimensionless"}, {"thickness_change", "percent"}, {"angles", "degrees"}};
   std::map<std::string, Index> counts;
   std::vector<double> e1, e2, th, eng1, eng2, true1, true2, shear;
   for (const PointResult& p : r.points) {
@@ -172,26 +209,32 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                         : r.penalty_kind == PenaltyKind::kJumps    ? "fourth-order edge jumps (delta)"
                                                                    : "sobolev (alpha, beta)";
     params["smoothing_automatic"] = r.smoothing_automatic;
-    params["undeformed"] = {{"alpha", r.penalty_undeformed.alpha}, {"beta", r.penalty_undeformed.beta},
-                            {"gamma", r.penalty_undeformed.gamma}, {"delta", r.penalty_undeformed.delta}};
-    params["deformed"] = {{"alpha", r.penalty_deformed.alpha}, {"beta", r.penalty_deformed.beta},
-                          {"gamma", r.penalty_deformed.gamma}, {"delta", r.penalty_deformed.delta},
+    params["undeformed"] = {{"alpha", r.penalty_undeformed.alpha},
+                            {"beta", r.penalty_undeformed.beta},
+                            {"gamma", r.penalty_undeformed.gamma},
+                            {"delta", r.penalty_undeformed.delta}};
+    params["deformed"] = {{"alpha", r.penalty_deformed.alpha},
+                          {"beta", r.penalty_deformed.beta},
+                          {"gamma", r.penalty_deformed.gamma},
+                          {"delta", r.penalty_deformed.delta},
                           {"smooths", "displacement less its best-fit rigid motion"}};
     const Eigen::AngleAxisd turn(r.rigid.rotation);
-    params["rigid_motion"] = {{"rotation_deg", turn.angle() * 180.0 / kPi},
-                              {"rotation_axis", {turn.axis()[0], turn.axis()[1], turn.axis()[2]}},
-                              {"translation", {r.rigid.translation[0], r.rigid.translation[1], r.rigid.translation[2]}}};
+    params["rigid_motion"] = {
+        {"rotation_deg", turn.angle() * 180.0 / kPi},
+        {"rotation_axis", {turn.axis()[0], turn.axis()[1], turn.axis()[2]}},
+        {"translation", {r.rigid.translation[0], r.rigid.translation[1], r.rigid.translation[2]}}};
     params["noise_estimate"] = r.noise_estimate;
     params["mark_spacing"] = r.mark_spacing;
     params["gauge_length"] = r.gauge_length;
     params["projection_iterations"] = r.projection_iterations;
     params["outlier_sigma"] = r.outlier_sigma;
-    nlohmann::json smoothing = {{"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
-                                {"log10_delta_optimum", json_number(r.log10_delta_optimum)},
-                                {"criterion_value", json_number(r.smoothing_criterion_value)},
-                                {"gauge_length", r.gauge_length},
-                                {"relaxed_elements", r.relaxed_elements},
-                                {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
+    nlohmann::json smoothing = {
+        {"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
+        {"log10_delta_optimum", json_number(r.log10_delta_optimum)},
+        {"criterion_value", json_number(r.smoothing_criterion_value)},
+        {"gauge_length", r.gauge_length},
+        {"relaxed_elements", r.relaxed_elements},
+        {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
     params["smoothing"] = smoothing;
     if (r.noise.sigma_total() > 0 || r.noise_undeformed.sigma_total() > 0) {
       auto model = [](const NoiseEstimate& e) {
@@ -202,9 +245,10 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
       };
       params["noise_model"] = {{"undeformed", model(r.noise_undeformed)},
                                {"deformed", model(r.noise)},
-                               {"meaning", "per coordinate; covariance sigma_correlated^2 exp(-r^2 / (2 L^2)) + "
-                                           "sigma_white^2 [same point], L = correlation_length; deformed: of the "
-                                           "displacement noise, both states together"}};
+                               {"meaning",
+                                "per coordinate; covariance sigma_correlated^2 exp(-r^2 / (2 L^2)) + "
+                                "sigma_white^2 [same point], L = correlation_length; deformed: of the "
+                                "displacement noise, both states together"}};
     }
     nlohmann::json flagged = nlohmann::json::array();
     for (std::size_t p = 0; p < r.points.size(); ++p) {
@@ -216,7 +260,8 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                           {"deviation", pr.flag->deviation},
                           {"threshold", pr.flag->threshold},
                           {"noise", pr.flag->noise}};
-      const Eigen::RowVector3d at = grid.has_deformed(static_cast<Index>(p)) ? grid.deformed.row(p) : grid.undeformed.row(p);
+      const Eigen::RowVector3d at =
+          grid.has_deformed(static_cast<Index>(p)) ? grid.deformed.row(p) : grid.undeformed.row(p);
       if (at.allFinite()) f["position"] = {at[0], at[1], at[2]};
       f["position_state"] = grid.has_deformed(static_cast<Index>(p)) ? "deformed" : "undeformed";
       flagged.push_back(std::move(f));
@@ -224,9 +269,10 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     j["outliers"] = {{"sigma", r.outlier_sigma},
                      {"noise_undeformed", r.noise_outliers_undeformed},
                      {"noise_deformed", r.noise_outliers_deformed},
-                     {"rule", "isolated points only: deviation from the local quadratic of the 16 nearest neighbours "
-                              "above sigma x noise and 2.5 x the second largest among the 8 nearest; flagged points "
-                              "keep a strain"},
+                     {"rule",
+                      "isolated points only: deviation from the local quadratic of the 16 nearest neighbours "
+                      "above sigma x noise and 2.5 x the second largest among the 8 nearest; flagged points "
+                      "keep a strain"},
                      {"flagged", flagged}};
     j["fit"] = {{"undeformed", {{"rms_residual", r.rms_undeformed}, {"max_residual", r.max_undeformed}}},
                 {"deformed", {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}}}};
@@ -235,12 +281,16 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   }
   if (!r.fibre_angles.empty()) params["fibre_angles_deg"] = r.fibre_angles;
   j["parameters"] = params;
-  j["strain_ranges"] = {{"E1", range_of(e1)}, {"E2", range_of(e2)}, {"eng1", range_of(eng1)},
-                        {"eng2", range_of(eng2)}, {"true1", range_of(true1)}, {"true2", range_of(true2)},
+  j["strain_ranges"] = {{"E1", range_of(e1)},
+                        {"E2", range_of(e2)},
+                        {"eng1", range_of(eng1)},
+                        {"eng2", range_of(eng2)},
+                        {"true1", range_of(true1)},
+                        {"true2", range_of(true2)},
                         {"thickness_change_pct", range_of(th)}};
   if (r.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
-  j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh}, {"project", r.times.project},
-                    {"fit", r.times.fit}, {"strain", r.times.strain}, {"write", r.times.write}};
+  j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh},     {"project", r.times.project},
+                    {"fit", r.times.fit},   {"strain", r.times.strain}, {"write", r.times.write}};
   j["warnings"] = r.warnings;
   return j;
 }
@@ -251,7 +301,7 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   const Index ne = r.mesh.n_elements();
   const int np = subdiv + 1;
   pm.points.resize(ne * np * np, 3);
-  std::vector<std::string> names = {"E1", "E2", "eng1", "eng2", "true1", "true2", "thickness_change_pct",
+  std::vector<std::string> names = {"E1",      "E2",     "eng1", "eng2", "true1", "true2", "thickness_change_pct",
                                     "lambda1", "lambda2"};
   std::vector<io::FieldArray> scalars(names.size());
   for (std::size_t k = 0; k < names.size(); ++k) scalars[k] = {names[k], 1, {}};
@@ -334,7 +384,8 @@ void write_samples_csv(const std::string& path, const AnalysisResult& r, const O
         const auto b = basis::BicubicHermite::evaluate(xi, basis::kValues | basis::kFirst);
         const fe::SurfacePoint pu = fu.evaluate3(e, b), pd = fd.evaluate3(e, b);
         const Fields f = fields_of(surface_strain(pu.dx, pd.dx));
-        w.begin_row().add(e).add(xi[0]).add(xi[1]).add(pu.x[0]).add(pu.x[1]).add(pu.x[2]).add(pd.x[0]).add(pd.x[1]).add(pd.x[2]);
+        w.begin_row().add(e).add(xi[0]).add(xi[1]).add(pu.x[0]).add(pu.x[1]).add(pu.x[2]).add(pd.x[0]).add(pd.x[1]).add(
+            pd.x[2]);
         w.add(f.e1).add(f.e2).add(f.thick).add(f.dir1[0]).add(f.dir1[1]).add(f.dir1[2]);
         w.end_row();
       }

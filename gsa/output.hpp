@@ -51,9 +51,9 @@ void write_samples_csv(const std::string& path, const AnalysisResult& result, co
 
 // What write_results() computed on the way.
 struct WrittenResults {
-  nlohmann::json summary;              // summary.json's content
-  std::optional<FlcMargins> margins;   // with OutputOptions::flc
-  io::PolyMesh undeformed, deformed;   // with OutputOptions::keep_surfaces (surface method)
+  nlohmann::json summary;             // summary.json's content
+  std::optional<FlcMargins> margins;  // with OutputOptions::flc
+  io::PolyMesh undeformed, deformed;  // with OutputOptions::keep_surfaces (surface method)
 };
 
 // Writes everything into `out` (not committed here): strains.csv once (with the forming

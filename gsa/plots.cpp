@@ -38,9 +38,7 @@ constexpr double kSamplesAcross = 10.0;
 
 const io::FieldArray* find_field(const io::PolyMesh& m, const std::string& name, int n_components) {
   for (const auto& f : m.point_data)
-    if (f.name == name && f.n_components == n_components &&
-        static_cast<Index>(f.n_tuples()) == m.n_points())
-      return &f;
+    if (f.name == name && f.n_components == n_components && static_cast<Index>(f.n_tuples()) == m.n_points()) return &f;
   return nullptr;
 }
 
@@ -77,8 +75,8 @@ using Results = PlotData;
 // Sampling points for arrows and fibre lines
 
 struct Sampling {
-  std::vector<Index> points;                     // point indices (same on both surfaces)
-  double spacing = 1;                            // model units on the undeformed surface
+  std::vector<Index> points;                      // point indices (same on both surfaces)
+  double spacing = 1;                             // model units on the undeformed surface
   std::vector<std::vector<Index>> element_edges;  // element boundaries as polylines
 };
 
@@ -96,14 +94,12 @@ Sampling sample_surface(const io::PolyMesh& m) {
   if (n_el > 0 && m.polygons.size() % static_cast<std::size_t>(n_el) == 0) {
     const auto per = static_cast<double>(m.polygons.size() / static_cast<std::size_t>(n_el));
     subdiv = static_cast<int>(std::lround(std::sqrt(per)));
-    if (static_cast<double>(subdiv) * subdiv != per ||
-        m.n_points() != n_el * (subdiv + 1) * (subdiv + 1))
-      subdiv = 0;
+    if (static_cast<double>(subdiv) * subdiv != per || m.n_points() != n_el * (subdiv + 1) * (subdiv + 1)) subdiv = 0;
   }
   if (subdiv > 0) {
     const int np = subdiv + 1;
-    const int k = std::clamp(static_cast<int>(std::lround(kSamplesAcross / std::sqrt(double(n_el)))), 1,
-                             std::max(1, subdiv / 2));
+    const int k =
+        std::clamp(static_cast<int>(std::lround(kSamplesAcross / std::sqrt(double(n_el)))), 1, std::max(1, subdiv / 2));
     std::vector<int> at;
     for (int q = 0; q < k; ++q) at.push_back(static_cast<int>(std::lround((q + 0.5) * subdiv / k)));
     for (Index e = 0; e < n_el; ++e) {
@@ -350,8 +346,8 @@ void draw_flagged_marks(const Results& r, render::Scene& scene) {
   const auto out = r.summary.find("outliers");
   if (out == r.summary.end() || !out->contains("flagged")) return;
   double size = 0.0;
-  if (const auto p = r.summary.find("parameters"); p != r.summary.end() && p->contains("mark_spacing") &&
-                                                   (*p)["mark_spacing"].is_number())
+  if (const auto p = r.summary.find("parameters");
+      p != r.summary.end() && p->contains("mark_spacing") && (*p)["mark_spacing"].is_number())
     size = 0.45 * (*p)["mark_spacing"].get<double>();
   if (!(size > 0.0) && r.deformed.n_points() > 0)
     size = 0.005 * (r.deformed.points.colwise().maxCoeff() - r.deformed.points.colwise().minCoeff()).norm();
@@ -433,8 +429,8 @@ render::Scene fibre_scene(const Results& r, const Sampling& s, const PlotOptions
 // Principal strain plot
 
 // Reference path lambda2 = lambda1^k for lambda1 >= 1 (both directions for k = 1).
-render::ChartSeries reference_line(double k, StrainMeasure m, const std::string& label,
-                                   const render::Colour& colour, double dash) {
+render::ChartSeries reference_line(double k, StrainMeasure m, const std::string& label, const render::Colour& colour,
+                                   double dash) {
   render::ChartSeries s;
   s.style = render::ChartSeries::Style::kLine;
   s.label = label;
@@ -464,7 +460,8 @@ render::Chart principal_chart(const Results& r, PlotSummary& summary) {
   chart.y_label = "major strain (" + w + ")";
   chart.equal_axes = true;
   chart.legend_title = "Key";
-  const std::string uni = r.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
+  const std::string uni =
+      r.measure == StrainMeasure::kTrue ? "uniaxial tension (major = -2 minor)" : "uniaxial tension";
   const std::string shear = r.measure == StrainMeasure::kTrue ? "pure shear (major = -minor)" : "pure shear";
   chart.series.push_back(reference_line(1.0, r.measure, "equibiaxial (major = minor)", {0.85, 0.45, 0.0}, 9));
   chart.series.push_back(reference_line(0.0, r.measure, "plane strain (minor = 0)", {0.10, 0.55, 0.20}, 0));
@@ -509,8 +506,8 @@ render::Chart principal_chart(const Results& r, PlotSummary& summary) {
     beyond.label = "marks beyond the limit (" + std::to_string(beyond.x.size()) + ")";
     chart.series.push_back(beyond);
   }
-  chart.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain  \xC2\xB7  " +
-                   std::to_string(n) + " marks";
+  chart.subtitle =
+      r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain  \xC2\xB7  " + std::to_string(n) + " marks";
   chart.footnote = "One dot per analysed mark (strains.csv). Equal axes." +
                    std::string(flc ? " Forming limit curve from " + fs::path(flc->source).filename().string() +
                                          ", in " + w + " strain."
@@ -537,8 +534,8 @@ PlotData plot_data(ResultsFolder folder, StrainMeasure measure) {
   return d;
 }
 
-PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed,
-                   io::PolyMesh deformed, const std::string& dir, StrainMeasure measure) {
+PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed, io::PolyMesh deformed,
+                   const std::string& dir, StrainMeasure measure) {
   PlotData d;
   d.source = dir;
   d.case_name = case_name_of(summary, dir);
@@ -547,8 +544,8 @@ PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::Pol
   d.measure = measure;
   d.marks = mark_strains(result, measure);
   d.summary = std::move(summary);
-  d.has_surfaces = undeformed.n_points() > 0 && !undeformed.polygons.empty() &&
-                   deformed.n_points() == undeformed.n_points();
+  d.has_surfaces =
+      undeformed.n_points() > 0 && !undeformed.polygons.empty() && deformed.n_points() == undeformed.n_points();
   d.undeformed = std::move(undeformed);
   d.deformed = std::move(deformed);
   return d;
@@ -578,8 +575,9 @@ void draw_surface_pictures(const Results& r, const std::function<void(const std:
   const std::string w = measure_word(r.measure);
   const auto e1 = scalar_values(r.deformed, names[0], file);
   const auto e2 = scalar_values(r.deformed, names[1], file);
-  render::Scene major = contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
-                                      measure_name(r.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o);
+  render::Scene major =
+      contour_scene(r, e1, "Major strain", "Major " + w + " strain", "-", 0.01,
+                    measure_name(r.measure) + " strain, " + range_text(e1, decimals_for(e1), "", 0.01), o);
   draw_flagged_marks(r, major);
   draw("major_strain.png", major);
   draw("minor_strain.png",
@@ -588,10 +586,9 @@ void draw_surface_pictures(const Results& r, const std::function<void(const std:
   if (!fibres) return;
   const auto sh = scalar_values(r.deformed, "shear_angle_deg", file);
   draw("shear_angle.png",
-       contour_scene(r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
-                     "initial angle between the fibre families minus the current one, " +
-                         range_text(sh, 1, "\xC2\xB0", 1.0),
-                     o));
+       contour_scene(
+           r, sh, "Trellis shear angle", "Shear angle", "\xC2\xB0", 1.0,
+           "initial angle between the fibre families minus the current one, " + range_text(sh, 1, "\xC2\xB0", 1.0), o));
   draw("fibres.png", fibre_scene(r, s, o));
 }
 

@@ -49,13 +49,13 @@ struct PlotOptions {
 
 // The results of one analysis as the pictures show them.
 struct PlotData {
-  std::string source;                // the results folder, for messages
-  std::string case_name;             // e.g. "dome/grid.csv": the input's folder and name
-  std::string units = "mm";          // length unit
-  std::vector<double> fibre_angles;  // degrees, fibre mode only
-  nlohmann::json summary;            // summary.json's content
-  bool has_surfaces = false;         // fitted surfaces (surface method)
-  io::PolyMesh undeformed, deformed;  // tessellated surfaces with the strain fields, as in the .vtp files
+  std::string source;                            // the results folder, for messages
+  std::string case_name;                         // e.g. "dome/grid.csv": the input's folder and name
+  std::string units = "mm";                      // length unit
+  std::vector<double> fibre_angles;              // degrees, fibre mode only
+  nlohmann::json summary;                        // summary.json's content
+  bool has_surfaces = false;                     // fitted surfaces (surface method)
+  io::PolyMesh undeformed, deformed;             // tessellated surfaces with the strain fields, as in the .vtp files
   StrainMeasure measure = StrainMeasure::kTrue;  // the strain the pictures show
   MarkStrains marks;                             // every mark's principal strains in `measure`
   std::optional<FormingLimitCurve> flc;          // drawn in the principal strain plot (in `measure`)
@@ -65,8 +65,8 @@ struct PlotData {
 PlotData plot_data(ResultsFolder folder, StrainMeasure measure);
 // From the results in memory: the analysis, its summary and its tessellated surfaces
 // (empty for the triangle method); `dir` is the results folder.
-PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed,
-                   io::PolyMesh deformed, const std::string& dir, StrainMeasure measure);
+PlotData plot_data(const AnalysisResult& result, nlohmann::json summary, io::PolyMesh undeformed, io::PolyMesh deformed,
+                   const std::string& dir, StrainMeasure measure);
 
 // The arrow diagram on the undeformed (deformed = false) or deformed surface, as a scene
 // (write it with render::write_png). Needs has_surfaces.

@@ -108,7 +108,6 @@ void page_head(std::ostream& h, const nlohmann::json& s, const ReportPage& page)
   if (page.pictures.size() > 1)
     h << "<a href=\"undeformed.vtp\">undeformed.vtp</a><a href=\"deformed.vtp\">deformed.vtp</a>";
   h << "</span></div></header>\n<div class=\"page\">\n<aside>\n";
-
 }
 
 // The summary's inputs and parameters.
@@ -124,9 +123,10 @@ void parameter_tables(std::ostream& h, const nlohmann::json& s) {
     Table t("Parameters");
     const auto& p = at(s, {"parameters"});
     t.row("method", text_of(at(p, {"method"})));
-    t.row("mesh", text_of(at(p, {"mesh", "grid"})) +
-                      (at(p, {"mesh", "elements"}).is_null() ? "" : " (" + text_of(at(p, {"mesh", "elements"})) +
-                                                                         " elements)"));
+    t.row(
+        "mesh",
+        text_of(at(p, {"mesh", "grid"})) +
+            (at(p, {"mesh", "elements"}).is_null() ? "" : " (" + text_of(at(p, {"mesh", "elements"})) + " elements)"));
     t.row("element", text_of(at(p, {"mesh", "element_type"})));
     t.row("smoothing", text_of(at(p, {"penalty"})));
     t.row("automatic weights", text_of(at(p, {"smoothing_automatic"})));
@@ -146,9 +146,9 @@ void parameter_tables(std::ostream& h, const nlohmann::json& s) {
             "rotation " + text_of(at(p, {"rigid_motion", "rotation_deg"})) + "&deg;, translation " +
                 text_of(at(p, {"rigid_motion", "translation"})) + unit);
     if (at(p, {"smoothing", "criterion"}).is_string())
-      t.row("smoothing chosen by", text_of(at(p, {"smoothing", "criterion"})) + " = " +
-                                       text_of(at(p, {"smoothing", "criterion_value"})) + " at log10(&delta;/d<sup>6</sup>) " +
-                                       text_of(at(p, {"smoothing", "log10_delta_optimum"})));
+      t.row("smoothing chosen by",
+            text_of(at(p, {"smoothing", "criterion"})) + " = " + text_of(at(p, {"smoothing", "criterion_value"})) +
+                " at log10(&delta;/d<sup>6</sup>) " + text_of(at(p, {"smoothing", "log10_delta_optimum"})));
     if (at(p, {"smoothing", "local_gauge_length"}).is_number())
       t.row("locally relaxed smoothing", text_of(at(p, {"smoothing", "relaxed_elements"})) +
                                              " elements, gauge length there " +
@@ -156,10 +156,9 @@ void parameter_tables(std::ostream& h, const nlohmann::json& s) {
     for (const char* which : {"undeformed", "deformed"}) {
       const auto& n = at(p, {"noise_model", which});
       if (n.is_object())
-        t.row(std::string("noise model, ") + which,
-              "correlated " + text_of(at(n, {"sigma_correlated"})) + unit + " over " +
-                  text_of(at(n, {"correlation_length"})) + unit + ", independent " + text_of(at(n, {"sigma_white"})) +
-                  unit);
+        t.row(std::string("noise model, ") + which, "correlated " + text_of(at(n, {"sigma_correlated"})) + unit +
+                                                        " over " + text_of(at(n, {"correlation_length"})) + unit +
+                                                        ", independent " + text_of(at(n, {"sigma_white"})) + unit);
     }
     t.row("outlier threshold (sigmas)", text_of(at(p, {"outlier_sigma"})));
     t.row("fibre angles (deg)", text_of(at(p, {"fibre_angles_deg"})));
@@ -191,7 +190,8 @@ void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& p
     if (r.is_object()) {
       h << "<h2>Strain ranges at the marks</h2>\n<p>E: Green-Lagrange, eng: engineering, true: logarithmic "
            "strain; the pictures show "
-        << io::xml_escape(measure_name(page.measure)) << " strain.</p>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
+        << io::xml_escape(measure_name(page.measure))
+        << " strain.</p>\n<table>\n<tr><th>field</th><td><b>min</b></td><td><b>max</b></td></tr>\n";
       for (auto it = r.begin(); it != r.end(); ++it)
         h << "<tr><th>" << io::xml_escape(it.key()) << "</th><td>" << text_of(at(it.value(), {"min"})) << "</td><td>"
           << text_of(at(it.value(), {"max"})) << "</td></tr>\n";
@@ -210,7 +210,8 @@ void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& p
     const auto& f = at(s, {"outliers", "flagged"});
     if (f.is_array() && !f.empty()) {
       const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
-      h << "<h2>Flagged marks (" << f.size() << ")</h2>\n<p>Isolated points their neighbours disagree with; "
+      h << "<h2>Flagged marks (" << f.size()
+        << ")</h2>\n<p>Isolated points their neighbours disagree with; "
            "each keeps the fitted surfaces' strain and took no part in the fit. Drawn as crosses on the "
            "major strain picture.</p>\n<table>\n<tr><th>id</th><td><b>reason</b></td><td><b>off by / threshold"
         << unit << "</b></td></tr>\n";
@@ -239,8 +240,8 @@ void figures(std::ostream& h, const ReportPage& page) {
   h << "</aside>\n<main>\n";
   for (const std::string& name : page.pictures)
     h << "<figure><a href=\"" << io::xml_escape(name) << "\"><img src=\"" << io::xml_escape(name) << "\" alt=\""
-      << io::xml_escape(caption_of(name, page.measure)) << "\"></a>\n<figcaption>" << io::xml_escape(caption_of(name, page.measure))
-      << "</figcaption></figure>\n";
+      << io::xml_escape(caption_of(name, page.measure)) << "\"></a>\n<figcaption>"
+      << io::xml_escape(caption_of(name, page.measure)) << "</figcaption></figure>\n";
   if (page.pictures.size() == 1)
     h << "<p>The triangle method has no fitted surfaces: only the principal strain plot is drawn. "
          "Run with <code>--method surface</code> for arrow diagrams and contours.</p>\n";

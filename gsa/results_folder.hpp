@@ -17,16 +17,16 @@ namespace sf::gsa {
 
 struct ResultsFolder {
   std::string dir;
-  nlohmann::json summary;            // summary.json (null if absent)
-  io::CsvTable strains;              // strains.csv
-  bool has_surfaces = false;         // undeformed.vtp and deformed.vtp present (surface method)
+  nlohmann::json summary;     // summary.json (null if absent)
+  io::CsvTable strains;       // strains.csv
+  bool has_surfaces = false;  // undeformed.vtp and deformed.vtp present (surface method)
   io::PolyMesh undeformed, deformed;
 };
 // Throws sf::InputError when DIR has no strains.csv or its files do not belong together.
 ResultsFolder read_results_folder(const std::string& dir);
 
 // What summary.json says about the run, with defaults for a missing summary.
-std::string units_of(const nlohmann::json& summary);                // length unit ("mm")
+std::string units_of(const nlohmann::json& summary);                 // length unit ("mm")
 std::vector<double> fibre_angles_of(const nlohmann::json& summary);  // degrees; empty unless fibre mode
 // "dome/grid.csv": the first input's folder and name; the folder's name without inputs.
 std::string case_name_of(const nlohmann::json& summary, const std::string& dir);

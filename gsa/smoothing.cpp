@@ -14,8 +14,8 @@ namespace {
 // Calibration constants of the automatic smoothing (docs/theory/strain.md).
 // (Calibrated against a noise estimate that was sigma/sqrt(3); rescaled when the
 // estimate was corrected to sigma, so the weights did not change.)
-constexpr double kAutoGamma = 258.7;   // 500 / 3^0.6
-constexpr double kAutoBeta = 115.47;   // 200 / sqrt(3)
+constexpr double kAutoGamma = 258.7;    // 500 / 3^0.6
+constexpr double kAutoBeta = 115.47;    // 200 / sqrt(3)
 constexpr double kAutoDelta = 11547.0;  // 2e4 / sqrt(3)
 // A whisper of third-order smoothing holds elements the edge jumps alone cannot
 // (a single element, or elements with fewer marks than parameters).

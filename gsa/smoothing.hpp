@@ -63,7 +63,7 @@ double gauge_length(const Penalty& penalty, double mark_spacing);
 
 struct SmoothingChoice {
   Penalty penalty;
-  int passes = 1;  // of the fit (iterated Tikhonov, gsa/fit.hpp)
+  int passes = 1;                                                         // of the fit (iterated Tikhonov, gsa/fit.hpp)
   double log10_delta_optimum = std::numeric_limits<double>::quiet_NaN();  // the criterion's optimum, log10(delta / d^6)
   const char* criterion = "";  // "GCV" or "Cp" (noise model); empty for explicit weights
   double criterion_value = std::numeric_limits<double>::quiet_NaN();  // at the optimum (GCV: mm^2; Cp: mm^2 summed)

@@ -13,8 +13,7 @@ std::optional<SurfaceStrain> surface_strain(const Mat32& G, const Mat32& g) {
   const Mat2 m = g.transpose() * g;
   const double detM = M.determinant(), detm = m.determinant();
   const double scaleM = M.trace() * M.trace(), scalem = m.trace() * m.trace();
-  if (!(detM > 1e-14 * scaleM) || !(detm > 1e-14 * scalem) || !G.allFinite() || !g.allFinite())
-    return std::nullopt;
+  if (!(detM > 1e-14 * scaleM) || !(detm > 1e-14 * scalem) || !G.allFinite() || !g.allFinite()) return std::nullopt;
   // Generalised symmetric eigenproblem m v = l M v (M SPD); eigenvalues ascending.
   Eigen::GeneralizedSelfAdjointEigenSolver<Mat2> es(m, M);
   if (es.info() != Eigen::Success) return std::nullopt;

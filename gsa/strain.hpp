@@ -21,11 +21,14 @@
 namespace sf::gsa {
 
 struct SurfaceStrain {
-  double lambda1 = 0, lambda2 = 0;  // principal stretches, lambda1 >= lambda2
+  double lambda1 = 0, lambda2 = 0;        // principal stretches, lambda1 >= lambda2
   Vec3 dir1_deformed, dir2_deformed;      // unit major/minor directions, deformed surface
   Vec3 dir1_undeformed, dir2_undeformed;  // the same material directions, undeformed surface
   Vec3 normal_deformed, normal_undeformed;
-  double green(int i) const { const double l = i == 0 ? lambda1 : lambda2; return 0.5 * (l * l - 1.0); }
+  double green(int i) const {
+    const double l = i == 0 ? lambda1 : lambda2;
+    return 0.5 * (l * l - 1.0);
+  }
   double engineering(int i) const { return (i == 0 ? lambda1 : lambda2) - 1.0; }
   double true_strain(int i) const;
   double thickness_stretch() const { return 1.0 / (lambda1 * lambda2); }

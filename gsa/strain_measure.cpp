@@ -7,45 +7,60 @@ namespace sf::gsa {
 
 std::string measure_name(StrainMeasure m) {
   switch (m) {
-    case StrainMeasure::kTrue: return "true";
-    case StrainMeasure::kEngineering: return "engineering";
-    case StrainMeasure::kLagrangian: return "Lagrangian (Green)";
+    case StrainMeasure::kTrue:
+      return "true";
+    case StrainMeasure::kEngineering:
+      return "engineering";
+    case StrainMeasure::kLagrangian:
+      return "Lagrangian (Green)";
   }
   return "true";
 }
 
 std::string measure_word(StrainMeasure m) {
   switch (m) {
-    case StrainMeasure::kTrue: return "true";
-    case StrainMeasure::kEngineering: return "engineering";
-    case StrainMeasure::kLagrangian: return "Green";
+    case StrainMeasure::kTrue:
+      return "true";
+    case StrainMeasure::kEngineering:
+      return "engineering";
+    case StrainMeasure::kLagrangian:
+      return "Green";
   }
   return "true";
 }
 
 std::array<std::string, 2> measure_fields(StrainMeasure m) {
   switch (m) {
-    case StrainMeasure::kTrue: return {"true1", "true2"};
-    case StrainMeasure::kEngineering: return {"eng1", "eng2"};
-    case StrainMeasure::kLagrangian: return {"E1", "E2"};
+    case StrainMeasure::kTrue:
+      return {"true1", "true2"};
+    case StrainMeasure::kEngineering:
+      return {"eng1", "eng2"};
+    case StrainMeasure::kLagrangian:
+      return {"E1", "E2"};
   }
   return {"true1", "true2"};
 }
 
 double strain_of_stretch(double l, StrainMeasure m) {
   switch (m) {
-    case StrainMeasure::kTrue: return std::log(l);
-    case StrainMeasure::kEngineering: return l - 1;
-    case StrainMeasure::kLagrangian: return 0.5 * (l * l - 1);
+    case StrainMeasure::kTrue:
+      return std::log(l);
+    case StrainMeasure::kEngineering:
+      return l - 1;
+    case StrainMeasure::kLagrangian:
+      return 0.5 * (l * l - 1);
   }
   return std::numeric_limits<double>::quiet_NaN();
 }
 
 double principal_strain(const SurfaceStrain& s, int i, StrainMeasure m) {
   switch (m) {
-    case StrainMeasure::kTrue: return s.true_strain(i);
-    case StrainMeasure::kEngineering: return s.engineering(i);
-    case StrainMeasure::kLagrangian: return s.green(i);
+    case StrainMeasure::kTrue:
+      return s.true_strain(i);
+    case StrainMeasure::kEngineering:
+      return s.engineering(i);
+    case StrainMeasure::kLagrangian:
+      return s.green(i);
   }
   return std::numeric_limits<double>::quiet_NaN();
 }

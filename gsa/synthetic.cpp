@@ -13,9 +13,7 @@ namespace sf::gsa {
 namespace {
 
 // Rigid motion: rotation about an oblique axis plus translation.
-Mat3 rotation() {
-  return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())).toRotationMatrix();
-}
+Mat3 rotation() { return (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())).toRotationMatrix(); }
 Vec3 rigid_map(const Vec3& X) { return rotation() * X + Vec3(10, -5, 3); }
 ExactStrain rigid_exact(const Vec3&) { return {1.0, 1.0}; }
 
@@ -68,7 +66,7 @@ ExactStrain wavy_exact(const Vec3& X) {
   const double x = X.x(), y = X.y();
   Mat32 g;
   g << 1.0 + (2.0 / 25.0) * std::cos(x / 25.0) + 0.001 * y, 0.001 * x,  //
-      0.0, 1.0 + (1.5 / 20.0) * std::cos(y / 20.0 + 0.5),            //
+      0.0, 1.0 + (1.5 / 20.0) * std::cos(y / 20.0 + 0.5),               //
       (6.0 / 18.0) * std::cos(x / 18.0) * std::cos(y / 22.0), -(6.0 / 22.0) * std::sin(x / 18.0) * std::sin(y / 22.0);
   const Mat2 C = g.transpose() * g;
   const double tr = C.trace(), det = C.determinant();
@@ -104,8 +102,8 @@ const std::vector<SyntheticCase>& cases() {
        dome_exact},
       {"wavy", "in-plane stretch varying across the sheet plus an out-of-plane wave (amplitude 6 mm)", wavy_map,
        wavy_exact},
-      {"trellis", "pin-jointed net of 0/90 fibres: trellis shear growing from 0 to 34.4 degrees across Y",
-       trellis_map, trellis_exact},
+      {"trellis", "pin-jointed net of 0/90 fibres: trellis shear growing from 0 to 34.4 degrees across Y", trellis_map,
+       trellis_exact},
   };
   return all;
 }

@@ -19,7 +19,7 @@ struct ExactStrain {
 };
 
 struct SyntheticCase {
-  std::string name;         // dome, cylinder, trellis, wavy, rigid, stretch, shear
+  std::string name;  // dome, cylinder, trellis, wavy, rigid, stretch, shear
   std::string description;
   Vec3 (*map)(const Vec3& X) = nullptr;
   ExactStrain (*exact)(const Vec3& X) = nullptr;
@@ -30,12 +30,12 @@ const SyntheticCase& synthetic_case(const std::string& name);
 std::vector<std::string> synthetic_case_names();
 
 struct SyntheticGridOptions {
-  int n = 21;               // marks per side
-  double spacing = 5.0;     // mm
-  double noise = 0.0;       // standard deviation per coordinate, both states (mm)
+  int n = 21;                     // marks per side
+  double spacing = 5.0;           // mm
+  double noise = 0.0;             // standard deviation per coordinate, both states (mm)
   double missing_deformed = 0.0;  // fraction of marks without a deformed position
-  int outliers = 0;         // marks moved by 2 mm in the deformed state
-  bool round = false;       // only the marks inside the grid's inscribed circle (a round blank)
+  int outliers = 0;               // marks moved by 2 mm in the deformed state
+  bool round = false;             // only the marks inside the grid's inscribed circle (a round blank)
   unsigned seed = 1;
 };
 

@@ -133,8 +133,7 @@ SyntheticMeasurement make_measurement(const Deformation& deformation, const Synt
   const std::vector<LayoutPoint> pts = layout_points(o.layout, rng);
   const CorrelatedField field_u(o.undeformed_noise.sigma_correlated, o.undeformed_noise.correlation_length,
                                 2 * o.seed + 1);
-  const CorrelatedField field_d(o.deformed_noise.sigma_correlated, o.deformed_noise.correlation_length,
-                                2 * o.seed + 2);
+  const CorrelatedField field_d(o.deformed_noise.sigma_correlated, o.deformed_noise.correlation_length, 2 * o.seed + 2);
   std::normal_distribution<double> normal(0.0, 1.0);
   SyntheticMeasurement m;
   const Index n = static_cast<Index>(pts.size());

@@ -24,10 +24,10 @@ namespace sf::gsa {
 // sigma_correlated^2 exp(-r^2 / (2 L^2)) (L = correlation_length, r the distance
 // between the points' undeformed positions) plus independent noise sigma_white.
 struct NoiseModel {
-  double sigma_correlated = 0.0;   // mm
-  double correlation_length = 0.0; // mm (0 with sigma_correlated > 0: invalid)
-  double sigma_white = 0.0;        // mm
-  double sigma_total() const;      // sqrt of the summed variances
+  double sigma_correlated = 0.0;    // mm
+  double correlation_length = 0.0;  // mm (0 with sigma_correlated > 0: invalid)
+  double sigma_white = 0.0;         // mm
+  double sigma_total() const;       // sqrt of the summed variances
 };
 
 // An analytic deformation of a flat blank (Z = 0) with its exact gradient
@@ -60,23 +60,23 @@ struct PointLayout {
   enum class Kind { kGrid, kJittered, kScattered };
   Kind kind = Kind::kGrid;
   double length_x = 100.0, length_y = 100.0;  // mm
-  double spacing = 5.0;                        // mm
-  double jitter = 0.3;                         // fraction of the spacing (kJittered)
-  bool round = false;                          // keep the ellipse inscribed in the rectangle
+  double spacing = 5.0;                       // mm
+  double jitter = 0.3;                        // fraction of the spacing (kJittered)
+  bool round = false;                         // keep the ellipse inscribed in the rectangle
 };
 
 struct SyntheticMeasurementOptions {
   PointLayout layout;
   NoiseModel undeformed_noise, deformed_noise;
-  int blunders = 0;              // isolated marks moved by blunder_size (deformed state)
-  double blunder_size = 0.0;     // mm, 0 = 10 x the deformed noise sigma
+  int blunders = 0;           // isolated marks moved by blunder_size (deformed state)
+  double blunder_size = 0.0;  // mm, 0 = 10 x the deformed noise sigma
   unsigned seed = 1;
 };
 
 struct SyntheticMeasurement {
-  GridData grid;                    // ids, positions (and i, j on kGrid)
-  std::vector<Vec3> nominal;        // exact undeformed positions
-  std::vector<ExactStrain> exact;   // exact strains at each point
+  GridData grid;                      // ids, positions (and i, j on kGrid)
+  std::vector<Vec3> nominal;          // exact undeformed positions
+  std::vector<ExactStrain> exact;     // exact strains at each point
   std::vector<double> edge_distance;  // distance of the nominal position from the layout's outline, mm
   std::vector<Index> blunder_points;  // points given a blunder
 };

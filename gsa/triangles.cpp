@@ -60,14 +60,16 @@ std::vector<std::array<Index, 3>> delaunay_triangles(const GridData& g, const st
   std::vector<double> edge;
   for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f)
     for (int k = 0; k < 3; ++k)
-      edge.push_back(std::sqrt(CGAL::to_double(CGAL::squared_distance(f->vertex(k)->point(), f->vertex((k + 1) % 3)->point()))));
+      edge.push_back(
+          std::sqrt(CGAL::to_double(CGAL::squared_distance(f->vertex(k)->point(), f->vertex((k + 1) % 3)->point()))));
   std::nth_element(edge.begin(), edge.begin() + edge.size() / 2, edge.end());
   const double typical = edge.empty() ? 0.0 : edge[edge.size() / 2];
   for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
     double longest = 0.0;
     for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, std::sqrt(CGAL::to_double(
-                                      CGAL::squared_distance(f->vertex(k)->point(), f->vertex((k + 1) % 3)->point()))));
+      longest = std::max(
+          longest,
+          std::sqrt(CGAL::to_double(CGAL::squared_distance(f->vertex(k)->point(), f->vertex((k + 1) % 3)->point()))));
     if (longest > 2.5 * typical) continue;
     tris.push_back({f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()});
   }
@@ -86,9 +88,12 @@ AnalysisResult analyse_triangles(const GridData& g, const AnalyseOptions& option
   std::vector<Index> usable;
   bool all_ij = g.has_ij;
   for (Index p = 0; p < n; ++p) {
-    if (!g.has_undeformed(p)) r.points[p].status = g.not_measured_undeformed(p) ? kStatusNotMeasured : kStatusMissingUndeformed;
-    else if (!g.has_deformed(p)) r.points[p].status = g.not_measured_deformed(p) ? kStatusNotMeasured : kStatusMissingDeformed;
-    else usable.push_back(p);
+    if (!g.has_undeformed(p))
+      r.points[p].status = g.not_measured_undeformed(p) ? kStatusNotMeasured : kStatusMissingUndeformed;
+    else if (!g.has_deformed(p))
+      r.points[p].status = g.not_measured_deformed(p) ? kStatusNotMeasured : kStatusMissingDeformed;
+    else
+      usable.push_back(p);
     if (g.has_ij && g.i[p] == std::numeric_limits<long>::min()) all_ij = false;
   }
   if (usable.size() < 3)

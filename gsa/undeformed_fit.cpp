@@ -37,8 +37,10 @@ double project_marks(const FrameAndMesh& setup, const FitMarks& marks, const Mat
   double max_dxi = 0.0;
   for (Index k = 0; k < m; ++k) {
     if (!proj[k].ok()) continue;
-    if (proj[k].element == loc[k].element) max_dxi = std::max(max_dxi, (proj[k].xi - loc[k].xi).norm());
-    else max_dxi = 1.0;
+    if (proj[k].element == loc[k].element)
+      max_dxi = std::max(max_dxi, (proj[k].xi - loc[k].xi).norm());
+    else
+      max_dxi = 1.0;
     loc[k] = {proj[k].element, proj[k].xi};
   }
   return max_dxi;

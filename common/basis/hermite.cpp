@@ -4,11 +4,16 @@ namespace sf::basis {
 
 std::array<double, 4> cubic_hermite(double t, int derivative_order) {
   switch (derivative_order) {
-    case 0: return cubic_hermite_table<0>(t)[0];
-    case 1: return cubic_hermite_table<1>(t)[1];
-    case 2: return cubic_hermite_table<2>(t)[2];
-    case 3: return cubic_hermite_table<3>(t)[3];
-    default: return {0.0, 0.0, 0.0, 0.0};
+    case 0:
+      return cubic_hermite_table<0>(t)[0];
+    case 1:
+      return cubic_hermite_table<1>(t)[1];
+    case 2:
+      return cubic_hermite_table<2>(t)[2];
+    case 3:
+      return cubic_hermite_table<3>(t)[3];
+    default:
+      return {0.0, 0.0, 0.0, 0.0};
   }
 }
 

@@ -75,10 +75,10 @@ struct BasisValues {
   static constexpr int kNumFunctions = NF;
   static constexpr int kDim = DIM;
   static constexpr int kNumSecond = DIM * (DIM + 1) / 2;
-  unsigned updated = 0;                           // which flags were computed
-  Eigen::Matrix<double, NF, 1> value;             // N_k
-  Eigen::Matrix<double, NF, DIM> first;           // dN_k / dxi_i
-  Eigen::Matrix<double, NF, kNumSecond> second;   // d2N_k / dxi_i dxi_j
+  unsigned updated = 0;                          // which flags were computed
+  Eigen::Matrix<double, NF, 1> value;            // N_k
+  Eigen::Matrix<double, NF, DIM> first;          // dN_k / dxi_i
+  Eigen::Matrix<double, NF, kNumSecond> second;  // d2N_k / dxi_i dxi_j
 };
 
 using BicubicValues = BasisValues<16, 2>;

@@ -43,8 +43,7 @@ Program::Program(std::string name, std::string description)
 Program::~Program() = default;
 
 void Program::add_command(const std::string& name, const std::string& description,
-                          const std::function<void(CLI::App&)>& configure,
-                          const std::function<int()>& run) {
+                          const std::function<void(CLI::App&)>& configure, const std::function<int()>& run) {
   auto cmd = std::make_unique<Command>();
   cmd->app = app_->add_subcommand(name, description);
   configure(*cmd->app);
@@ -83,8 +82,7 @@ int Program::main(int argc, char** argv) {
       std::cerr << name_ << ": error: out of memory\n";
       return kExitFailure;
     } catch (const std::exception& e) {
-      std::cerr << name_ << ": internal error: " << e.what()
-                << " (please report this with the input that caused it)\n";
+      std::cerr << name_ << ": internal error: " << e.what() << " (please report this with the input that caused it)\n";
       return kExitFailure;
     }
   }

@@ -39,8 +39,7 @@ class Program {
   // Adds a subcommand; `configure` declares its options on the CLI11 app, `run`
   // executes it after parsing and returns an exit code.
   void add_command(const std::string& name, const std::string& description,
-                   const std::function<void(CLI::App&)>& configure,
-                   const std::function<int()>& run);
+                   const std::function<void(CLI::App&)>& configure, const std::function<int()>& run);
 
   // Parses, dispatches, catches every error at the top and maps it to an exit code.
   int main(int argc, char** argv);

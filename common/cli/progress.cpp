@@ -34,8 +34,7 @@ void Progress::finish() {
 }
 
 void Progress::draw(long done, bool final) {
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (total_ > 0) {
     const double pct = 100.0 * static_cast<double>(done) / static_cast<double>(total_);
     std::fprintf(stderr, "\r%s: %5.1f%% (%ld/%ld) %.1f s%s", label_.c_str(), pct, done, total_, secs,

@@ -5,8 +5,7 @@
 
 namespace sf {
 
-std::string located_message(const std::string& file, int line, int column,
-                            const std::string& message) {
+std::string located_message(const std::string& file, int line, int column, const std::string& message) {
   std::string out = file;
   if (line > 0) {
     out += ":" + std::to_string(line);

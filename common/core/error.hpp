@@ -29,8 +29,7 @@ class UsageError : public Error {
 };
 
 // Formats "file:line:column: message" (line/column 1-based; 0 = not applicable).
-std::string located_message(const std::string& file, int line, int column,
-                            const std::string& message);
+std::string located_message(const std::string& file, int line, int column, const std::string& message);
 
 namespace detail {
 [[noreturn]] void assert_fail(const char* expr, const char* file, int line, const std::string& msg);
@@ -41,6 +40,5 @@ namespace detail {
 #ifdef NDEBUG
 #define SF_ASSERT(cond, msg) ((void)0)
 #else
-#define SF_ASSERT(cond, msg) \
-  ((cond) ? (void)0 : ::sf::detail::assert_fail(#cond, __FILE__, __LINE__, (msg)))
+#define SF_ASSERT(cond, msg) ((cond) ? (void)0 : ::sf::detail::assert_fail(#cond, __FILE__, __LINE__, (msg)))
 #endif

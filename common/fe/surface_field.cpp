@@ -42,12 +42,18 @@ SurfacePoint SurfaceField::evaluate3(Index e, const Vec2& xi, unsigned updates) 
 namespace {
 double pick(const basis::BicubicValues& b, int k, int which) {
   switch (which) {
-    case 0: return b.value[k];
-    case 1: return b.first(k, 0);
-    case 2: return b.first(k, 1);
-    case 3: return b.second(k, 0);
-    case 4: return b.second(k, 1);
-    default: return b.second(k, 2);
+    case 0:
+      return b.value[k];
+    case 1:
+      return b.first(k, 0);
+    case 2:
+      return b.first(k, 1);
+    case 3:
+      return b.second(k, 0);
+    case 4:
+      return b.second(k, 1);
+    default:
+      return b.second(k, 2);
   }
 }
 }  // namespace

@@ -27,7 +27,7 @@ struct FieldPoint {
 struct SurfacePoint {
   unsigned updated = 0;
   Vec3 x = Vec3::Zero();
-  Mat32 dx = Mat32::Zero();                         // columns x,1 x,2
+  Mat32 dx = Mat32::Zero();                                               // columns x,1 x,2
   Eigen::Matrix<double, 3, 3> d2x = Eigen::Matrix<double, 3, 3>::Zero();  // columns x,11 x,12 x,22
 };
 

@@ -21,12 +21,9 @@ namespace {
 
 std::atomic<unsigned> g_temp_counter{0};
 
-std::string temp_suffix() {
-  return fmt::format(".tmp-{}-{}", static_cast<long>(::getpid()), g_temp_counter++);
-}
+std::string temp_suffix() { return fmt::format(".tmp-{}-{}", static_cast<long>(::getpid()), g_temp_counter++); }
 
-[[noreturn]] void throw_fs_error(const fs::path& path, const std::string& what,
-                                 const std::error_code& ec) {
+[[noreturn]] void throw_fs_error(const fs::path& path, const std::string& what, const std::error_code& ec) {
   throw Error(located_message(path.string(), 0, 0, fmt::format("{} ({})", what, ec.message())));
 }
 
@@ -93,15 +90,15 @@ void AtomicOutputDir::commit() {
     }
   }
   if (fs::exists(final_dir_, ec) && !fs::is_directory(final_dir_, ec)) {
-    throw Error(located_message(final_dir_.string(), 0, 0,
-                                "cannot write the output: it exists and is not a directory"));
+    throw Error(
+        located_message(final_dir_.string(), 0, 0, "cannot write the output: it exists and is not a directory"));
   }
   fs::create_directories(final_dir_, ec);
   if (ec) throw_fs_error(final_dir_, "cannot create the output directory", ec);
   // List first, then move: a directory changed while iterating may be listed incompletely.
   std::vector<fs::path> entries;
-  for (auto it = fs::recursive_directory_iterator(temp_dir_, ec);
-       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+  for (auto it = fs::recursive_directory_iterator(temp_dir_, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
     entries.push_back(it->path());
   }
   if (ec) throw_fs_error(temp_dir_, "cannot list the temporary output directory", ec);
@@ -123,8 +120,7 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) {
-      throw Error(
-          located_message(path, 0, 0, fmt::format("cannot write file ({})", std::strerror(errno))));
+      throw Error(located_message(path, 0, 0, fmt::format("cannot write file ({})", std::strerror(errno))));
     }
     try {
       write(out);
@@ -152,9 +148,8 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
-  write_file_atomic(path, [&content](std::ostream& out) {
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-  });
+  write_file_atomic(
+      path, [&content](std::ostream& out) { out.write(content.data(), static_cast<std::streamsize>(content.size())); });
 }
 
 }  // namespace sf::io

@@ -31,8 +31,7 @@ constexpr int kHeaderSearchLines = 1000;
 bool is_blank(char c, char delimiter) { return (c == ' ' || c == '\t') && c != delimiter; }
 
 bool equals_nan(std::string_view s) {
-  return s.size() == 3 && (s[0] == 'n' || s[0] == 'N') && (s[1] == 'a' || s[1] == 'A') &&
-         (s[2] == 'n' || s[2] == 'N');
+  return s.size() == 3 && (s[0] == 'n' || s[0] == 'N') && (s[1] == 'a' || s[1] == 'A') && (s[2] == 'n' || s[2] == 'N');
 }
 
 // Strict decimal floating-point parse of the whole of `s`; false on anything else.
@@ -98,8 +97,8 @@ std::size_t CsvTable::column_index(std::string_view name) const {
     if (c > 0) found += ", ";
     found += names_[c];
   }
-  throw InputError(located_message(
-      file_name_, 0, 0, fmt::format("missing required column '{}' (found: {})", name, found)));
+  throw InputError(
+      located_message(file_name_, 0, 0, fmt::format("missing required column '{}' (found: {})", name, found)));
 }
 
 std::string CsvTable::column_label(std::size_t col) const {
@@ -112,8 +111,7 @@ std::string_view CsvTable::cell(std::size_t row, std::size_t col) const {
   const std::size_t index = row * n_columns_ + col;
   const Cell& c = cells_[index];
   if (c.size_and_flags & kEscaped) return escaped_.at(index);
-  const std::size_t begin =
-      rows_[row].line_begin + c.offset + ((c.size_and_flags & kQuoted) ? 1 : 0);
+  const std::size_t begin = rows_[row].line_begin + c.offset + ((c.size_and_flags & kQuoted) ? 1 : 0);
   return std::string_view(text_).substr(begin, c.size_and_flags & kSizeMask);
 }
 
@@ -150,10 +148,9 @@ void CsvTable::throw_bad_cell(std::size_t row, std::size_t col, const char* what
     double ignored = 0.0;
     if (parse_double(dotted, ignored)) hint = " (a decimal comma? read the file with ',' as the decimal separator)";
   }
-  throw InputError(
-      located_message(file_name_, line(row), static_cast<int>(col + 1),
-                      fmt::format("expected {} in column {}, found {}{}", what, column_label(col),
-                                  quote_for_message(s), hint)));
+  throw InputError(located_message(
+      file_name_, line(row), static_cast<int>(col + 1),
+      fmt::format("expected {} in column {}, found {}{}", what, column_label(col), quote_for_message(s), hint)));
 }
 
 double CsvTable::number(std::size_t row, std::size_t col, bool allow_missing) const {
@@ -304,7 +301,8 @@ char count_delimiter(std::string_view line, bool brackets, char decimal) {
   if (best >= 0) return kCandidates[best];
   const auto first = line.find_first_not_of(" \t");
   const auto last = line.find_last_not_of(" \t");
-  if (first != std::string_view::npos && line.substr(first, last - first + 1).find_first_of(" \t") != std::string_view::npos)
+  if (first != std::string_view::npos &&
+      line.substr(first, last - first + 1).find_first_of(" \t") != std::string_view::npos)
     return ' ';
   return ',';
 }
@@ -366,17 +364,17 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
     while (!preamble_.empty() && preamble_.back().first >= header_line_) preamble_.pop_back();
   };
   auto delimiter_of = [&](std::string_view content) {
-    return options.delimiter != kDetectDelimiter ? options.delimiter
-                                                 : count_delimiter(content, options.brackets_in_header, options.decimal);
+    return options.delimiter != kDetectDelimiter
+               ? options.delimiter
+               : count_delimiter(content, options.brackets_in_header, options.decimal);
   };
   // The delimiter for which `content` passes the header test, or '\0'.
   auto passing_delimiter = [&](std::string_view content) -> char {
     std::vector<std::string> trial;
     int f = 0;
     std::string why;
-    const std::vector<char> candidates = options.delimiter != kDetectDelimiter
-                                             ? std::vector<char>{options.delimiter}
-                                             : std::vector<char>{',', ';', '\t', ' '};
+    const std::vector<char> candidates = options.delimiter != kDetectDelimiter ? std::vector<char>{options.delimiter}
+                                                                               : std::vector<char>{',', ';', '\t', ' '};
     for (const char d : candidates) {
       if (d == ',' && options.decimal == ',') continue;
       if (split_names(content, d, options.brackets_in_header, trial, f, why) && options.header_test(trial)) return d;
@@ -394,9 +392,9 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
       ++line_no;
     }
     if (pos >= size)
-      throw InputError(located_message(file_name_, 0, 0,
-                                       fmt::format("the header line {} is past the end of the file ({} lines)",
-                                                   options.header_line, line_no)));
+      throw InputError(located_message(
+          file_name_, 0, 0,
+          fmt::format("the header line {} is past the end of the file ({} lines)", options.header_line, line_no)));
     const LineSpan l = line_at(text_, pos);
     const std::string_view content = without_comment_mark(text.substr(l.begin, l.end - l.begin), options.comment);
     accept(content, line_no + 1, delimiter_of(content));
@@ -491,14 +489,13 @@ void CsvTable::parse(const CsvOptions& options) {
   auto blank = [&](char c) { return whitespace ? is_space_or_tab(c) : is_blank(c, delim); };
 
   // Reserve for the data rows from the number of line ends.
-  const std::size_t n_lines_estimate =
-      static_cast<std::size_t>(std::count(text + pos, text + size, '\n')) + 1;
+  const std::size_t n_lines_estimate = static_cast<std::size_t>(std::count(text + pos, text + size, '\n')) + 1;
   bool width_known = options.has_header;
   if (width_known) {
     cells_.reserve(n_lines_estimate * n_columns_);
     rows_.reserve(n_lines_estimate);
   }
-  std::string unescaped;  // scratch for a quoted field with doubled quotes
+  std::string unescaped;                                         // scratch for a quoted field with doubled quotes
   std::vector<std::pair<std::size_t, std::string>> row_escaped;  // (field, text) of this row
 
   while (pos < size) {
@@ -538,8 +535,7 @@ void CsvTable::parse(const CsvOptions& options) {
         std::size_t close = 0;
         for (;;) {
           const char* quote =
-              q < line_end ? static_cast<const char*>(std::memchr(text + q, '"', line_end - q))
-                           : nullptr;
+              q < line_end ? static_cast<const char*>(std::memchr(text + q, '"', line_end - q)) : nullptr;
           if (!quote) {
             throw InputError(located_message(file_name_, line_int, static_cast<int>(field + 1),
                                              "unterminated quoted field (a quoted field must "
@@ -570,14 +566,13 @@ void CsvTable::parse(const CsvOptions& options) {
         if (!whitespace) {
           while (p < line_end && blank(text[p])) ++p;
           if (p < line_end && text[p] != delim) {
-            throw InputError(located_message(
-                file_name_, line_int, static_cast<int>(field + 1),
-                fmt::format("unexpected character '{}' after the closing quote", text[p])));
+            throw InputError(
+                located_message(file_name_, line_int, static_cast<int>(field + 1),
+                                fmt::format("unexpected character '{}' after the closing quote", text[p])));
           }
         } else if (p < line_end && !separator(text[p])) {
-          throw InputError(located_message(
-              file_name_, line_int, static_cast<int>(field + 1),
-              fmt::format("unexpected character '{}' after the closing quote", text[p])));
+          throw InputError(located_message(file_name_, line_int, static_cast<int>(field + 1),
+                                           fmt::format("unexpected character '{}' after the closing quote", text[p])));
         }
       } else {
         std::size_t field_end = line_end;
@@ -619,10 +614,9 @@ void CsvTable::parse(const CsvOptions& options) {
       cells_.reserve(n_lines_estimate * n_columns_);
       rows_.reserve(n_lines_estimate);
     } else if (n_fields != n_columns_) {
-      throw InputError(
-          located_message(file_name_, line_int, 0,
-                          fmt::format("expected {} fields (as in the {}), found {}", n_columns_,
-                                      options.has_header ? "header" : "first row", n_fields)));
+      throw InputError(located_message(file_name_, line_int, 0,
+                                       fmt::format("expected {} fields (as in the {}), found {}", n_columns_,
+                                                   options.has_header ? "header" : "first row", n_fields)));
     }
     const std::size_t row_index = rows_.size();
     for (auto& [f, value] : row_escaped) {
@@ -657,8 +651,8 @@ char CsvTable::detect_decimal() const {
 CsvTable read_csv_string(std::string text, const std::string& name, const CsvOptions& options) {
   if (options.delimiter == '"' || options.delimiter == '\n' || options.delimiter == '\r' ||
       (options.comment != '\0' && options.comment == options.delimiter) ||
-      (options.decimal != '.' && options.decimal != ',' && options.decimal != kDetectDecimal) || (options.decimal == ',' && options.delimiter == ',') ||
-      options.skip_lines < 0 || options.header_line < 0 ||
+      (options.decimal != '.' && options.decimal != ',' && options.decimal != kDetectDecimal) ||
+      (options.decimal == ',' && options.delimiter == ',') || options.skip_lines < 0 || options.header_line < 0 ||
       (options.header_line > 0 && options.header_line <= options.skip_lines)) {
     throw std::logic_error("read_csv: invalid delimiter/comment/decimal/skip_lines/header_line options");
   }
@@ -679,11 +673,9 @@ CsvTable read_csv(const std::string& path, const CsvOptions& options) {
   if (std::filesystem::is_directory(path, ec)) {
     throw InputError(located_message(path, 0, 0, "cannot open file (it is a directory)"));
   }
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                       &std::fclose);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!file) {
-    throw InputError(
-        located_message(path, 0, 0, fmt::format("cannot open file ({})", std::strerror(errno))));
+    throw InputError(located_message(path, 0, 0, fmt::format("cannot open file ({})", std::strerror(errno))));
   }
   std::string text;
   const auto size = std::filesystem::file_size(path, ec);
@@ -695,8 +687,7 @@ CsvTable read_csv(const std::string& path, const CsvOptions& options) {
     if (n < sizeof buffer) break;
   }
   if (std::ferror(file.get())) {
-    throw InputError(
-        located_message(path, 0, 0, fmt::format("cannot read file ({})", std::strerror(errno))));
+    throw InputError(located_message(path, 0, 0, fmt::format("cannot read file ({})", std::strerror(errno))));
   }
   return read_csv_string(std::move(text), path, options);
 }
@@ -779,8 +770,7 @@ CsvWriter& CsvWriter::add(std::string_view text) {
 void CsvWriter::end_row() {
   if (!in_row_) throw std::logic_error("CsvWriter: end_row() without begin_row()");
   if (n_in_row_ != n_columns_) {
-    throw std::logic_error(
-        fmt::format("CsvWriter: row has {} cells, header has {}", n_in_row_, n_columns_));
+    throw std::logic_error(fmt::format("CsvWriter: row has {} cells, header has {}", n_in_row_, n_columns_));
   }
   in_row_ = false;
   // A row of empty cells alone would read back as a blank line: quote its first cell.

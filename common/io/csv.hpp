@@ -134,8 +134,7 @@ class CsvTable {
   Eigen::VectorXd numbers(std::size_t col, bool allow_missing = false) const;
 
  private:
-  friend CsvTable read_csv_string(std::string text, const std::string& name,
-                                  const CsvOptions& options);
+  friend CsvTable read_csv_string(std::string text, const std::string& name, const CsvOptions& options);
 
   // A cell: offset of the field start from its line start, and the content size.
   // kQuoted: content starts one byte after the field start (the opening quote).

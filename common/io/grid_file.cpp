@@ -50,12 +50,15 @@ void GridReadOptions::validate() const {
     return false;
   };
   if (mapped({"X", "Y", "Z"}) && mapped({"x", "y", "z"}) && mapped({"u", "v", "w"}))
-    bad_option("columns", "reference positions (X, Y, Z), current positions (x, y, z) and displacements (u, v, w) "
-                          "all mapped; map two of them");
+    bad_option("columns",
+               "reference positions (X, Y, Z), current positions (x, y, z) and displacements (u, v, w) "
+               "all mapped; map two of them");
   if (format == MeasurementFormat::kPlain && positions != Positions::kAsFormat)
-    bad_option("positions", "applies to a measuring system's format; in the plain grid file the names say it "
-                            "(X, Y, Z reference, x, y, z current positions)");
-  if (!id_columns.empty() && columns.count("id")) bad_option("id_columns", "give the id columns once, not also as columns id=...");
+    bad_option("positions",
+               "applies to a measuring system's format; in the plain grid file the names say it "
+               "(X, Y, Z reference, x, y, z current positions)");
+  if (!id_columns.empty() && columns.count("id"))
+    bad_option("id_columns", "give the id columns once, not also as columns id=...");
   if (id_from_row && (!id_columns.empty() || columns.count("id")))
     bad_option("id_from_row", "the id is either the row number or taken from columns");
   for (const std::string& c : id_columns)
@@ -178,8 +181,10 @@ void GridFileWriter::add(std::string_view id, const Vec3& undeformed, const Vec3
   if (!impl_->with_ij) throw std::logic_error("GridFileWriter: this grid has no i, j columns");
   impl_->row(id, undeformed, deformed, extra);
   for (const long v : {i, j}) {
-    if (v == kNoGridIndex) impl_->csv.add(kNaN);
-    else impl_->csv.add(v);
+    if (v == kNoGridIndex)
+      impl_->csv.add(kNaN);
+    else
+      impl_->csv.add(v);
   }
   impl_->end(extra);
 }
@@ -193,8 +198,10 @@ void write_grid_file(const std::string& path, const GridData& grid, const GridWr
     for (Index p = 0; p < grid.n_points(); ++p) {
       const Vec3 X = grid.undeformed.row(p).transpose(), x = grid.deformed.row(p).transpose();
       const auto k = static_cast<std::size_t>(p);
-      if (grid.has_ij) w.add(grid.ids[k], X, x, grid.i[k], grid.j[k]);
-      else w.add(grid.ids[k], X, x);
+      if (grid.has_ij)
+        w.add(grid.ids[k], X, x, grid.i[k], grid.j[k]);
+      else
+        w.add(grid.ids[k], X, x);
     }
   });
 }

@@ -63,7 +63,7 @@
 namespace sf::io {
 
 // Every key a grid file's columns can stand for: id X Y Z x y z u v w i j sigma.
-inline constexpr std::array<std::string_view, 13> kGridColumnKeys = {"id", "X", "Y", "Z", "x", "y", "z",
+inline constexpr std::array<std::string_view, 13> kGridColumnKeys = {"id", "X", "Y", "Z", "x", "y",    "z",
                                                                      "u",  "v", "w", "i", "j", "sigma"};
 bool is_grid_column_key(std::string_view key);
 
@@ -116,8 +116,8 @@ struct GridData {
   Points3 undeformed;  // n x 3; a row of NaN where not digitised
   Points3 deformed;    // n x 3; a row of NaN where not digitised
   bool has_ij = false;
-  std::vector<long> i, j;          // grid row and column (n each) when has_ij; kNoGridIndex where empty
-  std::vector<std::string> where;  // "file:line" of each mark, for messages
+  std::vector<long> i, j;            // grid row and column (n each) when has_ij; kNoGridIndex where empty
+  std::vector<std::string> where;    // "file:line" of each mark, for messages
   std::vector<std::string> sources;  // the file(s) read
   // Uncertainty of each measured position (a standard deviation, in `units`), for fit
   // weights w = 1/sigma^2: n entries, or empty when the input gives none; NaN for a mark

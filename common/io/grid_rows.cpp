@@ -171,7 +171,8 @@ std::vector<Candidate> candidates(const FormatSpec& spec, const GridReadOptions&
   // Without duplicates, in order.
   std::vector<Candidate> unique;
   for (const Candidate& c : out) {
-    const bool seen = std::any_of(unique.begin(), unique.end(), [&](const Candidate& u) { return u.triples == c.triples; });
+    const bool seen =
+        std::any_of(unique.begin(), unique.end(), [&](const Candidate& u) { return u.triples == c.triples; });
     if (!seen) unique.push_back(c);
   }
   return unique;
@@ -297,9 +298,8 @@ std::string candidate_text(const Candidate& c) {
     if (!others.empty()) detail += " (or " + join(others, "; or ") + ")";
     detail += "; ";
   }
-  throw InputError(located_message(path, line, 0,
-                                   fmt::format("missing required column '{}' ({}found: {})", best.missing, detail,
-                                               join(h.names()))));
+  throw InputError(located_message(
+      path, line, 0, fmt::format("missing required column '{}' ({}found: {})", best.missing, detail, join(h.names()))));
 }
 
 // "# units: U" in the comment lines before the header (as the grid writer puts it).
@@ -320,8 +320,9 @@ std::string file_unit(const CsvTable& t) {
 
 // The factor from column `col`'s unit to the options' unit; nothing for a column in
 // pixels without a pixel size when `soft` (the caller then does without it).
-std::optional<double> scale_of(const CsvTable& t, const Header& h, std::size_t col, bool pixels, const std::string& unit_of_file,
-                               const GridReadOptions& o, bool soft, const std::string& lengths_of = "") {
+std::optional<double> scale_of(const CsvTable& t, const Header& h, std::size_t col, bool pixels,
+                               const std::string& unit_of_file, const GridReadOptions& o, bool soft,
+                               const std::string& lengths_of = "") {
   const NameAndUnit& nu = h.unit(col);
   std::string unit = nu.has_unit ? nu.unit : pixels ? "px" : unit_of_file;
   auto fail = [&](const std::string& what) -> double {
@@ -332,18 +333,20 @@ std::optional<double> scale_of(const CsvTable& t, const Header& h, std::size_t c
     // Taken to be in the options' unit, unless the format says it holds lengths (metric
     // coordinates of a calibrated system) and pixels are asked for.
     if (!lengths_of.empty() && is_pixel_unit(o.units))
-      return fail(fmt::format("holds lengths ({} writes calibrated coordinates), which cannot be read in pixels "
-                              "(--units {}); give the length unit of the calibration, e.g. --units mm",
-                              lengths_of, o.units));
+      return fail(
+          fmt::format("holds lengths ({} writes calibrated coordinates), which cannot be read in pixels "
+                      "(--units {}); give the length unit of the calibration, e.g. --units mm",
+                      lengths_of, o.units));
     return 1.0;
   }
   if (is_pixel_unit(unit)) {
     if (is_pixel_unit(o.units)) return 1.0;
     if (std::isfinite(o.pixel_size)) return o.pixel_size;
     if (soft) return std::nullopt;
-    return fail(fmt::format("is in image pixels; give the pixel size (gsa analyse --pixel-size, in {} per pixel) or "
-                            "read in pixels (--units px)",
-                            o.units));
+    return fail(
+        fmt::format("is in image pixels; give the pixel size (gsa analyse --pixel-size, in {} per pixel) or "
+                    "read in pixels (--units px)",
+                    o.units));
   }
   const auto mm = millimetres_per(unit);
   if (!mm) {
@@ -485,7 +488,8 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
   GridRows out;
   out.path = path;
   if (options.decimal == kDetectDecimal && t.decimal() == ',')
-    out.notes.push_back(path + ": numbers with a decimal comma (found in the data; --decimal point reads them otherwise)");
+    out.notes.push_back(path +
+                        ": numbers with a decimal comma (found in the data; --decimal point reads them otherwise)");
   const std::string unit_of_file = file_unit(t);
   // Scale of each position and displacement column.
   std::array<std::array<double, 3>, 3> scale{};
@@ -503,14 +507,16 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
   }
   double sigma_scale = 1.0;
   if (plan->sigma) {
-    const auto s = scale_of(t, h, *plan->sigma, spec.sigma_pixels && !h.unit(*plan->sigma).has_unit, unit_of_file, o, true);
+    const auto s =
+        scale_of(t, h, *plan->sigma, spec.sigma_pixels && !h.unit(*plan->sigma).has_unit, unit_of_file, o, true);
     if (s) {
       sigma_scale = *s;
       out.has_sigma = true;
     } else {
-      out.notes.push_back(fmt::format("{}: column '{}' (uncertainty) is in image pixels and no pixel size was given: "
-                                      "not read (--pixel-size converts it)",
-                                      path, h.name(*plan->sigma)));
+      out.notes.push_back(
+          fmt::format("{}: column '{}' (uncertainty) is in image pixels and no pixel size was given: "
+                      "not read (--pixel-size converts it)",
+                      path, h.name(*plan->sigma)));
     }
   }
   const auto& tri = plan->triples;
@@ -531,8 +537,7 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
                                     std::isfinite(o.pitch) ? "; reference positions from i, j and the pitch" : "",
                                     detected ? " (--format chooses another)" : ""));
   }
-  if (!converted.empty())
-    out.notes.push_back(fmt::format("{}: converted to {}: {}", path, o.units, join(converted)));
+  if (!converted.empty()) out.notes.push_back(fmt::format("{}: converted to {}: {}", path, o.units, join(converted)));
   if (plan->planar) out.notes.push_back(path + ": no out-of-plane columns: planar (2-D) data, Z = z = 0");
   if (plan->id.empty() && !o.id_from_row)
     out.notes.push_back(path + ": no id column: the marks are numbered by row (1, 2, ...)");
@@ -556,9 +561,9 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       for (std::size_t k = 0; k < plan->id.size(); ++k) {
         const std::string_view cell = t.cell(r, plan->id[k]);
         if (cell.empty())
-          throw InputError(located_message(t.file_name(), row.line, t.char_column(r, plan->id[k]),
-                                           plan->id.size() == 1 ? std::string("empty id")
-                                                                : "empty id cell in column '" + id_names[k] + "'"));
+          throw InputError(located_message(
+              t.file_name(), row.line, t.char_column(r, plan->id[k]),
+              plan->id.size() == 1 ? std::string("empty id") : "empty id cell in column '" + id_names[k] + "'"));
         if (k > 0) row.id += '_';
         row.id += cell;
       }
@@ -589,15 +594,17 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       }
       if (missing) v[tr].setConstant(kNaN);
     }
-    row.reference = tri[kReference] ? v[kReference]
+    row.reference = tri[kReference]                         ? v[kReference]
                     : (tri[kCurrent] && tri[kDisplacement]) ? Vec3(v[kCurrent] - v[kDisplacement])
                                                             : Vec3::Constant(kNaN);
-    row.current = tri[kCurrent] ? v[kCurrent] : (tri[kReference] && tri[kDisplacement]) ? Vec3(v[kReference] + v[kDisplacement])
-                                                                                       : Vec3::Constant(kNaN);
+    row.current = tri[kCurrent]                             ? v[kCurrent]
+                  : (tri[kReference] && tri[kDisplacement]) ? Vec3(v[kReference] + v[kDisplacement])
+                                                            : Vec3::Constant(kNaN);
     double sigma = plan->sigma ? t.number(r, *plan->sigma, /*allow_missing=*/true) : kNaN;
     // The format's rule for points it could not measure.
     switch (spec.invalid) {
-      case InvalidRule::kNone: break;
+      case InvalidRule::kNone:
+        break;
       case InvalidRule::kEmptyCells:
         row.flagged_reference = out.has_reference && !row.reference.allFinite();
         row.flagged_current = !row.current.allFinite();
@@ -622,8 +629,10 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       case InvalidRule::kDiceMatch: {
         bool failed = false;
         const double match = plan->match ? t.number(r, *plan->match, true) : kNaN;
-        if (!std::isnan(match)) failed = match != 0.0;
-        else if (plan->sigma) failed = sigma < 0;
+        if (!std::isnan(match))
+          failed = match != 0.0;
+        else if (plan->sigma)
+          failed = sigma < 0;
         if (failed) row.current.setConstant(kNaN);
         row.flagged_reference = out.has_reference && !row.reference.allFinite();
         row.flagged_current = !row.current.allFinite();
@@ -638,8 +647,9 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
     }
     if (std::isfinite(o.pitch)) {
       row.flagged_reference = false;
-      row.reference = row.i == kNoGridIndex ? Vec3::Constant(kNaN)
-                                            : Vec3(static_cast<double>(row.j) * o.pitch, static_cast<double>(row.i) * o.pitch, 0.0);
+      row.reference = row.i == kNoGridIndex
+                          ? Vec3::Constant(kNaN)
+                          : Vec3(static_cast<double>(row.j) * o.pitch, static_cast<double>(row.i) * o.pitch, 0.0);
     }
   }
   return out;

@@ -21,23 +21,23 @@ struct GridRow {
   std::string id;
   Vec3 reference = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  // X; NaN where unknown
   Vec3 current = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());    // x; NaN where unknown
-  bool flagged_reference = false;  // the format's rule marked the reference state not measured
-  bool flagged_current = false;    // ... the current state
+  bool flagged_reference = false;                           // the format's rule marked the reference state not measured
+  bool flagged_current = false;                             // ... the current state
   double sigma = std::numeric_limits<double>::quiet_NaN();  // in the options' unit
   long i = kNoGridIndex, j = kNoGridIndex;
-  int line = 0;        // line in the file
-  int id_column = 0;   // 1-based character column of the id's first field (0: row number)
-  std::string stage;   // the stage column's cell, when asked for
+  int line = 0;       // line in the file
+  int id_column = 0;  // 1-based character column of the id's first field (0: row number)
+  std::string stage;  // the stage column's cell, when asked for
 };
 
 struct GridRows {
   std::string path;
   std::vector<GridRow> rows;
   bool has_ij = false;
-  bool has_sigma = false;       // sigma values were read (and converted)
-  bool has_reference = false;   // the layout gives reference positions (or the pitch does)
+  bool has_sigma = false;         // sigma values were read (and converted)
+  bool has_reference = false;     // the layout gives reference positions (or the pitch does)
   bool has_displacement = false;  // the layout has displacement columns
-  std::string id_text;          // "id", "x_pic, y_pic" or "row number", for messages
+  std::string id_text;            // "id", "x_pic, y_pic" or "row number", for messages
   std::vector<std::string> notes;
 };
 

@@ -38,7 +38,8 @@ double time_of_value(const std::string& value) {
 
 bool stage_extension(const fs::path& p) {
   std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".csv" || ext == ".txt" || ext == ".tsv" || ext == ".dat";
 }
 
@@ -228,7 +229,7 @@ GridData GridSeries::stage_grid(std::size_t k) const {
   for (std::size_t p = 0; p < g.where.size(); ++p)
     if (g.where[p].empty()) g.where[p] = st.where[p];
   g.sources = sources.empty() || sources.front() == st.source ? std::vector<std::string>{st.source}
-                                                               : std::vector<std::string>{sources.front(), st.source};
+                                                              : std::vector<std::string>{sources.front(), st.source};
   g.sigma_undeformed = sigma_undeformed;
   g.sigma_deformed = st.sigma;
   if (!not_measured_undeformed.empty() || !st.not_measured.empty()) {
@@ -246,8 +247,7 @@ GridData GridSeries::stage_grid(std::size_t k) const {
 
 namespace detail {
 
-GridSeries build_series(const std::string& reference, const std::vector<std::string>& files,
-                        const GridReadOptions& o) {
+GridSeries build_series(const std::string& reference, const std::vector<std::string>& files, const GridReadOptions& o) {
   o.validate();
   if (std::isfinite(o.pitch) && !reference.empty())
     throw UsageError("the pitch gives the undeformed positions: give no reference (undeformed) file with it");
@@ -261,7 +261,8 @@ GridSeries build_series(const std::string& reference, const std::vector<std::str
     b.s.has_ij = rows.has_ij;
     b.any_sigma = rows.has_sigma;
     b.s.notes.insert(b.s.notes.end(), rows.notes.begin(), rows.notes.end());
-    for (const GridRow& row : rows.rows) b.set_undeformed(b.add(row.id), row.current, row.flagged_current, row, reference);
+    for (const GridRow& row : rows.rows)
+      b.set_undeformed(b.add(row.id), row.current, row.flagged_current, row, reference);
     reference_rows = rows.rows.size();
   }
   bool first_stage = true;
@@ -321,8 +322,8 @@ GridSeries read_grid_series(const std::string& reference, const std::vector<std:
   return detail::build_series(reference, files, options);
 }
 
-GridSeries read_grid_series_column(const std::string& path, const std::string& stage_column,
-                                   const GridReadOptions& o, const std::string& reference_stage) {
+GridSeries read_grid_series_column(const std::string& path, const std::string& stage_column, const GridReadOptions& o,
+                                   const std::string& reference_stage) {
   if (stage_column.empty()) throw UsageError("read_grid_series_column: no stage column given");
   detail::GridRows rows = detail::read_grid_rows(
       path, o, reference_stage.empty() ? detail::FileRole::kBothStates : detail::FileRole::kOneState, stage_column);
@@ -330,12 +331,13 @@ GridSeries read_grid_series_column(const std::string& path, const std::string& s
   std::vector<std::string> values;
   for (const auto& row : rows.rows)
     if (std::find(values.begin(), values.end(), row.stage) == values.end()) values.push_back(row.stage);
-  std::sort(values.begin(), values.end(), [](const std::string& a, const std::string& b) { return natural_less(a, b); });
+  std::sort(values.begin(), values.end(),
+            [](const std::string& a, const std::string& b) { return natural_less(a, b); });
   if (!reference_stage.empty() && std::find(values.begin(), values.end(), reference_stage) == values.end()) {
     std::string list;
     for (const auto& v : values) list += (list.empty() ? "" : ", ") + v;
-    throw InputError(located_message(path, 0, 0,
-                                     fmt::format("no rows of the reference stage '{}' (stages: {})", reference_stage, list)));
+    throw InputError(located_message(
+        path, 0, 0, fmt::format("no rows of the reference stage '{}' (stages: {})", reference_stage, list)));
   }
   Builder b;
   b.s.units = o.units;
@@ -383,8 +385,10 @@ GridSeries read_grid_series_column(const std::string& path, const std::string& s
     } else {
       p = b.add(row.id);
       const auto k = static_cast<std::size_t>(p);
-      if (!b.undeformed[k].allFinite() && row.reference.allFinite()) b.set_undeformed(p, row.reference, false, row, path);
-      else if (!b.undeformed[k].allFinite() && row.flagged_reference) b.flagged[k] = 1;
+      if (!b.undeformed[k].allFinite() && row.reference.allFinite())
+        b.set_undeformed(p, row.reference, false, row, path);
+      else if (!b.undeformed[k].allFinite() && row.flagged_reference)
+        b.flagged[k] = 1;
     }
     b.stages[stage_of.at(row.stage)].rows.emplace_back(p, std::move(row));
   }

@@ -42,19 +42,19 @@ struct GridStage {
   // file name ("surface-1_12.500 s" -> 12.5, as GOM names stage files), or a stage value
   // that is a number; NaN otherwise.
   double time = std::numeric_limits<double>::quiet_NaN();
-  std::string source;               // the file
-  Points3 deformed;                 // n x 3; NaN where absent or not measured
-  std::vector<std::string> where;   // n: "file:line" of the mark's row; empty where absent
+  std::string source;                      // the file
+  Points3 deformed;                        // n x 3; NaN where absent or not measured
+  std::vector<std::string> where;          // n: "file:line" of the mark's row; empty where absent
   std::vector<std::uint8_t> not_measured;  // n: 1 where the format flagged the mark; empty if none
-  std::vector<double> sigma;        // n: uncertainty (units), NaN where none; empty if none
+  std::vector<double> sigma;               // n: uncertainty (units), NaN where none; empty if none
 };
 
 struct GridSeries {
   std::vector<std::string> ids;
-  Points3 undeformed;               // n x 3; NaN where unknown
+  Points3 undeformed;  // n x 3; NaN where unknown
   bool has_ij = false;
-  std::vector<long> i, j;           // n each when has_ij; kNoGridIndex where empty
-  std::vector<std::string> where;   // n: "file:line" where the undeformed position was read
+  std::vector<long> i, j;                             // n each when has_ij; kNoGridIndex where empty
+  std::vector<std::string> where;                     // n: "file:line" where the undeformed position was read
   std::vector<std::uint8_t> not_measured_undeformed;  // n: 1 where flagged; empty if none
   std::vector<double> sigma_undeformed;               // n or empty
   std::string not_measured_rule;

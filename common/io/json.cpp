@@ -23,8 +23,7 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw InputError(
-        located_message(path, 0, 0, fmt::format("cannot open file ({})", std::strerror(errno))));
+    throw InputError(located_message(path, 0, 0, fmt::format("cannot open file ({})", std::strerror(errno))));
   }
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   try {

@@ -93,7 +93,8 @@ std::vector<FormatSpec> make_specs() {
   dice.sigma = {"SIGMA"};
   dice.sigma_pixels = true;
   dice.invalid = InvalidRule::kDiceMatch;
-  dice.invalid_text = "MATCH != 0, or without a MATCH column SIGMA < 0 (the subset centre stays the reference position)";
+  dice.invalid_text =
+      "MATCH != 0, or without a MATCH column SIGMA < 0 (the subset centre stays the reference position)";
   dice.planar = true;
   dice.brackets = false;
   specs.push_back(dice);

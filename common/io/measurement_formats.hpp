@@ -57,8 +57,8 @@ struct FormatLayout {
 
 struct FormatSpec {
   MeasurementFormat format = MeasurementFormat::kPlain;
-  std::string name;   // the --format value
-  std::string title;  // e.g. "Correlated Solutions VIC-3D CSV export"
+  std::string name;                           // the --format value
+  std::string title;                          // e.g. "Correlated Solutions VIC-3D CSV export"
   std::vector<FormatLayout> layouts;          // tried in order: the first found in the header is read
   std::vector<std::vector<std::string>> ids;  // id column sets, tried in order
   std::vector<std::string> sigma;             // uncertainty column names, tried in order

@@ -222,8 +222,8 @@ void read_binary(const std::string& bytes, const std::string& name, TriangleMesh
         const std::size_t byte = at + 12 + 12 * static_cast<std::size_t>(k) + 4 * static_cast<std::size_t>(i);
         const double c = read_f32(bytes, byte);
         if (!std::isfinite(c))
-          throw InputError(byte_message(name, byte, "vertex coordinate of facet " + std::to_string(f + 1) +
-                                                        " is not finite"));
+          throw InputError(
+              byte_message(name, byte, "vertex coordinate of facet " + std::to_string(f + 1) + " is not finite"));
         v[k][i] = c;
       }
     builder.add_facet(v);
@@ -258,11 +258,10 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& name) {
       bytes.size() == kHeaderBytes + 4 + kFacetBytes * static_cast<std::size_t>(read_u32(bytes, kHeaderBytes));
   std::size_t first = 0;
   while (first < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[first]))) ++first;
-  const bool starts_solid = bytes.size() >= first + 5 && std::equal(bytes.begin() + static_cast<long>(first),
-                                                                    bytes.begin() + static_cast<long>(first) + 5,
-                                                                    "solid", [](char a, char b) {
-                                                                      return std::tolower(static_cast<unsigned char>(a)) == b;
-                                                                    });
+  const bool starts_solid =
+      bytes.size() >= first + 5 &&
+      std::equal(bytes.begin() + static_cast<long>(first), bytes.begin() + static_cast<long>(first) + 5, "solid",
+                 [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; });
   if (sized_as_binary) {
     read_binary(bytes, name, mesh);
   } else if (starts_solid) {
@@ -270,8 +269,9 @@ TriangleMesh read_stl_bytes(const std::string& bytes, const std::string& name) {
   } else if (bytes.size() >= kHeaderBytes + 4) {
     read_binary(bytes, name, mesh);  // reports the size mismatch
   } else {
-    throw InputError(byte_message(name, 0, "not an STL file: neither ASCII (starting with 'solid') nor binary (" +
-                                               std::to_string(bytes.size()) + " bytes, fewer than the 84 of a header)"));
+    throw InputError(byte_message(name, 0,
+                                  "not an STL file: neither ASCII (starting with 'solid') nor binary (" +
+                                      std::to_string(bytes.size()) + " bytes, fewer than the 84 of a header)"));
   }
   if (mesh.triangles.empty())
     throw InputError(name + ": no facet of positive area (" + std::to_string(mesh.dropped_degenerate) +

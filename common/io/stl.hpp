@@ -34,11 +34,11 @@
 namespace sf::io {
 
 struct TriangleMesh {
-  Points3 vertices;                            // n_vertices x 3, welded
+  Points3 vertices;                             // n_vertices x 3, welded
   std::vector<std::array<Index, 3>> triangles;  // vertex indices, counter-clockwise from outside
-  bool binary = false;                         // how the file was written
-  std::string name;                            // ASCII: the first solid's name; binary: the header, trimmed
-  Index dropped_degenerate = 0;                // facets of zero area left out
+  bool binary = false;                          // how the file was written
+  std::string name;                             // ASCII: the first solid's name; binary: the header, trimmed
+  Index dropped_degenerate = 0;                 // facets of zero area left out
 };
 
 // Reads an ASCII or binary STL file. Throws sf::InputError (see header) when the file

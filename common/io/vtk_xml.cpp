@@ -41,14 +41,22 @@ namespace fs = std::filesystem;
 
 int n_cell_nodes(CellType type) {
   switch (type) {
-    case CellType::kVertex: return 1;
-    case CellType::kLine: return 2;
-    case CellType::kTriangle: return 3;
-    case CellType::kPolygon: return 0;
-    case CellType::kQuad: return 4;
-    case CellType::kTetra: return 4;
-    case CellType::kHexahedron: return 8;
-    case CellType::kWedge: return 6;
+    case CellType::kVertex:
+      return 1;
+    case CellType::kLine:
+      return 2;
+    case CellType::kTriangle:
+      return 3;
+    case CellType::kPolygon:
+      return 0;
+    case CellType::kQuad:
+      return 4;
+    case CellType::kTetra:
+      return 4;
+    case CellType::kHexahedron:
+      return 8;
+    case CellType::kWedge:
+      return 6;
   }
   return -1;
 }
@@ -60,12 +68,10 @@ std::string check_node_count(CellType type, std::size_t n_nodes) {
   const int expected = n_cell_nodes(type);
   if (expected < 0) return fmt::format("unsupported VTK cell type {}", static_cast<int>(type));
   if (expected == 0) {
-    return n_nodes >= 3 ? std::string()
-                        : fmt::format("a polygon needs >= 3 nodes, has {}", n_nodes);
+    return n_nodes >= 3 ? std::string() : fmt::format("a polygon needs >= 3 nodes, has {}", n_nodes);
   }
   if (n_nodes != static_cast<std::size_t>(expected)) {
-    return fmt::format("VTK cell type {} needs {} nodes, has {}", static_cast<int>(type), expected,
-                       n_nodes);
+    return fmt::format("VTK cell type {} needs {} nodes, has {}", static_cast<int>(type), expected, n_nodes);
   }
   return {};
 }
@@ -135,22 +141,20 @@ void check_fields(const std::vector<FieldArray>& fields, std::size_t n_tuples, c
       throw std::logic_error(fmt::format("VTK {}: field '{}' appears twice", where, f.name));
     }
     if (f.n_components < 1) {
-      throw std::logic_error(
-          fmt::format("VTK {}: field '{}' has {} components", where, f.name, f.n_components));
+      throw std::logic_error(fmt::format("VTK {}: field '{}' has {} components", where, f.name, f.n_components));
     }
     const std::size_t expected = n_tuples * static_cast<std::size_t>(f.n_components);
     if (f.values.size() != expected) {
-      throw std::logic_error(
-          fmt::format("VTK {}: field '{}' has {} values, expected {} ({} tuples x {} components)",
-                      where, f.name, f.values.size(), expected, n_tuples, f.n_components));
+      throw std::logic_error(fmt::format("VTK {}: field '{}' has {} values, expected {} ({} tuples x {} components)",
+                                         where, f.name, f.values.size(), expected, n_tuples, f.n_components));
     }
   }
 }
 
 void check_index(Index i, Index n_points, const char* what, std::size_t cell) {
   if (i < 0 || i >= n_points) {
-    throw std::logic_error(fmt::format("VTK mesh: {} {} refers to point {}, but there are {}", what,
-                                       cell, i, n_points));
+    throw std::logic_error(
+        fmt::format("VTK mesh: {} {} refers to point {}, but there are {}", what, cell, i, n_points));
   }
 }
 
@@ -159,8 +163,7 @@ vtkSmartPointer<vtkPoints> make_points(const Points3& p) {
   coords->SetNumberOfComponents(3);
   coords->SetNumberOfTuples(p.rows());
   if (p.size() > 0) {
-    std::memcpy(coords->GetPointer(0), p.data(),
-                sizeof(double) * static_cast<std::size_t>(p.size()));
+    std::memcpy(coords->GetPointer(0), p.data(), sizeof(double) * static_cast<std::size_t>(p.size()));
   }
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToDouble();
@@ -181,8 +184,8 @@ void add_fields(vtkDataSetAttributes* attributes, const std::vector<FieldArray>&
   }
 }
 
-vtkSmartPointer<vtkCellArray> make_cells(const std::vector<std::vector<Index>>& cells,
-                                         Index n_points, std::size_t min_nodes, const char* what) {
+vtkSmartPointer<vtkCellArray> make_cells(const std::vector<std::vector<Index>>& cells, Index n_points,
+                                         std::size_t min_nodes, const char* what) {
   vtkNew<vtkIdTypeArray> offsets;
   vtkNew<vtkIdTypeArray> connectivity;
   offsets->SetNumberOfTuples(static_cast<vtkIdType>(cells.size() + 1));
@@ -190,8 +193,8 @@ vtkSmartPointer<vtkCellArray> make_cells(const std::vector<std::vector<Index>>& 
   offsets->SetValue(0, 0);
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (cells[c].size() < min_nodes) {
-      throw std::logic_error(fmt::format("VTK mesh: {} {} has {} points, needs >= {}", what, c,
-                                         cells[c].size(), min_nodes));
+      throw std::logic_error(
+          fmt::format("VTK mesh: {} {} has {} points, needs >= {}", what, c, cells[c].size(), min_nodes));
     }
     total += static_cast<vtkIdType>(cells[c].size());
     offsets->SetValue(static_cast<vtkIdType>(c + 1), total);
@@ -254,9 +257,8 @@ void check_readable(const std::string& path) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
     throw InputError(located_message(path, 0, 0,
-                                     fs::exists(path, ec)
-                                         ? "cannot open file (not a regular file)"
-                                         : "cannot open file (No such file or directory)"));
+                                     fs::exists(path, ec) ? "cannot open file (not a regular file)"
+                                                          : "cannot open file (No such file or directory)"));
   }
 }
 
@@ -355,9 +357,9 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOp
   const std::size_t n_cells = mesh.n_cells();
   if (mesh.offsets.size() != n_cells + 1 || mesh.offsets.front() != 0 ||
       mesh.offsets.back() != static_cast<Index>(mesh.connectivity.size())) {
-    throw std::logic_error(fmt::format(
-        "VTK volume mesh: {} cell types, {} offsets (expected n_cells + 1, from 0 to {})", n_cells,
-        mesh.offsets.size(), mesh.connectivity.size()));
+    throw std::logic_error(
+        fmt::format("VTK volume mesh: {} cell types, {} offsets (expected n_cells + 1, from 0 to {})", n_cells,
+                    mesh.offsets.size(), mesh.connectivity.size()));
   }
   check_fields(mesh.point_data, static_cast<std::size_t>(n_points), "point data");
   check_fields(mesh.cell_data, n_cells, "cell data");
@@ -370,10 +372,8 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOp
   for (std::size_t c = 0; c < n_cells; ++c) {
     const Index begin = mesh.offsets[c];
     const Index end = mesh.offsets[c + 1];
-    if (end < begin)
-      throw std::logic_error(fmt::format("VTK volume mesh: offsets decrease at cell {}", c));
-    const std::string why =
-        check_node_count(mesh.cell_types[c], static_cast<std::size_t>(end - begin));
+    if (end < begin) throw std::logic_error(fmt::format("VTK volume mesh: offsets decrease at cell {}", c));
+    const std::string why = check_node_count(mesh.cell_types[c], static_cast<std::size_t>(end - begin));
     if (!why.empty()) throw std::logic_error(fmt::format("VTK volume mesh: cell {}: {}", c, why));
     types->SetValue(static_cast<vtkIdType>(c), static_cast<unsigned char>(mesh.cell_types[c]));
     offsets->SetValue(static_cast<vtkIdType>(c + 1), static_cast<vtkIdType>(end));
@@ -402,8 +402,7 @@ void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOp
   run_writer(writer, path);
 }
 
-void write_pvd(const std::string& path,
-               const std::vector<std::pair<double, std::string>>& time_and_relative_file) {
+void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& time_and_relative_file) {
   std::vector<PvdDataSet> sets;
   for (const auto& [time, file] : time_and_relative_file) sets.push_back({time, file, 0});
   write_pvd(path, sets);
@@ -444,8 +443,7 @@ PolyMesh read_vtp(const std::string& path) {
   mesh.point_data = read_fields(poly->GetPointData());
   mesh.cell_data = read_fields(poly->GetCellData());
   if (mesh.vertices.size() != static_cast<std::size_t>(poly->GetNumberOfVerts())) {
-    throw InputError(
-        located_message(path, 0, 0, "poly-vertex cells (several points) are not supported"));
+    throw InputError(located_message(path, 0, 0, "poly-vertex cells (several points) are not supported"));
   }
   return mesh;
 }

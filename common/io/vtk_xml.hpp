@@ -20,9 +20,7 @@ struct FieldArray {
   int n_components = 1;        // >= 1
   std::vector<double> values;  // n_tuples * n_components, tuple-major
 
-  std::size_t n_tuples() const {
-    return n_components > 0 ? values.size() / static_cast<std::size_t>(n_components) : 0;
-  }
+  std::size_t n_tuples() const { return n_components > 0 ? values.size() / static_cast<std::size_t>(n_components) : 0; }
 };
 
 // A surface: points with vertex, line and polygon cells (0-based point indices).
@@ -83,12 +81,10 @@ struct VtkWriteOptions {
 // error and throws std::logic_error naming the field or cell. A failing writer throws
 // sf::Error naming the path.
 void write_vtp(const std::string& path, const PolyMesh& mesh, const VtkWriteOptions& options = {});
-void write_vtu(const std::string& path, const VolumeMesh& mesh,
-               const VtkWriteOptions& options = {});
+void write_vtu(const std::string& path, const VolumeMesh& mesh, const VtkWriteOptions& options = {});
 
 // A ParaView collection: (time, file relative to the .pvd) per step, in the order given.
-void write_pvd(const std::string& path,
-               const std::vector<std::pair<double, std::string>>& time_and_relative_file);
+void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& time_and_relative_file);
 // The same with several data sets per time step: each its part number (ParaView shows
 // the parts of one time together, e.g. the plies, the tools and the contact points).
 struct PvdDataSet {

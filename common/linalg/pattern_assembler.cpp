@@ -231,8 +231,8 @@ bool PatternAssembler::flush() {
 
 std::size_t PatternAssembler::memory_bytes() const {
   std::size_t bytes = static_cast<std::size_t>(matrix_.nonZeros()) * (sizeof(double) + sizeof(int)) +
-                      static_cast<std::size_t>(matrix_.outerSize() + 1) * sizeof(int) +
-                      index_.size() * sizeof(Index) + active_dofs_.size() * sizeof(Index);
+                      static_cast<std::size_t>(matrix_.outerSize() + 1) * sizeof(int) + index_.size() * sizeof(Index) +
+                      active_dofs_.size() * sizeof(Index);
   for (const Element& el : elements_)
     bytes += el.pos.size() * sizeof(int) + el.slot.size() * (2 * sizeof(int) + sizeof(double)) +
              el.unknowns.size() * sizeof(Index) + el.first_of_slot.size() * sizeof(int);

@@ -113,7 +113,7 @@ class PatternAssembler {
   std::vector<Index> active_dofs_, index_;
   std::vector<Element> elements_;
   std::vector<std::vector<Index>> colours_;
-  std::vector<std::pair<Index, Index>> extra_;                    // merged entries beyond the elements' pattern
+  std::vector<std::pair<Index, Index>> extra_;                       // merged entries beyond the elements' pattern
   std::vector<std::pair<std::pair<Index, Index>, double>> pending_;  // kept aside by add()
   SparseMatrix matrix_;
   int generation_ = 0;

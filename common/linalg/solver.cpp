@@ -98,19 +98,18 @@ class CholmodBackend final : public Backend {
     if (llt_.info() == Eigen::Success) return {};
     const int status = llt_.cholmod().status;
     if (status < CHOLMOD_OK) {
-      return {Status::kFailed,
-              fmt::format("CHOLMOD numeric factorisation failed (status {}{})", status,
-                          status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "")};
+      return {Status::kFailed, fmt::format("CHOLMOD numeric factorisation failed (status {}{})", status,
+                                           status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "")};
     }
     const cholmod_factor* f = llt_.factor();
     if (ldlt_)
       return {Status::kSingular, fmt::format("zero pivot in LDL^T at {} of {} in elimination order (singular, or "
-                                             "needs pivoting)", f->minor + 1, f->n)};
-    return {Status::kSingular,
-            fmt::format("matrix is not positive definite: Cholesky broke down at pivot {} of {} "
-                        "in elimination order; a symmetric indefinite matrix needs "
-                        "MatrixProperty::kSymmetricIndefinite",
-                        f->minor + 1, f->n)};
+                                             "needs pivoting)",
+                                             f->minor + 1, f->n)};
+    return {Status::kSingular, fmt::format("matrix is not positive definite: Cholesky broke down at pivot {} of {} "
+                                           "in elimination order; a symmetric indefinite matrix needs "
+                                           "MatrixProperty::kSymmetricIndefinite",
+                                           f->minor + 1, f->n)};
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
@@ -145,9 +144,8 @@ class UmfpackBackend final : public Backend {
     if (code == UMFPACK_WARNING_singular_matrix) {
       return {Status::kSingular, "matrix is singular: UMFPACK found a zero pivot"};
     }
-    return {Status::kFailed,
-            fmt::format("UMFPACK numeric factorisation failed (status {}{})", code,
-                        code == UMFPACK_ERROR_out_of_memory ? ", out of memory" : "")};
+    return {Status::kFailed, fmt::format("UMFPACK numeric factorisation failed (status {}{})", code,
+                                         code == UMFPACK_ERROR_out_of_memory ? ", out of memory" : "")};
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
@@ -172,8 +170,7 @@ class EigenLdltBackend final : public Backend {
   Outcome factorize(const SparseMatrix& a) override {
     ldlt_.factorize(a);
     if (ldlt_.info() == Eigen::Success) return {};
-    return {Status::kSingular,
-            "zero pivot in LDL^T: matrix is singular or needs pivoting, try umfpack"};
+    return {Status::kSingular, "zero pivot in LDL^T: matrix is singular or needs pivoting, try umfpack"};
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
@@ -280,8 +277,7 @@ SolverKind parse_solver_kind(const std::string& name, const std::string& where) 
     expected += expected.empty() ? "" : ", ";
     expected += named.name;
   }
-  std::string message =
-      fmt::format("unknown linear solver '{}' (expected one of: {})", name, expected);
+  std::string message = fmt::format("unknown linear solver '{}' (expected one of: {})", name, expected);
   if (!where.empty()) message = where + ": " + message;
   throw InputError(message);
 }
@@ -337,11 +333,9 @@ std::string to_string(SolveReport::Status status) {
 }
 
 std::string SolveReport::brief() const {
-  std::string out =
-      fmt::format("{} n={} nnz={}: {}", to_string(used), n_rows, n_nonzeros, to_string(status));
+  std::string out = fmt::format("{} n={} nnz={}: {}", to_string(used), n_rows, n_nonzeros, to_string(status));
   if (!message.empty()) out += " (" + message + ")";
-  out += reused_analysis ? fmt::format("; analysis reused")
-                         : fmt::format("; analyse {:.3g} s", analyze_seconds);
+  out += reused_analysis ? fmt::format("; analysis reused") : fmt::format("; analyse {:.3g} s", analyze_seconds);
   out += fmt::format(", factor {:.3g} s, solve {:.3g} s", factor_seconds, solve_seconds);
   return out;
 }
@@ -385,8 +379,7 @@ struct LinearSolver::Impl {
   }
 };
 
-LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property)
-    : impl_(std::make_unique<Impl>()) {
+LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property) : impl_(std::make_unique<Impl>()) {
   const bool needs_symmetry = reads_lower_triangle(kind);
   if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
     throw InputError(

@@ -36,8 +36,8 @@ using Traits = CGAL::Search_traits_adapter<Sample, SamplePointMap, BaseTraits>;
 using KnnSearch = CGAL::Orthogonal_k_neighbor_search<Traits>;
 using Tree = KnnSearch::Tree;
 
-constexpr double kTrustRadius = 0.5;   // largest Newton step in xi
-constexpr int kMaxHalvings = 60;       // backtracking cuts per iteration (0.5 * 2^-60 < any tol)
+constexpr double kTrustRadius = 0.5;  // largest Newton step in xi
+constexpr int kMaxHalvings = 60;      // backtracking cuts per iteration (0.5 * 2^-60 < any tol)
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -165,8 +165,7 @@ std::vector<Index> locality_order(const Eigen::Ref<const Points3>& points) {
     std::uint64_t code = 0;
     if (p.allFinite()) {
       const Vec3 q = ((p - lo) * scale).cwiseMax(0.0);
-      code = spread(static_cast<std::uint64_t>(q.x())) |
-             spread(static_cast<std::uint64_t>(q.y())) << 1 |
+      code = spread(static_cast<std::uint64_t>(q.x())) | spread(static_cast<std::uint64_t>(q.y())) << 1 |
              spread(static_cast<std::uint64_t>(q.z())) << 2;
     }
     keyed[static_cast<std::size_t>(i)] = {code, i};
@@ -231,8 +230,7 @@ bool SurfaceProjector::Impl::newton(const Vec3& p, State& s, int& iterations) co
     ++iterations;
     // Components on a bound with the gradient pushing outward stay fixed (sliding).
     bool fixed[2];
-    for (int i = 0; i < 2; ++i)
-      fixed[i] = (s.xi[i] <= 0.0 && s.g[i] > 0.0) || (s.xi[i] >= 1.0 && s.g[i] < 0.0);
+    for (int i = 0; i < 2; ++i) fixed[i] = (s.xi[i] <= 0.0 && s.g[i] > 0.0) || (s.xi[i] >= 1.0 && s.g[i] < 0.0);
     Mat2 gn;
     gn(0, 0) = s.ev.x1.squaredNorm();
     gn(1, 1) = s.ev.x2.squaredNorm();
@@ -319,7 +317,7 @@ int SurfaceProjector::Impl::exit_edge(const State& s, double p_scale) const {
 }
 
 SurfaceProjector::Impl::WalkResult SurfaceProjector::Impl::walk(const Vec3& p, Index element,
-                                                               const Vec2& xi_start) const {
+                                                                const Vec2& xi_start) const {
   WalkResult w;
   const double p_scale = p.cwiseAbs().maxCoeff();
   State& s = w.state;
@@ -422,8 +420,7 @@ Projection SurfaceProjector::Impl::project(const Vec3& p) const {
     const Index e = cand[c].first;
     if (std::find(ended, ended + n_ended, e) != ended + n_ended) continue;
     const ElementData& el = elements[e];
-    const double bound2 =
-        (el.lo - p).cwiseMax(0.0).cwiseMax(p - el.hi).squaredNorm();  // lower bound of distance^2
+    const double bound2 = (el.lo - p).cwiseMax(0.0).cwiseMax(p - el.hi).squaredNorm();  // lower bound of distance^2
     if (bound2 >= best.state.f) continue;
     WalkResult w = walk(p, e, sample_xi(cand[c].second));
     ended[n_ended++] = w.state.element;
@@ -436,8 +433,7 @@ Projection SurfaceProjector::Impl::project(const Vec3& p) const {
 
 void ProjectionOptions::validate() const {
   auto fail = [](const char* option, const char* expected, const std::string& found) {
-    throw InputError(std::string("ProjectionOptions.") + option + ": expected " + expected +
-                     ", found " + found);
+    throw InputError(std::string("ProjectionOptions.") + option + ": expected " + expected + ", found " + found);
   };
   if (candidates < 1) fail("candidates", "an integer >= 1", std::to_string(candidates));
   if (samples_per_edge < 1 || samples_per_edge > 64)
@@ -453,10 +449,14 @@ void ProjectionOptions::validate() const {
 
 const char* to_string(Projection::Status status) {
   switch (status) {
-    case Projection::Status::kConverged: return "converged";
-    case Projection::Status::kOnFreeEdge: return "on_free_edge";
-    case Projection::Status::kNotConverged: return "not_converged";
-    case Projection::Status::kFailed: return "failed";
+    case Projection::Status::kConverged:
+      return "converged";
+    case Projection::Status::kOnFreeEdge:
+      return "on_free_edge";
+    case Projection::Status::kNotConverged:
+      return "not_converged";
+    case Projection::Status::kFailed:
+      return "failed";
   }
   return "unknown";
 }
@@ -468,8 +468,7 @@ std::string Projection::brief() const {
   return buf;
 }
 
-SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh,
-                                   const Eigen::Ref<const MatX>& parameters,
+SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh, const Eigen::Ref<const MatX>& parameters,
                                    ProjectionOptions options) {
   options.validate();
   if (parameters.rows() != mesh.n_dofs() || parameters.cols() != 3)
@@ -483,9 +482,9 @@ SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh,
 
   // Hermite -> Bernstein: H_i = sum_j M(i, j) B_j.
   Eigen::Matrix4d m;
-  m << 1, 1, 0, 0,  //
+  m << 1, 1, 0, 0,         //
       0, 1.0 / 3.0, 0, 0,  //
-      0, 0, 1, 1,  //
+      0, 0, 1, 1,          //
       0, 0, -1.0 / 3.0, 0;
   std::map<Index, Index> fan_of_apex;
   for (Index e = 0; e < n_el; ++e) {
@@ -516,8 +515,10 @@ SurfaceProjector::SurfaceProjector(const SurfaceMesh& mesh,
       impl->fans[el.fan].push_back(e);
     }
     if (!(el.lo.allFinite() && el.hi.allFinite()))
-      throw InputError("SurfaceProjector: parameters: expected finite values, found a non-finite "
-                       "value in element " + std::to_string(e));
+      throw InputError(
+          "SurfaceProjector: parameters: expected finite values, found a non-finite "
+          "value in element " +
+          std::to_string(e));
   }
 
   // kd-tree of sample points.
@@ -577,12 +578,10 @@ void for_each_point(Index n, const std::vector<Index>& order, int threads, const
 
 }  // namespace
 
-std::vector<Projection> SurfaceProjector::project_all(
-    const Eigen::Ref<const Points3>& points) const {
+std::vector<Projection> SurfaceProjector::project_all(const Eigen::Ref<const Points3>& points) const {
   std::vector<Projection> out(static_cast<std::size_t>(points.rows()));
-  for_each_point(points.rows(), locality_order(points), impl_->options.threads, [&](Index i) {
-    out[static_cast<std::size_t>(i)] = impl_->project(points.row(i).transpose());
-  });
+  for_each_point(points.rows(), locality_order(points), impl_->options.threads,
+                 [&](Index i) { out[static_cast<std::size_t>(i)] = impl_->project(points.row(i).transpose()); });
   return out;
 }
 
@@ -595,8 +594,8 @@ std::vector<Projection> SurfaceProjector::refine_all(const Eigen::Ref<const Poin
                      " start xi");
   std::vector<Projection> out(elements.size());
   for_each_point(points.rows(), locality_order(points), impl_->options.threads, [&](Index i) {
-    out[static_cast<std::size_t>(i)] = refine(points.row(i).transpose(), elements[static_cast<std::size_t>(i)],
-                                              xi_start[static_cast<std::size_t>(i)]);
+    out[static_cast<std::size_t>(i)] =
+        refine(points.row(i).transpose(), elements[static_cast<std::size_t>(i)], xi_start[static_cast<std::size_t>(i)]);
   });
   return out;
 }

@@ -65,11 +65,11 @@
 namespace sf::mesh {
 
 struct ProjectionOptions {
-  int candidates = 8;          // nearest kd-tree samples queried per point (>= 1)
-  int samples_per_edge = 6;    // kd-tree samples per element: samples x samples (>= 1)
-  int max_iterations = 30;     // Newton iterations per candidate, over all hops (>= 1)
+  int candidates = 8;           // nearest kd-tree samples queried per point (>= 1)
+  int samples_per_edge = 6;     // kd-tree samples per element: samples x samples (>= 1)
+  int max_iterations = 30;      // Newton iterations per candidate, over all hops (>= 1)
   double xi_tolerance = 1e-10;  // convergence: xi step below this (> 0, < 0.1)
-  int threads = 0;             // project_all(): 0 = std::thread::hardware_concurrency()
+  int threads = 0;              // project_all(): 0 = std::thread::hardware_concurrency()
 
   // Throws sf::InputError naming the option, what was expected and what was found.
   void validate() const;
@@ -84,12 +84,12 @@ struct Projection {
     kFailed,        // no result: non-finite input, empty mesh, element out of range
   };
 
-  Index element = -1;          // element of the closest point (-1 when kFailed)
-  Vec2 xi = Vec2::Zero();      // its xi in [0,1]^2
-  Vec3 point = Vec3::Zero();   // the closest point x(element, xi)
+  Index element = -1;                                         // element of the closest point (-1 when kFailed)
+  Vec2 xi = Vec2::Zero();                                     // its xi in [0,1]^2
+  Vec3 point = Vec3::Zero();                                  // the closest point x(element, xi)
   double distance = std::numeric_limits<double>::infinity();  // |p - point|; infinity when kFailed
   Status status = Status::kFailed;
-  int iterations = 0;          // Newton iterations of the run that produced the result
+  int iterations = 0;  // Newton iterations of the run that produced the result
 
   bool ok() const { return status == Status::kConverged || status == Status::kOnFreeEdge; }
   // One line, e.g. "converged e=12 xi=(0.25,0.5) d=0.0123 it=3".
@@ -102,8 +102,7 @@ class SurfaceProjector {
  public:
   // `parameters`: n_dofs x 3 nodal parameters of the surface (usually mesh.geometry()).
   // Throws sf::InputError on a shape mismatch or invalid options.
-  SurfaceProjector(const SurfaceMesh& mesh, const Eigen::Ref<const MatX>& parameters,
-                   ProjectionOptions options = {});
+  SurfaceProjector(const SurfaceMesh& mesh, const Eigen::Ref<const MatX>& parameters, ProjectionOptions options = {});
 
   // Closest point of the surface to p.
   Projection project(const Vec3& p) const;

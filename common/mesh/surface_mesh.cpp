@@ -15,19 +15,27 @@ namespace sf::mesh {
 
 std::array<int, 2> edge_local_nodes(int edge) {
   switch (edge) {
-    case 0: return {0, 1};
-    case 1: return {1, 3};
-    case 2: return {2, 3};
-    default: return {0, 2};
+    case 0:
+      return {0, 1};
+    case 1:
+      return {1, 3};
+    case 2:
+      return {2, 3};
+    default:
+      return {0, 2};
   }
 }
 
 Vec2 edge_point(int edge, double t) {
   switch (edge) {
-    case 0: return {t, 0.0};
-    case 1: return {1.0, t};
-    case 2: return {t, 1.0};
-    default: return {0.0, t};
+    case 0:
+      return {t, 0.0};
+    case 1:
+      return {1.0, t};
+    case 2:
+      return {t, 1.0};
+    default:
+      return {0.0, t};
   }
 }
 
@@ -48,8 +56,7 @@ Index SurfaceMesh::add_nodes(Index count) {
 
 Index SurfaceMesh::add_element(const Element& element) {
   for (Index n : element.nodes)
-    if (n < 0 || n >= n_nodes_)
-      throw std::invalid_argument("SurfaceMesh::add_element: node index out of range");
+    if (n < 0 || n >= n_nodes_) throw std::invalid_argument("SurfaceMesh::add_element: node index out of range");
   if (element.shape == ElementShape::kCollapsed && element.nodes[0] != element.nodes[1])
     throw std::invalid_argument("SurfaceMesh::add_element: collapsed element needs nodes[0] == nodes[1]");
   elements_.push_back(element);
@@ -217,8 +224,9 @@ std::vector<double> breaks_or_uniform(const std::vector<double>& b, double len, 
     for (int i = 0; i + 1 < n; ++i) {
       const double w0 = b[i + 1] - b[i], w1 = b[i + 2] - b[i + 1];
       if (std::max(w0, w1) > 7.0 * std::min(w0, w1))
-        throw std::invalid_argument("make_rectangle_mesh: adjacent element widths differ by more than 7x "
-                                    "(the arc-length parameterisation would fold); grade more gently");
+        throw std::invalid_argument(
+            "make_rectangle_mesh: adjacent element widths differ by more than 7x "
+            "(the arc-length parameterisation would fold); grade more gently");
     }
     return b;
   }
@@ -228,8 +236,8 @@ std::vector<double> breaks_or_uniform(const std::vector<double>& b, double len, 
 }
 }  // namespace
 
-SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& a2, double length1,
-                                double length2, int n1, int n2, const std::vector<double>& breaks1,
+SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& a2, double length1, double length2,
+                                int n1, int n2, const std::vector<double>& breaks1,
                                 const std::vector<double>& breaks2) {
   check_frame(a1, a2);
   if (n1 < 1 || n2 < 1 || !(length1 > 0) || !(length2 > 0))
@@ -257,8 +265,8 @@ SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& 
   return mesh;
 }
 
-SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, double radius,
-                           int n_rings, int n_sectors) {
+SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, double radius, int n_rings,
+                           int n_sectors) {
   check_frame(a1, a2);
   if (n_rings < 1 || n_sectors < 3 || !(radius > 0))
     throw std::invalid_argument("make_disk_mesh: need radius > 0, n_rings >= 1, n_sectors >= 3");
@@ -299,8 +307,8 @@ SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, d
     for (int j = 0; j < n_sectors; ++j) {
       Element el;
       el.nodes = {id(i, j), id(i, j + 1), id(i + 1, j), id(i + 1, j + 1)};
-      el.scale = {{{i * dr * dtheta, dr}, {i * dr * dtheta, dr}, {(i + 1) * dr * dtheta, dr},
-                   {(i + 1) * dr * dtheta, dr}}};
+      el.scale = {
+          {{i * dr * dtheta, dr}, {i * dr * dtheta, dr}, {(i + 1) * dr * dtheta, dr}, {(i + 1) * dr * dtheta, dr}}};
       mesh.add_element(el);
     }
   mesh.build_topology();

@@ -103,8 +103,8 @@ class SurfaceMesh {
   // The element's parameter map (depends on scale factors and shape).
   ElementMap element_map(Index e) const;
   // u_e (16 x n_components) of any field stored like geometry() (n_dofs x n_components).
-  Eigen::Matrix<double, kElementParams, Eigen::Dynamic> element_parameters(
-      Index e, const Eigen::Ref<const MatX>& field) const;
+  Eigen::Matrix<double, kElementParams, Eigen::Dynamic> element_parameters(Index e,
+                                                                           const Eigen::Ref<const MatX>& field) const;
 
   // Topology: call after adding elements (the generators do).
   void build_topology();
@@ -144,16 +144,15 @@ Vec2 edge_point(int edge, double t);
 // t in [0, L2] (a1, a2 orthonormal), n1 x n2 elements; optional graded breakpoints
 // s1 (n1+1 ascending values from 0 to L1) and s2; adjacent widths may differ by at
 // most 7x (std::invalid_argument otherwise). Arc-length parameters exact.
-SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& a2, double length1,
-                                double length2, int n1, int n2,
-                                const std::vector<double>& breaks1 = {},
+SurfaceMesh make_rectangle_mesh(const Vec3& origin, const Vec3& a1, const Vec3& a2, double length1, double length2,
+                                int n1, int n2, const std::vector<double>& breaks1 = {},
                                 const std::vector<double>& breaks2 = {});
 
 // Structured mesh of a flat disk (centre, radius, in the plane of orthonormal a1, a2):
 // n_rings rings of n_sectors elements; the innermost ring is collapsed elements
 // with the apex at the centre. xi1 runs around (anticlockwise about a1 x a2), xi2 outwards.
-SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, double radius,
-                           int n_rings, int n_sectors);
+SurfaceMesh make_disk_mesh(const Vec3& centre, const Vec3& a1, const Vec3& a2, double radius, int n_rings,
+                           int n_sectors);
 
 }  // namespace sf::mesh
 

@@ -192,7 +192,8 @@ SurfaceClosestPoint TriangleSurface::closest(const Vec3& x) const {
   // Beyond a boundary edge or vertex of an open surface: no contact.
   bool boundary = false;
   if (tp.feature == F::kEdge) boundary = m.free_edge[static_cast<std::size_t>(t)][static_cast<std::size_t>(tp.which)];
-  if (tp.feature == F::kVertex) boundary = m.free_vertex[static_cast<std::size_t>(tri[static_cast<std::size_t>(tp.which)])];
+  if (tp.feature == F::kVertex)
+    boundary = m.free_vertex[static_cast<std::size_t>(tri[static_cast<std::size_t>(tp.which)])];
   if (boundary && out.distance > 0.0) out.in_front = std::abs(out.gap) >= kFrontCos * out.distance;
   return out;
 }

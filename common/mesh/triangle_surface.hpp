@@ -41,10 +41,10 @@ struct SurfaceClosestPoint {
   Vec3 point = Vec3::Zero();        // p
   Vec3 barycentric = Vec3::Zero();  // b
   Vec3 facet_normal = Vec3::Zero();
-  Vec3 normal = Vec3::Zero();       // smoothed n
-  double gap = 0.0;                 // (x - p) . n
-  double distance = 0.0;            // |x - p|
-  Vec3 gap_gradient = Vec3::Zero();  // d gap / dx
+  Vec3 normal = Vec3::Zero();           // smoothed n
+  double gap = 0.0;                     // (x - p) . n
+  double distance = 0.0;                // |x - p|
+  Vec3 gap_gradient = Vec3::Zero();     // d gap / dx
   Mat3 normal_gradient = Mat3::Zero();  // d n / dx (not symmetric in general)
   bool in_front = true;
 };

@@ -226,9 +226,8 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
 
   // Frame, ticks and labels.
   const double lw = std::max(1.0, 1.3 * f);
-  scene.shapes.push_back(line({{plot[0], plot[1]}, {plot[2], plot[1]}, {plot[2], plot[3]}, {plot[0], plot[3]},
-                               {plot[0], plot[1]}},
-                              kInk, lw));
+  scene.shapes.push_back(line(
+      {{plot[0], plot[1]}, {plot[2], plot[1]}, {plot[2], plot[3]}, {plot[0], plot[3]}, {plot[0], plot[1]}}, kInk, lw));
   const double tick = 6 * f;
   for (double t : xt) {
     const Vec2 p = px(t, y0);
@@ -242,8 +241,7 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
   }
   scene.texts.push_back({chart.x_label, Vec2((plot[0] + plot[2]) / 2, plot[1] - tick - 3 * f - tick_font * 1.3 - 8 * f),
                          label_font, kInk, 0, 1, false, 0});
-  scene.texts.push_back({chart.y_label,
-                         Vec2(plot[0] - tick - 4 * f - ytick_w - 12 * f, (plot[1] + plot[3]) / 2),
+  scene.texts.push_back({chart.y_label, Vec2(plot[0] - tick - 4 * f - ytick_w - 12 * f, (plot[1] + plot[3]) / 2),
                          label_font, kInk, 0, -1, false, 90});  // justified in the text's own frame
   write_png(scene, size, path);
   return cf;

@@ -44,7 +44,7 @@ struct Chart {
 struct ChartFraming {
   int width = 0, height = 0;
   double x_min = 0, x_max = 1, y_min = 0, y_max = 1;  // the axes' data range
-  std::array<double, 4> plot_px{};  // plot area x0, y0, x1, y1; origin bottom left
+  std::array<double, 4> plot_px{};                    // plot area x0, y0, x1, y1; origin bottom left
   // Pixel position, origin top left, y down (as RgbImage).
   Vec2 to_pixel(double x, double y) const;
 };

@@ -70,8 +70,7 @@ double nice_step(double raw, int* decimals) {
 }  // namespace
 
 Colour colour_at(ColourMap map, double t) {
-  return map == ColourMap::kViridis ? interpolate(kViridisStops, t)
-                                    : interpolate(kDivergingStops, t);
+  return map == ColourMap::kViridis ? interpolate(kViridisStops, t) : interpolate(kDivergingStops, t);
 }
 
 Bands nice_bands(double lo, double hi, int target, bool symmetric) {

@@ -61,8 +61,7 @@ std::string find_on_path(const std::string& program) {
     if (dir.empty()) dir = ".";
     const std::string candidate = dir + "/" + program;
     struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
-        ::access(candidate.c_str(), X_OK) == 0)
+    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
       return candidate;
   }
   return {};
@@ -103,16 +102,15 @@ struct StartedServer {
 // Starts Xvfb and waits until it accepts connections. Throws sf::Error on failure.
 StartedServer start_xvfb(const std::string& xvfb) {
   int fds[2];
-  if (::pipe(fds) != 0)
-    throw Error(std::string("cannot draw pictures: pipe() failed: ") + std::strerror(errno));
+  if (::pipe(fds) != 0) throw Error(std::string("cannot draw pictures: pipe() failed: ") + std::strerror(errno));
   // Xvfb's messages go to an anonymous temporary file, read back only to explain a failure.
   char log_name[] = "/tmp/sf-xvfb-log-XXXXXX";
   const int log_fd = ::mkstemp(log_name);
   if (log_fd >= 0) ::unlink(log_name);
 
   const std::string fd_text = std::to_string(fds[1]);
-  std::vector<std::string> args = {xvfb,     "-displayfd", fd_text, "-screen",   "0",
-                                   "1280x1024x24", "-nolisten", "tcp", "-noreset"};
+  std::vector<std::string> args = {xvfb,           "-displayfd", fd_text, "-screen", "0",
+                                   "1280x1024x24", "-nolisten",  "tcp",   "-noreset"};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -153,15 +151,13 @@ StartedServer start_xvfb(const std::string& xvfb) {
     if (log_fd >= 0) ::close(log_fd);
     stop_server(pid);
     throw Error("cannot draw pictures: no X display (DISPLAY is " +
-                std::string(std::getenv("DISPLAY") ? "not usable" : "not set") + ") and " + xvfb +
-                " " + why + (tail.empty() ? "" : " (it said: " + tail + ")") + "; " + kWhatToDo);
+                std::string(std::getenv("DISPLAY") ? "not usable" : "not set") + ") and " + xvfb + " " + why +
+                (tail.empty() ? "" : " (it said: " + tail + ")") + "; " + kWhatToDo);
   };
 
   // Read the display number Xvfb writes when it is ready ("99\n").
   const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   std::string number_text;
   while (number_text.find('\n') == std::string::npos) {
     if (elapsed() > kStartTimeoutSeconds) fail("did not start within 15 s");
@@ -177,8 +173,7 @@ StartedServer start_xvfb(const std::string& xvfb) {
         int status = 0;
         ::waitpid(pid, &status, 0);
         const bool not_run = WIFEXITED(status) && WEXITSTATUS(status) == 127;
-        fail(not_run ? "could not be run"
-                     : "exited before it was ready (status " + std::to_string(status) + ")");
+        fail(not_run ? "could not be run" : "exited before it was ready (status " + std::to_string(status) + ")");
       }
     }
   }
@@ -227,8 +222,7 @@ DisplayGuard::DisplayGuard() {
   const std::string xvfb = find_on_path("Xvfb");
   if (xvfb.empty())
     throw Error(std::string("cannot draw pictures: no X display (DISPLAY is ") +
-                (current ? "'" + previous_display_ + "', which does not accept connections"
-                         : std::string("not set")) +
+                (current ? "'" + previous_display_ + "', which does not accept connections" : std::string("not set")) +
                 ") and Xvfb was not found on PATH; " + kWhatToDo);
   const StartedServer s = start_xvfb(xvfb);
   server_pid_ = s.pid;

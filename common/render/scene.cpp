@@ -45,7 +45,7 @@ namespace sf::render {
 
 namespace {
 
-constexpr int kSupersample = 2;      // render at twice the size and average
+constexpr int kSupersample = 2;       // render at twice the size and average
 constexpr int kMaxRenderSide = 4096;  // ... unless that exceeds this many pixels
 const Colour kDark{0.15, 0.15, 0.15};
 const Colour kNanColour{0.72, 0.72, 0.72};
@@ -53,9 +53,7 @@ const Colour kNanColour{0.72, 0.72, 0.72};
 // ---------------------------------------------------------------------------------------
 // Sizes relative to a 1200 x 900 picture.
 
-double font_scale(const ImageSize& s) {
-  return std::max(0.25, std::min(s.width / 1200.0, s.height / 900.0));
-}
+double font_scale(const ImageSize& s) { return std::max(0.25, std::min(s.width / 1200.0, s.height / 900.0)); }
 double font_px(double base, double f) { return std::max(8.0, std::round(base * f)); }
 
 struct Fonts {
@@ -132,8 +130,7 @@ double panel_width(const Scene& scene, const ImageSize& size, const Fonts& ft) {
     double labels = 0;
     for (const auto& l : edge_labels(c->bands)) labels = std::max(labels, text_extent(l, ft.panel)[0]);
     need = std::max(need, ft.bar_width + 14 * ft.f + labels);
-    need = std::max(need, std::min(text_extent(c->title, ft.panel_title, true)[0],
-                                   0.3 * size.width));
+    need = std::max(need, std::min(text_extent(c->title, ft.panel_title, true)[0], 0.3 * size.width));
     if (any_nan(c->values)) need = std::max(need, 30 * ft.f + text_extent("no value", ft.panel)[0]);
   }
   if (!scene.legend.empty()) {
@@ -178,10 +175,18 @@ ViewFrame view_frame(const Scene& scene) {
       if (d.z() < 0 || (d.z() == 0 && (d.y() < 0 || (d.y() == 0 && d.x() < 0)))) d = -d;
       break;
     }
-    case ViewKind::kTop: d = Vec3::UnitZ(); break;
-    case ViewKind::kFront: d = -Vec3::UnitY(); break;
-    case ViewKind::kSide: d = Vec3::UnitX(); break;
-    case ViewKind::kIso: d = Vec3(1, -1, 1).normalized(); break;
+    case ViewKind::kTop:
+      d = Vec3::UnitZ();
+      break;
+    case ViewKind::kFront:
+      d = -Vec3::UnitY();
+      break;
+    case ViewKind::kSide:
+      d = Vec3::UnitX();
+      break;
+    case ViewKind::kIso:
+      d = Vec3(1, -1, 1).normalized();
+      break;
     case ViewKind::kDirection:
       d = scene.view.direction.norm() > 0 ? scene.view.direction.normalized() : Vec3::UnitZ();
       break;
@@ -219,9 +224,7 @@ struct PolyBuilder {
     const unsigned char rgba[4] = {to8(c.r), to8(c.g), to8(c.b), to8(opacity)};
     colours->InsertNextTypedTuple(rgba);
   }
-  static unsigned char to8(double v) {
-    return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
-  }
+  static unsigned char to8(double v) { return static_cast<unsigned char>(std::lround(std::clamp(v, 0.0, 1.0) * 255)); }
   vtkSmartPointer<vtkPolyData> data(bool with_colours) {
     auto pd = vtkSmartPointer<vtkPolyData>::New();
     pd->SetPoints(points);
@@ -244,8 +247,7 @@ void stroke(PolyBuilder& b, const Shape2D& s) {
   };
   auto dot = [&](const Vec2& c) {
     std::vector<Vec2> pts;
-    for (int k = 0; k < 8; ++k)
-      pts.emplace_back(c + w / 2 * Vec2(std::cos(k * kPi / 4), std::sin(k * kPi / 4)));
+    for (int k = 0; k < 8; ++k) pts.emplace_back(c + w / 2 * Vec2(std::cos(k * kPi / 4), std::sin(k * kPi / 4)));
     b.polygon(pts, s.colour, s.opacity);
   };
   const double period = 2 * s.dash_px;
@@ -279,9 +281,8 @@ void fill_overlay(PolyBuilder& b, const Shape2D& s) {
 }
 
 // A flat arrow (or segment) in the plane facing the eye.
-void glyph_polygons(PolyBuilder& b, const Vec3& tail, const Vec3& head, bool arrow, double width,
-                    double head_length, double head_width, const Vec3& toward_eye, const Vec3& lift,
-                    const Colour& c) {
+void glyph_polygons(PolyBuilder& b, const Vec3& tail, const Vec3& head, bool arrow, double width, double head_length,
+                    double head_width, const Vec3& toward_eye, const Vec3& lift, const Colour& c) {
   const Vec3 d = head - tail;
   const double len = d.norm();
   if (len <= 1e-12 || !d.allFinite()) return;
@@ -291,8 +292,7 @@ void glyph_polygons(PolyBuilder& b, const Vec3& tail, const Vec3& head, bool arr
   side.normalize();
   const Vec3 t = tail + lift, h = head + lift;
   if (!arrow) {
-    b.polygon(std::vector<Vec3>{t - side * width / 2, h - side * width / 2, h + side * width / 2,
-                                t + side * width / 2},
+    b.polygon(std::vector<Vec3>{t - side * width / 2, h - side * width / 2, h + side * width / 2, t + side * width / 2},
               c, 1.0);
     return;
   }
@@ -300,15 +300,15 @@ void glyph_polygons(PolyBuilder& b, const Vec3& tail, const Vec3& head, bool arr
   const double hw = head_width * hl / head_length;
   const Vec3 base = h - u * hl;
   if (len - hl > 1e-12)
-    b.polygon(std::vector<Vec3>{t - side * width / 2, base - side * width / 2,
-                                base + side * width / 2, t + side * width / 2},
-              c, 1.0);
+    b.polygon(
+        std::vector<Vec3>{t - side * width / 2, base - side * width / 2, base + side * width / 2, t + side * width / 2},
+        c, 1.0);
   b.polygon(std::vector<Vec3>{base - side * hw / 2, h, base + side * hw / 2}, c, 1.0);
 }
 
 // The same arrow in pixels (legend).
-void arrow_2d(PolyBuilder& b, const Vec2& tail, const Vec2& head, double width, double head_length,
-              double head_width, const Colour& c) {
+void arrow_2d(PolyBuilder& b, const Vec2& tail, const Vec2& head, double width, double head_length, double head_width,
+              const Colour& c) {
   const Vec2 d = head - tail;
   const double len = d.norm();
   if (len <= 1e-9) return;
@@ -316,8 +316,7 @@ void arrow_2d(PolyBuilder& b, const Vec2& tail, const Vec2& head, double width, 
   const double hl = std::min(head_length, 0.6 * len);
   const double hw = head_width * hl / head_length;
   const Vec2 base = head - u * hl;
-  b.polygon(std::vector<Vec2>{tail - n * width / 2, base - n * width / 2, base + n * width / 2,
-                              tail + n * width / 2},
+  b.polygon(std::vector<Vec2>{tail - n * width / 2, base - n * width / 2, base + n * width / 2, tail + n * width / 2},
             c, 1.0);
   b.polygon(std::vector<Vec2>{base - n * hw / 2, head, base + n * hw / 2}, c, 1.0);
 }
@@ -333,18 +332,17 @@ void check_surface(const Surface& s, std::size_t which) {
                                   " has a polygon with fewer than 3 points");
     for (Index i : poly)
       if (i < 0 || i >= n)
-        throw std::invalid_argument("render: surface " + std::to_string(which) +
-                                    ": point index " + std::to_string(i) + " out of range");
+        throw std::invalid_argument("render: surface " + std::to_string(which) + ": point index " + std::to_string(i) +
+                                    " out of range");
   }
   for (const auto& line : s.lines)
     for (Index i : line)
       if (i < 0 || i >= n)
-        throw std::invalid_argument("render: surface " + std::to_string(which) +
-                                    ": line point index out of range");
+        throw std::invalid_argument("render: surface " + std::to_string(which) + ": line point index out of range");
   if (s.colouring && static_cast<Index>(s.colouring->values.size()) != n)
     throw std::invalid_argument("render: surface " + std::to_string(which) + ": " +
-                                std::to_string(s.colouring->values.size()) + " values for " +
-                                std::to_string(n) + " points");
+                                std::to_string(s.colouring->values.size()) + " values for " + std::to_string(n) +
+                                " points");
 }
 
 vtkSmartPointer<vtkPoints> to_vtk_points(const Points3& p) {
@@ -365,8 +363,7 @@ vtkSmartPointer<vtkCellArray> to_vtk_cells(const std::vector<std::vector<Index>>
   return ca;
 }
 
-vtkSmartPointer<vtkActor> line_actor(vtkAlgorithmOutput* port, vtkPolyData* data, const Colour& c,
-                                     double width) {
+vtkSmartPointer<vtkActor> line_actor(vtkAlgorithmOutput* port, vtkPolyData* data, const Colour& c, double width) {
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
   if (port)
     mapper->SetInputConnection(port);
@@ -392,8 +389,7 @@ void add_surface(vtkRenderer* ren, const Surface& s, double f, std::vector<vtkSm
     auto values = vtkSmartPointer<vtkDoubleArray>::New();
     values->SetName("values");
     values->SetNumberOfValues(static_cast<vtkIdType>(c.values.size()));
-    for (std::size_t i = 0; i < c.values.size(); ++i)
-      values->SetValue(static_cast<vtkIdType>(i), c.values[i]);
+    for (std::size_t i = 0; i < c.values.size(); ++i) values->SetValue(static_cast<vtkIdType>(i), c.values[i]);
     pd->GetPointData()->SetScalars(values);
     auto lut = vtkSmartPointer<vtkLookupTable>::New();
     const int n = c.banded ? std::max(1, c.bands.n_bands) : 256;
@@ -419,9 +415,9 @@ void add_surface(vtkRenderer* ren, const Surface& s, double f, std::vector<vtkSm
   // normals are smooth across element edges and the outline is the true boundary.
   double bounds[6];
   pd->GetBounds(bounds);
-  const double diag = std::sqrt((bounds[1] - bounds[0]) * (bounds[1] - bounds[0]) +
-                                (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) +
-                                (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
+  const double diag =
+      std::sqrt((bounds[1] - bounds[0]) * (bounds[1] - bounds[0]) + (bounds[3] - bounds[2]) * (bounds[3] - bounds[2]) +
+                (bounds[5] - bounds[4]) * (bounds[5] - bounds[4]));
   auto clean = vtkSmartPointer<vtkCleanPolyData>::New();
   clean->SetInputData(pd);
   clean->PointMergingOn();
@@ -469,8 +465,7 @@ void add_surface(vtkRenderer* ren, const Surface& s, double f, std::vector<vtkSm
     const auto& v = s.colouring->values;
     std::vector<std::vector<Index>> valid;
     for (const auto& poly : s.polygons)
-      if (std::all_of(poly.begin(), poly.end(), [&](Index i) { return std::isfinite(v[i]); }))
-        valid.push_back(poly);
+      if (std::all_of(poly.begin(), poly.end(), [&](Index i) { return std::isfinite(v[i]); })) valid.push_back(poly);
     auto cp = vtkSmartPointer<vtkPolyData>::New();
     cp->SetPoints(pd->GetPoints());
     cp->SetPolys(to_vtk_cells(valid));
@@ -482,8 +477,7 @@ void add_surface(vtkRenderer* ren, const Surface& s, double f, std::vector<vtkSm
     contour->ComputeScalarsOff();
     contour->ComputeNormalsOff();
     keep.push_back(contour);
-    ren->AddActor(line_actor(contour->GetOutputPort(), nullptr, Colour{0.2, 0.2, 0.2},
-                             std::max(1.0, 1.2 * f)));
+    ren->AddActor(line_actor(contour->GetOutputPort(), nullptr, Colour{0.2, 0.2, 0.2}, std::max(1.0, 1.2 * f)));
   }
   if (s.outline && !s.polygons.empty()) {
     auto edges = vtkSmartPointer<vtkFeatureEdges>::New();
@@ -494,8 +488,7 @@ void add_surface(vtkRenderer* ren, const Surface& s, double f, std::vector<vtkSm
     edges->ManifoldEdgesOff();
     edges->ColoringOff();
     keep.push_back(edges);
-    ren->AddActor(line_actor(edges->GetOutputPort(), nullptr, Colour{0.25, 0.25, 0.25},
-                             std::max(1.0, 1.5 * f)));
+    ren->AddActor(line_actor(edges->GetOutputPort(), nullptr, Colour{0.25, 0.25, 0.25}, std::max(1.0, 1.5 * f)));
   }
 }
 
@@ -508,8 +501,7 @@ void configure_text(vtkTextProperty* p, const Text2D& t) {
   p->SetShadow(0);
   p->SetOrientation(t.angle_deg);
   p->SetJustification(t.halign < 0 ? VTK_TEXT_LEFT : t.halign == 0 ? VTK_TEXT_CENTERED : VTK_TEXT_RIGHT);
-  p->SetVerticalJustification(t.valign < 0 ? VTK_TEXT_BOTTOM
-                                           : t.valign == 0 ? VTK_TEXT_CENTERED : VTK_TEXT_TOP);
+  p->SetVerticalJustification(t.valign < 0 ? VTK_TEXT_BOTTOM : t.valign == 0 ? VTK_TEXT_CENTERED : VTK_TEXT_TOP);
 }
 
 // Everything the renderer adds in 2-D: title band, colour bar, legend.
@@ -531,8 +523,8 @@ ResolvedGlyph resolve_glyph(const GlyphSet& g, double part_size) {
   return r;
 }
 
-void draw_colour_bar(Overlay& o, const ScalarColouring& c, const Fonts& ft, double x0, double top,
-                     double bottom, double panel_w) {
+void draw_colour_bar(Overlay& o, const ScalarColouring& c, const Fonts& ft, double x0, double top, double bottom,
+                     double panel_w) {
   const auto lines = bar_title_lines(c, panel_w - ft.pad, ft.panel_title);
   double y = top;
   for (const auto& l : lines) {
@@ -580,15 +572,13 @@ void draw_colour_bar(Overlay& o, const ScalarColouring& c, const Fonts& ft, doub
   }
   if (nan) {
     const double s = 16 * ft.f, yb = bar_bottom - 24 * ft.f - s;
-    o.shapes.polygon(std::vector<Vec2>{{x0, yb}, {x0 + s, yb}, {x0 + s, yb + s}, {x0, yb + s}},
-                     kNanColour, 1.0);
+    o.shapes.polygon(std::vector<Vec2>{{x0, yb}, {x0 + s, yb}, {x0 + s, yb + s}, {x0, yb + s}}, kNanColour, 1.0);
     o.texts.push_back({"no value", Vec2(x0 + s + 8 * ft.f, yb + s / 2), ft.panel, kDark, -1, 0, false, 0});
   }
 }
 
-double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, double top,
-                   double panel_w, double pixels_per_unit,
-                   const std::vector<ResolvedGlyph>& glyphs) {
+double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, double top, double panel_w,
+                   double pixels_per_unit, const std::vector<ResolvedGlyph>& glyphs) {
   double y = top;
   if (!scene.legend_title.empty()) {
     o.texts.push_back({scene.legend_title, Vec2(x0, y), ft.panel_title, kDark, -1, 1, true, 0});
@@ -602,9 +592,9 @@ double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, d
     switch (e.kind) {
       case LegendEntry::Kind::kSwatch: {
         const double s = 16 * ft.f;
-        o.shapes.polygon(std::vector<Vec2>{{x0, yc - s / 2}, {x0 + s, yc - s / 2}, {x0 + s, yc + s / 2},
-                                           {x0, yc + s / 2}},
-                         e.colour, 1.0);
+        o.shapes.polygon(
+            std::vector<Vec2>{{x0, yc - s / 2}, {x0 + s, yc - s / 2}, {x0 + s, yc + s / 2}, {x0, yc + s / 2}}, e.colour,
+            1.0);
         break;
       }
       case LegendEntry::Kind::kLine: {
@@ -620,8 +610,7 @@ double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, d
       case LegendEntry::Kind::kDot: {
         std::vector<Vec2> pts;
         for (int k = 0; k < 16; ++k)
-          pts.emplace_back(Vec2(x0 + sym / 2, yc) +
-                           e.width_px * Vec2(std::cos(k * kPi / 8), std::sin(k * kPi / 8)));
+          pts.emplace_back(Vec2(x0 + sym / 2, yc) + e.width_px * Vec2(std::cos(k * kPi / 8), std::sin(k * kPi / 8)));
         o.shapes.polygon(pts, e.colour, 1.0);
         break;
       }
@@ -641,8 +630,7 @@ double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, d
           y -= row * 0.8;
           text_x = x0;
         } else {
-          arrow_2d(o.shapes, Vec2(x0 + (sym - len) / 2, yc), Vec2(x0 + (sym + len) / 2, yc), w, hl,
-                   hw, e.colour);
+          arrow_2d(o.shapes, Vec2(x0 + (sym - len) / 2, yc), Vec2(x0 + (sym + len) / 2, yc), w, hl, hw, e.colour);
         }
         break;
       }
@@ -657,9 +645,7 @@ double draw_legend(Overlay& o, const Scene& scene, const Fonts& ft, double x0, d
   return y;
 }
 
-std::string temp_path_for(const std::string& path) {
-  return path + ".tmp-" + std::to_string(::getpid()) + ".png";
-}
+std::string temp_path_for(const std::string& path) { return path + ".tmp-" + std::to_string(::getpid()) + ".png"; }
 
 }  // namespace
 
@@ -676,8 +662,7 @@ Layout layout_of(const Scene& scene, const ImageSize& size) {
   const auto foot = footnote_lines(scene, size, ft);
   l.footnote_band = foot.empty() ? 0 : ft.footnote * (1.0 + 1.3 * static_cast<double>(foot.size()));
   l.panel_left = size.width - panel_width(scene, size, ft);
-  l.frame = {ft.pad, l.footnote_band + ft.pad, l.panel_left - ft.pad,
-             size.height - l.title_band - ft.pad / 2};
+  l.frame = {ft.pad, l.footnote_band + ft.pad, l.panel_left - ft.pad, size.height - l.title_band - ft.pad / 2};
   if (scene.frame_px) l.frame = *scene.frame_px;
   return l;
 }
@@ -764,8 +749,8 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
       resolved.push_back(rg);
       PolyBuilder b;
       for (std::size_t i = 0; i < g.tails.size(); ++i)
-        glyph_polygons(b, g.tails[i], g.heads[i], g.kind == GlyphSet::Kind::kArrow, rg.width,
-                       rg.head_length, rg.head_width, vf.toward_eye, vf.toward_eye * rg.lift, g.colour);
+        glyph_polygons(b, g.tails[i], g.heads[i], g.kind == GlyphSet::Kind::kArrow, rg.width, rg.head_length,
+                       rg.head_width, vf.toward_eye, vf.toward_eye * rg.lift, g.colour);
       auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
       mapper->SetInputData(b.data(false));
       mapper->ScalarVisibilityOff();
@@ -785,8 +770,8 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
     y_title -= ft.title * 1.3;
   }
   if (!scene.subtitle.empty())
-    o.texts.push_back({scene.subtitle, Vec2(size.width / 2.0, y_title), ft.subtitle,
-                       Colour{0.3, 0.3, 0.3}, 0, 1, false, 0});
+    o.texts.push_back(
+        {scene.subtitle, Vec2(size.width / 2.0, y_title), ft.subtitle, Colour{0.3, 0.3, 0.3}, 0, 1, false, 0});
   {
     const auto foot = footnote_lines(scene, size, ft);
     for (std::size_t i = 0; i < foot.size(); ++i)
@@ -801,8 +786,7 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
     if (!scene.legend.empty()) {
       top = draw_legend(o, scene, ft, x0, top, panel_w, framing.pixels_per_unit, resolved) - ft.pad;
     }
-    if (const ScalarColouring* c = colour_bar_field(scene))
-      draw_colour_bar(o, *c, ft, x0, top, bottom, panel_w);
+    if (const ScalarColouring* c = colour_bar_field(scene)) draw_colour_bar(o, *c, ft, x0, top, bottom, panel_w);
   }
   for (const Shape2D& s : scene.shapes) fill_overlay(o.shapes, s);
   for (const Text2D& t : scene.texts) o.texts.push_back(t);
@@ -867,8 +851,7 @@ Scene scaled_overlay(const Scene& scene, double k) {
 }  // namespace
 
 Framing write_png(const Scene& scene, const ImageSize& size, const std::string& path) {
-  if (size.width < 16 || size.height < 16)
-    throw std::invalid_argument("render: image size too small");
+  if (size.width < 16 || size.height < 16) throw std::invalid_argument("render: image size too small");
   for (std::size_t i = 0; i < scene.surfaces.size(); ++i) check_surface(scene.surfaces[i], i);
   for (const GlyphSet& g : scene.glyphs)
     if (g.tails.size() != g.heads.size())

@@ -37,8 +37,8 @@ struct ScalarColouring {
   std::string units;           // e.g. "%", "-" (dimensionless), "deg"; shown as "[units]"
   std::vector<double> values;  // one per surface point; NaN = no value (drawn grey)
   ColourMap map = ColourMap::kViridis;
-  Bands bands;          // colour range [bands.min, bands.max] and band edges (nice_bands())
-  bool banded = true;   // discrete colour bands; false: a smooth map over the range
+  Bands bands;            // colour range [bands.min, bands.max] and band edges (nice_bands())
+  bool banded = true;     // discrete colour bands; false: a smooth map over the range
   bool iso_lines = true;  // dark lines along the interior band edges
   bool colour_bar = true;
 };
@@ -49,9 +49,9 @@ struct Surface {
   std::vector<std::vector<Index>> polygons;  // 0-based point indices, >= 3 each
   std::optional<ScalarColouring> colouring;  // none: plain `colour`
   Colour colour{0.88, 0.88, 0.88};
-  bool shading = true;  // mild headlight shading for a 3-D impression (surfaces facing the
-                        // camera keep their exact colour); false: exact colours everywhere
-  bool outline = true;  // the boundary edges as a dark line
+  bool shading = true;                    // mild headlight shading for a 3-D impression (surfaces facing the
+                                          // camera keep their exact colour); false: exact colours everywhere
+  bool outline = true;                    // the boundary edges as a dark line
   std::vector<std::vector<Index>> lines;  // extra polylines on the surface (e.g. element edges)
   Colour line_colour{0.6, 0.6, 0.6};
 };
@@ -117,8 +117,8 @@ struct LegendEntry {
   Kind kind = Kind::kSwatch;
   Colour colour;
   std::string label;
-  double dash_px = 0;     // kLine
-  double width_px = 2;    // kLine width, kDot radius
+  double dash_px = 0;       // kLine
+  double width_px = 2;      // kLine width, kDot radius
   double model_length = 0;  // kArrow: drawn this long in model units, to the picture's scale
   int glyph_set = -1;       // kArrow: take width and head from this GlyphSet
 };
@@ -159,10 +159,10 @@ struct Framing {
 
 // Pixel layout the renderer will use for a scene of this size (for overlay authors).
 struct Layout {
-  double scale = 1;        // font scale: height / 900
-  double title_band = 0;   // pixels at the top used by title and subtitle
+  double scale = 1;       // font scale: height / 900
+  double title_band = 0;  // pixels at the top used by title and subtitle
   double footnote_band = 0;
-  double panel_left = 0;   // x where the right panel starts (== width when no panel)
+  double panel_left = 0;          // x where the right panel starts (== width when no panel)
   std::array<double, 4> frame{};  // the 3-D frame (x0, y0, x1, y1), origin bottom left
 };
 Layout layout_of(const Scene& scene, const ImageSize& size);

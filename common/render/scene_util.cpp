@@ -16,11 +16,16 @@ namespace sf::render {
 
 View parse_view(const std::string& text, const std::string& option) {
   View v;
-  if (text == "auto") v.kind = ViewKind::kAuto;
-  else if (text == "iso") v.kind = ViewKind::kIso;
-  else if (text == "top") v.kind = ViewKind::kTop;
-  else if (text == "front") v.kind = ViewKind::kFront;
-  else if (text == "side") v.kind = ViewKind::kSide;
+  if (text == "auto")
+    v.kind = ViewKind::kAuto;
+  else if (text == "iso")
+    v.kind = ViewKind::kIso;
+  else if (text == "top")
+    v.kind = ViewKind::kTop;
+  else if (text == "front")
+    v.kind = ViewKind::kFront;
+  else if (text == "side")
+    v.kind = ViewKind::kSide;
   else {
     std::stringstream ss(text);
     std::string item;
@@ -35,10 +40,12 @@ View parse_view(const std::string& text, const std::string& option) {
         ok = false;
       }
     }
-    if (!ok || xyz.size() != 3 || !std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) ||
-        !std::isfinite(xyz[2]) || Vec3(xyz[0], xyz[1], xyz[2]).norm() == 0)
-      throw UsageError(option + ": expected auto, iso, top, front, side or a view direction x,y,z "
-                                "(e.g. 1,-1,2), found '" + text + "'");
+    if (!ok || xyz.size() != 3 || !std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]) ||
+        Vec3(xyz[0], xyz[1], xyz[2]).norm() == 0)
+      throw UsageError(option +
+                       ": expected auto, iso, top, front, side or a view direction x,y,z "
+                       "(e.g. 1,-1,2), found '" +
+                       text + "'");
     v.kind = ViewKind::kDirection;
     v.direction = Vec3(xyz[0], xyz[1], xyz[2]);
   }
@@ -47,11 +54,16 @@ View parse_view(const std::string& text, const std::string& option) {
 
 std::string view_name(const View& v) {
   switch (v.kind) {
-    case ViewKind::kAuto: return "auto (along the mean normal)";
-    case ViewKind::kIso: return "iso";
-    case ViewKind::kTop: return "top";
-    case ViewKind::kFront: return "front";
-    case ViewKind::kSide: return "side";
+    case ViewKind::kAuto:
+      return "auto (along the mean normal)";
+    case ViewKind::kIso:
+      return "iso";
+    case ViewKind::kTop:
+      return "top";
+    case ViewKind::kFront:
+      return "front";
+    case ViewKind::kSide:
+      return "side";
     case ViewKind::kDirection: {
       std::ostringstream os;
       os << "from (" << v.direction.x() << ", " << v.direction.y() << ", " << v.direction.z() << ")";
@@ -75,8 +87,7 @@ ImageSize parse_size(const std::string& text, const std::string& option) {
     throw UsageError(option + ": expected WIDTHxHEIGHT in pixels (e.g. 1200x900), found '" + text + "'");
   }
   if (s.width < 200 || s.height < 200 || s.width > 8000 || s.height > 8000)
-    throw UsageError(option + ": width and height must be between 200 and 8000 pixels, found '" +
-                     text + "'");
+    throw UsageError(option + ": width and height must be between 200 and 8000 pixels, found '" + text + "'");
   return s;
 }
 
@@ -95,15 +106,15 @@ Colour RgbImage::at(int x, int y) const {
 
 RgbImage read_png_rgb(const std::string& path) {
   vtkNew<vtkPNGReader> reader;
-  if (!std::filesystem::exists(path) || !reader->CanReadFile(path.c_str()))
-    throw Error(path + ": cannot read PNG");
+  if (!std::filesystem::exists(path) || !reader->CanReadFile(path.c_str())) throw Error(path + ": cannot read PNG");
   reader->SetFileName(path.c_str());
   reader->Update();
   vtkImageData* img = reader->GetOutput();
   int dims[3];
   img->GetDimensions(dims);
   const int nc = img->GetNumberOfScalarComponents();
-  if (dims[0] <= 0 || dims[1] <= 0 || nc < 3 || img->GetScalarType() != VTK_UNSIGNED_CHAR) throw Error(path + ": cannot read PNG");
+  if (dims[0] <= 0 || dims[1] <= 0 || nc < 3 || img->GetScalarType() != VTK_UNSIGNED_CHAR)
+    throw Error(path + ": cannot read PNG");
   RgbImage out;
   out.width = dims[0];
   out.height = dims[1];

@@ -100,8 +100,8 @@ Prescriptions build_prescriptions(const FormingCase& spec, const Model& model) {
   std::vector<CaseProblem> conflicts;
   const std::vector<PlyConditions> plies = discretise_boundary_conditions(spec, conflicts);
   if (!conflicts.empty())
-    throw InputError(located_message(spec.file, conflicts[0].place.line, conflicts[0].place.column,
-                                     conflicts[0].message));
+    throw InputError(
+        located_message(spec.file, conflicts[0].place.line, conflicts[0].place.column, conflicts[0].message));
   Prescriptions out;
   for (int b = 0; b < model.n_bodies(); ++b) out.add(model, b, plies[static_cast<std::size_t>(b)].parameters);
   return out;
@@ -118,8 +118,8 @@ void add_contacts(const FormingCase& spec, Model& model) {
       model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),
                                                           spec.tools.at(static_cast<std::size_t>(c.tool)).tool, o));
     } else {
-      model.add_interaction(std::make_shared<BodyContact>(
-          c.label, model, std::move(slave), ContactSurface::whole_face(model, c.with, c.with_top), o));
+      model.add_interaction(std::make_shared<BodyContact>(c.label, model, std::move(slave),
+                                                          ContactSurface::whole_face(model, c.with, c.with_top), o));
     }
   }
 }

@@ -48,8 +48,7 @@ std::vector<EdgeCondition> edge_conditions(const FormingCase& spec, int ply) {
   return out;
 }
 
-std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec,
-                                                          std::vector<CaseProblem>& problems) {
+std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>& problems) {
   std::vector<PlyConditions> out;
   for (std::size_t p = 0; p < spec.plies.size(); ++p) {
     const CasePly& ply = spec.plies[p];
@@ -60,7 +59,8 @@ std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spe
     for (const ConditionConflict& c : out.back().conflicts) {
       const CaseBoundary& later = *of_ply[static_cast<std::size_t>(c.later)];
       const CaseBoundary& earlier = *of_ply[static_cast<std::size_t>(c.earlier)];
-      problems.push_back({ProblemKind::kConflict, later.place,
+      problems.push_back({ProblemKind::kConflict,
+                          later.place,
                           to_string(later.kind) + " on " + to_string(later.side) + " of ply '" + ply.name +
                               "' prescribes some of the same dofs as the " + to_string(earlier.kind) + " on " +
                               to_string(earlier.side) + " (line " + std::to_string(earlier.place.line) +
@@ -75,8 +75,10 @@ void check_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>
   bool any = false;
   for (const PlyConditions& c : discretise_boundary_conditions(spec, problems)) any = any || !c.parameters.empty();
   if (!any)
-    problems.push_back({ProblemKind::kNothingHeld, {1, 1},
-                        "boundary_conditions: nothing is held (the plies could move as rigid bodies)", {}});
+    problems.push_back({ProblemKind::kNothingHeld,
+                        {1, 1},
+                        "boundary_conditions: nothing is held (the plies could move as rigid bodies)",
+                        {}});
 }
 
 }  // namespace sf::forming

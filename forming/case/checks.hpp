@@ -25,8 +25,7 @@ std::vector<EdgeCondition> edge_conditions(const FormingCase& spec, int ply);
 
 // Discretises the boundary conditions of every ply (needs valid plies); appends a
 // kConflict problem for each pair that prescribes a dof differently. One entry per ply.
-std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec,
-                                                          std::vector<CaseProblem>& problems);
+std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>& problems);
 
 // discretise_boundary_conditions() plus the kNothingHeld rule.
 void check_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>& problems);

@@ -41,28 +41,38 @@ int find_material(const FormingCase& spec, const std::string& name) {
   return -1;
 }
 
-const std::vector<std::string> kLawKeys = {"stiffness", "tolerance", "viscous", "coulomb", "stick_velocity",
-                                           "engage_gap", "points"};
+const std::vector<std::string> kLawKeys = {"stiffness",      "tolerance",  "viscous", "coulomb",
+                                           "stick_velocity", "engage_gap", "points"};
 
 // The contact law keys of mapping n (those present in kLawKeys); false on a problem.
 bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
   bool ok = true;
   if (const YAML::Node s = r.required(n, "stiffness", what); s.IsDefined()) {
-    if (const auto v = r.positive(s, what + " stiffness", "S_n, N/mm^3")) law.normal.stiffness = *v; else ok = false;
-  } else ok = false;
+    if (const auto v = r.positive(s, what + " stiffness", "S_n, N/mm^3"))
+      law.normal.stiffness = *v;
+    else
+      ok = false;
+  } else
+    ok = false;
   if (n["tolerance"].IsDefined()) {
-    if (const auto v = r.positive(n["tolerance"], what + " tolerance", "largest penetration, mm; augmented Lagrangian")) {
+    if (const auto v =
+            r.positive(n["tolerance"], what + " tolerance", "largest penetration, mm; augmented Lagrangian")) {
       law.normal.augmented = true;
       law.normal.tolerance = *v;
-    } else ok = false;
+    } else
+      ok = false;
   }
   const auto nonneg = [&](const char* key, const std::string& unit, double& out) {
     const YAML::Node v = n[key];
     if (!v.IsDefined()) return;
     const auto x = r.number(v, what + " " + key);
-    if (!x) { ok = false; return; }
+    if (!x) {
+      ok = false;
+      return;
+    }
     if (*x < 0.0) {
-      r.problem(ProblemKind::kOutOfRange, v, what + " " + key + ": expected a value >= 0 (" + unit + "), found " + v.Scalar());
+      r.problem(ProblemKind::kOutOfRange, v,
+                what + " " + key + ": expected a value >= 0 (" + unit + "), found " + v.Scalar());
       ok = false;
       return;
     }
@@ -72,15 +82,20 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
   nonneg("coulomb", "mu", law.friction.coulomb);
   nonneg("engage_gap", "mm", law.friction.engage_gap);
   if (n["stick_velocity"].IsDefined()) {
-    if (const auto v = r.positive(n["stick_velocity"], what + " stick_velocity", "mm/s")) law.friction.stick_velocity = *v;
-    else ok = false;
+    if (const auto v = r.positive(n["stick_velocity"], what + " stick_velocity", "mm/s"))
+      law.friction.stick_velocity = *v;
+    else
+      ok = false;
   } else if (law.friction.coulomb > 0.0) {
     r.problem(ProblemKind::kMissing, n["coulomb"],
               what + ": Coulomb friction needs stick_velocity (mm/s, the slip rate below which it sticks)");
     ok = false;
   }
   if (n["points"].IsDefined()) {
-    if (const auto v = r.integer(n["points"], what + " points (per face direction)", 1, 12)) law.points = *v; else ok = false;
+    if (const auto v = r.integer(n["points"], what + " points (per face direction)", 1, 12))
+      law.points = *v;
+    else
+      ok = false;
   }
   return ok;
 }
@@ -98,20 +113,32 @@ bool read_layup_list(Reader& r, const YAML::Node& l, const std::string& what, do
   for (std::size_t i = 0; i < l.size(); ++i) {
     const std::string pw = what + " layup ply " + std::to_string(i + 1);
     const YAML::Node p = l[i];
-    if (!r.mapping(p, pw, {"angle", "thickness", "material"})) { ok = false; continue; }
+    if (!r.mapping(p, pw, {"angle", "thickness", "material"})) {
+      ok = false;
+      continue;
+    }
     CasePly ply;
     ply.place = place_of(p);
-    if (const auto a = r.number(r.required(p, "angle", pw), pw + " angle (degrees)")) ply.angle_deg = *a; else ok = false;
+    if (const auto a = r.number(r.required(p, "angle", pw), pw + " angle (degrees)"))
+      ply.angle_deg = *a;
+    else
+      ok = false;
     ply.thickness = thickness;
     if (p["thickness"].IsDefined()) {
-      if (const auto h = r.positive(p["thickness"], pw + " thickness", "mm")) ply.thickness = *h; else ok = false;
+      if (const auto h = r.positive(p["thickness"], pw + " thickness", "mm"))
+        ply.thickness = *h;
+      else
+        ok = false;
     } else if (!(thickness > 0.0)) {
       r.problem(ProblemKind::kMissing, p, pw + ": no thickness (give it here or ply_thickness for the laminate)");
       ok = false;
     }
     ply.material = material;
     if (p["material"].IsDefined()) {
-      if (const auto m = r.text(p["material"], pw + " material")) ply.material = *m; else ok = false;
+      if (const auto m = r.text(p["material"], pw + " material"))
+        ply.material = *m;
+      else
+        ok = false;
     }
     ply.material_index = find_material(spec, ply.material);
     if (ply.material.empty()) {
@@ -137,24 +164,41 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   if (const auto name = r.text(r.required(n, "name", what), what + " name")) {
     lam.name = *name;
     what = "laminate '" + lam.name + "'";
-  } else ok = false;
+  } else
+    ok = false;
   CasePly base;
   if (const YAML::Node o = n["origin"]; o.IsDefined()) {
-    if (const auto v = vector3(r, o, what + " origin", "mm")) base.origin = *v; else ok = false;
+    if (const auto v = vector3(r, o, what + " origin", "mm"))
+      base.origin = *v;
+    else
+      ok = false;
   }
   if (const YAML::Node s = r.required(n, "size", what); s.IsDefined() && pair_of(r, s, what + " size")) {
     const auto a = r.positive(s[0], what + " size Lx", "mm");
     const auto b = r.positive(s[1], what + " size Ly", "mm");
-    if (a && b) { base.length_x = *a; base.length_y = *b; } else ok = false;
-  } else ok = false;
+    if (a && b) {
+      base.length_x = *a;
+      base.length_y = *b;
+    } else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined() && pair_of(r, e, what + " elements")) {
     const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
     const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
-    if (a && b) { base.n1 = *a; base.n2 = *b; } else ok = false;
-  } else ok = false;
+    if (a && b) {
+      base.n1 = *a;
+      base.n2 = *b;
+    } else
+      ok = false;
+  } else
+    ok = false;
   double thickness = 0.0;
   if (const YAML::Node t = n["ply_thickness"]; t.IsDefined()) {
-    if (const auto h = r.positive(t, what + " ply_thickness", "mm")) thickness = *h; else ok = false;
+    if (const auto h = r.positive(t, what + " ply_thickness", "mm"))
+      thickness = *h;
+    else
+      ok = false;
   }
   std::string material;
   if (const YAML::Node m = n["material"]; m.IsDefined()) {
@@ -164,7 +208,8 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
         r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + material + "'", material);
         ok = false;
       }
-    } else ok = false;
+    } else
+      ok = false;
   }
   std::vector<CasePly> plies;
   if (const YAML::Node l = r.required(n, "layup", what); l.IsDefined()) {
@@ -174,8 +219,7 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
       std::size_t offset = 0;
       const auto angles = parse_layup(l.Scalar(), error, offset);
       if (!angles) {
-        r.problem(ProblemKind::kWrongType, place_in_scalar(l, offset),
-                  what + " layup '" + l.Scalar() + "': " + error);
+        r.problem(ProblemKind::kWrongType, place_in_scalar(l, offset), what + " layup '" + l.Scalar() + "': " + error);
         ok = false;
       } else {
         if (!(thickness > 0.0)) {
@@ -201,20 +245,25 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
       ok = read_layup_list(r, l, what, thickness, material, spec, plies) && ok;
     } else {
       r.problem(ProblemKind::kWrongType, l,
-                what + " layup: expected a layup string such as \"[0,90]s\" or a list of {angle, thickness, material}, "
-                       "found " + describe(l));
+                what +
+                    " layup: expected a layup string such as \"[0,90]s\" or a list of {angle, thickness, material}, "
+                    "found " +
+                    describe(l));
       ok = false;
     }
-  } else ok = false;
+  } else
+    ok = false;
   CaseContactLaw law;
   const YAML::Node iface = n["interface"];
   if (plies.size() > 1) {
     if (!iface.IsDefined()) {
-      r.problem(ProblemKind::kMissing, n, what + ": missing required key 'interface' (the contact law between its plies)");
+      r.problem(ProblemKind::kMissing, n,
+                what + ": missing required key 'interface' (the contact law between its plies)");
       ok = false;
     } else if (r.mapping(iface, what + " interface", kLawKeys)) {
       ok = read_law(r, iface, what + " interface", law) && ok;
-    } else ok = false;
+    } else
+      ok = false;
   }
   if (!ok) return;
   lam.first_ply = static_cast<int>(spec.plies.size());
@@ -242,7 +291,8 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     c.with = c.ply + 1;
     c.with_top = false;
     c.law = law;
-    c.label = spec.plies[static_cast<std::size_t>(c.ply)].name + "/" + spec.plies[static_cast<std::size_t>(c.with)].name;
+    c.label =
+        spec.plies[static_cast<std::size_t>(c.ply)].name + "/" + spec.plies[static_cast<std::size_t>(c.with)].name;
     c.place = place_of(iface);
     spec.contacts.push_back(c);
   }
@@ -270,12 +320,18 @@ std::shared_ptr<const ToolShape> read_shape(Reader& r, const YAML::Node& n, cons
   const std::string kind = key.Scalar();
   const std::string sw = what + " " + kind;
   std::vector<std::string> keys;
-  if (kind == "plane") keys = {"point", "normal"};
-  else if (kind == "sphere") keys = {"centre", "radius"};
-  else if (kind == "cylinder") keys = {"point", "axis", "radius"};
-  else if (kind == "punch") keys = {"tip", "axis", "radius", "fillet"};
-  else if (kind == "die") keys = {"centre", "normal", "opening_radius", "slot_half_width", "along", "edge_radius"};
-  else keys = {"file", "scale", "offset"};
+  if (kind == "plane")
+    keys = {"point", "normal"};
+  else if (kind == "sphere")
+    keys = {"centre", "radius"};
+  else if (kind == "cylinder")
+    keys = {"point", "axis", "radius"};
+  else if (kind == "punch")
+    keys = {"tip", "axis", "radius", "fillet"};
+  else if (kind == "die")
+    keys = {"centre", "normal", "opening_radius", "slot_half_width", "along", "edge_radius"};
+  else
+    keys = {"file", "scale", "offset"};
   if (!r.mapping(body, sw, keys)) return nullptr;
   const auto vec = [&](const char* k) { return vector3(r, r.required(body, k, sw), sw + " " + k, "mm"); };
   const auto len = [&](const char* k) { return r.positive(r.required(body, k, sw), sw + " " + k, "mm"); };
@@ -301,16 +357,24 @@ std::shared_ptr<const ToolShape> read_shape(Reader& r, const YAML::Node& n, cons
       DieOpening o;
       bool have = true;
       if (body["opening_radius"].IsDefined() == body["slot_half_width"].IsDefined()) {
-        r.problem(ProblemKind::kWrongType, body, sw + ": give either opening_radius (circle) or slot_half_width and along");
+        r.problem(ProblemKind::kWrongType, body,
+                  sw + ": give either opening_radius (circle) or slot_half_width and along");
         have = false;
       } else if (body["opening_radius"].IsDefined()) {
         const auto R = r.positive(body["opening_radius"], sw + " opening_radius", "mm");
-        if (R) o.radius = *R; else have = false;
+        if (R)
+          o.radius = *R;
+        else
+          have = false;
       } else {
         o.slot = true;
         const auto hw = r.positive(body["slot_half_width"], sw + " slot_half_width", "mm");
         const auto al = vector3(r, r.required(body, "along", sw), sw + " along", "a direction");
-        if (hw && al) { o.half_width = *hw; o.along = *al; } else have = false;
+        if (hw && al) {
+          o.half_width = *hw;
+          o.along = *al;
+        } else
+          have = false;
       }
       if (c && nn && e && have) return make_die(*c, *nn, o, *e);
     } else {
@@ -328,9 +392,8 @@ std::shared_ptr<const ToolShape> read_shape(Reader& r, const YAML::Node& n, cons
         offset = *o;
       }
       if (!f) return nullptr;
-      const std::filesystem::path path = std::filesystem::path(*f).is_absolute()
-                                             ? std::filesystem::path(*f)
-                                             : std::filesystem::path(case_dir) / *f;
+      const std::filesystem::path path =
+          std::filesystem::path(*f).is_absolute() ? std::filesystem::path(*f) : std::filesystem::path(case_dir) / *f;
       file = path.string();
       try {
         return make_mesh_tool(io::read_stl(file), scale, offset);
@@ -349,8 +412,8 @@ std::optional<ToolMotion> read_motion(Reader& r, const YAML::Node& m, const std:
                                       const CaseSolver& solver) {
   const std::string mw = what + " motion";
   if (!r.mapping(m, mw, {"fixed", "displacement", "ramp", "duration", "velocity", "table"})) return std::nullopt;
-  const int kinds = m["fixed"].IsDefined() + m["displacement"].IsDefined() + m["velocity"].IsDefined() +
-                    m["table"].IsDefined();
+  const int kinds =
+      m["fixed"].IsDefined() + m["displacement"].IsDefined() + m["velocity"].IsDefined() + m["table"].IsDefined();
   if (kinds != 1) {
     r.problem(ProblemKind::kWrongType, m, mw + ": expected exactly one of fixed, displacement, velocity, table");
     return std::nullopt;
@@ -376,8 +439,7 @@ std::optional<ToolMotion> read_motion(Reader& r, const YAML::Node& m, const std:
       return ToolMotion::ramped(*d, ramp, duration);
     }
     for (const char* k : {"ramp", "duration"})
-      if (m[k].IsDefined())
-        r.problem(ProblemKind::kUnsupported, m[k], mw + " " + k + ": only used with displacement");
+      if (m[k].IsDefined()) r.problem(ProblemKind::kUnsupported, m[k], mw + " " + k + ": only used with displacement");
     if (m["velocity"].IsDefined()) {
       const auto v = vector3(r, m["velocity"], mw + " velocity", "mm/s");
       if (!v) return std::nullopt;
@@ -385,14 +447,16 @@ std::optional<ToolMotion> read_motion(Reader& r, const YAML::Node& m, const std:
     }
     const YAML::Node t = m["table"];
     if (!t.IsSequence() || t.size() == 0) {
-      r.problem(ProblemKind::kWrongType, t, mw + " table: expected a list of [t, dx, dy, dz] rows, found " + describe(t));
+      r.problem(ProblemKind::kWrongType, t,
+                mw + " table: expected a list of [t, dx, dy, dz] rows, found " + describe(t));
       return std::nullopt;
     }
     std::vector<std::pair<double, Vec3>> rows;
     for (std::size_t i = 0; i < t.size(); ++i) {
       const YAML::Node row = t[i];
       if (!row.IsSequence() || row.size() != 4) {
-        r.problem(ProblemKind::kWrongType, row, mw + " table: expected a row [t (s), dx, dy, dz (mm)], found " + describe(row));
+        r.problem(ProblemKind::kWrongType, row,
+                  mw + " table: expected a row [t (s), dx, dy, dz (mm)], found " + describe(row));
         return std::nullopt;
       }
       std::array<double, 4> v{};
@@ -427,12 +491,16 @@ void read_tool(Reader& r, const YAML::Node& n, int index, const std::string& cas
       r.problem(ProblemKind::kDuplicate, n["name"], what + ": name used by an earlier tool or ply");
       ok = false;
     }
-  } else ok = false;
+  } else
+    ok = false;
   t.tool.name = t.name;
   t.tool.shape = read_shape(r, n, what, case_dir, t.file);
   if (!t.tool.shape) ok = false;
   if (const YAML::Node m = n["motion"]; m.IsDefined()) {
-    if (const auto motion = read_motion(r, m, what, spec.solver)) t.tool.motion = *motion; else ok = false;
+    if (const auto motion = read_motion(r, m, what, spec.solver))
+      t.tool.motion = *motion;
+    else
+      ok = false;
     if (spec.solver.arc_length > 0.0 && t.tool.motion.moves()) {
       r.problem(ProblemKind::kUnsupported, m, what + " motion: tools cannot move under control: arc_length (no time)");
       ok = false;
@@ -452,22 +520,29 @@ void read_contact(Reader& r, const YAML::Node& n, int index, FormingCase& spec) 
   std::string ply_name;
   ok = case_yaml::ply_of(r, n, what, spec, ply_name, c.ply) && ok;
   if (const YAML::Node f = r.required(n, "face", what); f.IsDefined()) {
-    if (const auto top = face_of(r, f, what + " face")) c.top = *top; else ok = false;
-  } else ok = false;
+    if (const auto top = face_of(r, f, what + " face"))
+      c.top = *top;
+    else
+      ok = false;
+  } else
+    ok = false;
   const YAML::Node tool = n["tool"], with = n["with"];
   std::string partner;
   if (tool.IsDefined() == with.IsDefined()) {
-    r.problem(ProblemKind::kWrongType, n, what + ": expected exactly one partner: tool (a tool's name) or with (a ply's name)");
+    r.problem(ProblemKind::kWrongType, n,
+              what + ": expected exactly one partner: tool (a tool's name) or with (a ply's name)");
     ok = false;
   } else if (tool.IsDefined()) {
     if (const auto name = r.text(tool, what + " tool")) {
       partner = *name;
       c.tool = find_tool(spec, *name);
       if (c.tool < 0) {
-        r.problem(ProblemKind::kUnknownTool, tool, what + ": unknown tool '" + *name + "' (not defined under tools)", *name);
+        r.problem(ProblemKind::kUnknownTool, tool, what + ": unknown tool '" + *name + "' (not defined under tools)",
+                  *name);
         ok = false;
       }
-    } else ok = false;
+    } else
+      ok = false;
     if (n["with_face"].IsDefined()) {
       r.problem(ProblemKind::kUnsupported, n["with_face"], what + " with_face: only used with 'with' (a ply)");
       ok = false;
@@ -483,14 +558,20 @@ void read_contact(Reader& r, const YAML::Node& n, int index, FormingCase& spec) 
         r.problem(ProblemKind::kOutOfRange, with, what + ": a ply cannot be in contact with itself");
         ok = false;
       }
-    } else ok = false;
+    } else
+      ok = false;
     if (const YAML::Node f = r.required(n, "with_face", what); f.IsDefined()) {
-      if (const auto top = face_of(r, f, what + " with_face")) c.with_top = *top; else ok = false;
-    } else ok = false;
+      if (const auto top = face_of(r, f, what + " with_face"))
+        c.with_top = *top;
+      else
+        ok = false;
+    } else
+      ok = false;
   }
   ok = read_law(r, n, what, c.law) && ok;
   if (ok && spec.solver.arc_length > 0.0 && c.law.friction.active()) {
-    r.problem(ProblemKind::kUnsupported, n, what + ": friction needs slip rates, which control: arc_length does not have");
+    r.problem(ProblemKind::kUnsupported, n,
+              what + ": friction needs slip rates, which control: arc_length does not have");
     ok = false;
   }
   if (!ok) return;
@@ -513,7 +594,8 @@ std::optional<std::vector<double>> parse_layup(const std::string& text, std::str
   const auto integer = [&](int& out) {
     const std::size_t start = i;
     long v = 0;
-    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])) && v < 100000) v = 10 * v + (text[i++] - '0');
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])) && v < 100000)
+      v = 10 * v + (text[i++] - '0');
     out = static_cast<int>(v);
     return i > start && v > 0;
   };

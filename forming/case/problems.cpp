@@ -6,18 +6,30 @@ namespace sf::forming {
 
 std::string to_string(ProblemKind kind) {
   switch (kind) {
-    case ProblemKind::kUnreadable: return "unreadable";
-    case ProblemKind::kUnknownKey: return "unknown-key";
-    case ProblemKind::kDuplicate: return "duplicate";
-    case ProblemKind::kMissing: return "missing";
-    case ProblemKind::kWrongType: return "wrong-type";
-    case ProblemKind::kOutOfRange: return "out-of-range";
-    case ProblemKind::kUnknownMaterial: return "unknown-material";
-    case ProblemKind::kUnknownPly: return "unknown-ply";
-    case ProblemKind::kUnknownTool: return "unknown-tool";
-    case ProblemKind::kConflict: return "conflict";
-    case ProblemKind::kUnsupported: return "unsupported";
-    case ProblemKind::kNothingHeld: return "nothing-held";
+    case ProblemKind::kUnreadable:
+      return "unreadable";
+    case ProblemKind::kUnknownKey:
+      return "unknown-key";
+    case ProblemKind::kDuplicate:
+      return "duplicate";
+    case ProblemKind::kMissing:
+      return "missing";
+    case ProblemKind::kWrongType:
+      return "wrong-type";
+    case ProblemKind::kOutOfRange:
+      return "out-of-range";
+    case ProblemKind::kUnknownMaterial:
+      return "unknown-material";
+    case ProblemKind::kUnknownPly:
+      return "unknown-ply";
+    case ProblemKind::kUnknownTool:
+      return "unknown-tool";
+    case ProblemKind::kConflict:
+      return "conflict";
+    case ProblemKind::kUnsupported:
+      return "unsupported";
+    case ProblemKind::kNothingHeld:
+      return "nothing-held";
   }
   return "?";
 }

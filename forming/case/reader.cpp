@@ -20,8 +20,8 @@
 namespace sf::forming {
 
 using case_yaml::describe;
-using case_yaml::place_of;
 using case_yaml::pair_of;
+using case_yaml::place_of;
 using case_yaml::ply_of;
 using case_yaml::ramp_of;
 using case_yaml::Reader;
@@ -30,12 +30,11 @@ using case_yaml::vector3;
 namespace {
 
 const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "laminates", "boundary_conditions",
-                                           "loads", "solver", "tools", "contact", "output"};
+                                           "loads", "solver",    "tools", "contact",   "output"};
 
 // The law of material `what` under key `law` (neo_hookean: {E, nu} or {mu, lambda});
 // false (with a problem) when it cannot be read or the law rejects the constants.
-bool read_neo_hookean(Reader& r, const std::string& what, const YAML::Node& law, const YAML::Node& p,
-                      CaseMaterial& m) {
+bool read_neo_hookean(Reader& r, const std::string& what, const YAML::Node& law, const YAML::Node& p, CaseMaterial& m) {
   const std::string lw = what + " neo_hookean";
   m.kind = CaseMaterial::Kind::kNeoHookean;
   if (!r.mapping(p, lw, {"E", "nu", "mu", "lambda"})) return false;
@@ -74,10 +73,9 @@ bool read_transversely_isotropic(Reader& r, const std::string& what, const YAML:
   const std::string lw = what + " transversely_isotropic";
   m.kind = CaseMaterial::Kind::kTransverselyIsotropic;
   if (!r.mapping(p, lw, {"mu_T", "mu_L", "kappa_f", "lambda", "E_f", "E_T", "G_L", "G_T"})) return false;
-  const bool engineering = p["E_f"].IsDefined() || p["E_T"].IsDefined() || p["G_L"].IsDefined() ||
-                           p["G_T"].IsDefined();
-  const bool direct = p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() ||
-                      p["lambda"].IsDefined();
+  const bool engineering = p["E_f"].IsDefined() || p["E_T"].IsDefined() || p["G_L"].IsDefined() || p["G_T"].IsDefined();
+  const bool direct =
+      p["mu_T"].IsDefined() || p["mu_L"].IsDefined() || p["kappa_f"].IsDefined() || p["lambda"].IsDefined();
   if (engineering == direct) {
     r.problem(ProblemKind::kWrongType, law, lw + ": give either {E_f, E_T, G_L, G_T} or {mu_T, mu_L, kappa_f, lambda}");
     return false;
@@ -129,7 +127,8 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   std::size_t extras = 0;
   if (body["density"].IsDefined()) {
     ++extras;
-    if (const auto rho = r.positive(body["density"], what + " density", "t/mm^3, e.g. 1.5e-9 for GF/PP")) m.density = *rho;
+    if (const auto rho = r.positive(body["density"], what + " density", "t/mm^3, e.g. 1.5e-9 for GF/PP"))
+      m.density = *rho;
   }
   for (const char* flag : {"incompressible", "inextensible"}) {
     if (!body[flag].IsDefined()) continue;
@@ -180,7 +179,10 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
     } else {
       for (int i = 0; i < 3; ++i) {
         const auto v = r.number(o[i], what + " origin");
-        if (v) ply.origin[i] = *v; else ok = false;
+        if (v)
+          ply.origin[i] = *v;
+        else
+          ok = false;
       }
     }
   }
@@ -188,21 +190,40 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
     if (pair_of(r, s, what + " size")) {
       const auto a = r.positive(s[0], what + " size Lx", "mm");
       const auto b = r.positive(s[1], what + " size Ly", "mm");
-      if (a && b) { ply.length_x = *a; ply.length_y = *b; } else ok = false;
-    } else ok = false;
-  } else ok = false;
+      if (a && b) {
+        ply.length_x = *a;
+        ply.length_y = *b;
+      } else
+        ok = false;
+    } else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node t = r.required(n, "thickness", what); t.IsDefined()) {
-    if (const auto h = r.positive(t, what + " thickness", "mm")) ply.thickness = *h; else ok = false;
-  } else ok = false;
+    if (const auto h = r.positive(t, what + " thickness", "mm"))
+      ply.thickness = *h;
+    else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined()) {
     if (pair_of(r, e, what + " elements")) {
       const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
       const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
-      if (a && b) { ply.n1 = *a; ply.n2 = *b; } else ok = false;
-    } else ok = false;
-  } else ok = false;
+      if (a && b) {
+        ply.n1 = *a;
+        ply.n2 = *b;
+      } else
+        ok = false;
+    } else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node a = n["angle"]; a.IsDefined()) {
-    if (const auto v = r.number(a, what + " angle (degrees)")) ply.angle_deg = *v; else ok = false;
+    if (const auto v = r.number(a, what + " angle (degrees)"))
+      ply.angle_deg = *v;
+    else
+      ok = false;
   }
   if (const YAML::Node m = r.required(n, "material", what); m.IsDefined()) {
     if (const auto name = r.text(m, what + " material")) {
@@ -214,8 +235,10 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
                   what + ": unknown material '" + *name + "' (not defined under materials)", *name);
         ok = false;
       }
-    } else ok = false;
-  } else ok = false;
+    } else
+      ok = false;
+  } else
+    ok = false;
   if (ok) spec.plies.push_back(ply);
 }
 
@@ -264,8 +287,12 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   const bool symmetry = bc.kind == CaseBoundary::Kind::kSymmetry;
   const std::string side_key = symmetry ? "plane" : "edge";
   if (const YAML::Node s = r.required(b, side_key, bw); s.IsDefined()) {
-    if (const auto side = side_of(r, s, bw + " " + side_key, symmetry)) bc.side = *side; else ok = false;
-  } else ok = false;
+    if (const auto side = side_of(r, s, bw + " " + side_key, symmetry))
+      bc.side = *side;
+    else
+      ok = false;
+  } else
+    ok = false;
   if (bc.kind == CaseBoundary::Kind::kDisplacement) {
     const YAML::Node v = r.required(b, "value", bw);
     if (v.IsDefined()) {
@@ -278,14 +305,19 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
         for (int i = 0; i < 3; ++i) {
           if (v[i].IsNull() || (v[i].IsScalar() && v[i].Scalar() == "free")) continue;
           const auto u = r.number(v[i], bw + " value");
-          if (u) { bc.value[i] = *u; ++given; } else ok = false;
+          if (u) {
+            bc.value[i] = *u;
+            ++given;
+          } else
+            ok = false;
         }
         if (ok && given == 0) {
           r.problem(ProblemKind::kMissing, v, bw + " value: every component is free; give at least one");
           ok = false;
         }
       }
-    } else ok = false;
+    } else
+      ok = false;
     if (!ramp_of(r, b, bw, bc.ramp)) ok = false;
   }
   if (ok) spec.boundaries.push_back(bc);
@@ -302,23 +334,34 @@ bool read_pressure(Reader& r, const YAML::Node& b, const std::string& lw, CaseLo
       r.problem(ProblemKind::kWrongType, f, lw + " face: expected top or bottom, found " + describe(f));
       ok = false;
     }
-  } else ok = false;
+  } else
+    ok = false;
   if (const YAML::Node v = r.required(b, "value", lw); v.IsDefined()) {
-    if (const auto p = r.number(v, lw + " value (MPa)")) load.value = *p; else ok = false;
-  } else ok = false;
+    if (const auto p = r.number(v, lw + " value (MPa)"))
+      load.value = *p;
+    else
+      ok = false;
+  } else
+    ok = false;
   if (b["follower"].IsDefined()) {
-    if (const auto f = r.boolean(b["follower"], lw + " follower")) load.follower = *f; else ok = false;
+    if (const auto f = r.boolean(b["follower"], lw + " follower"))
+      load.follower = *f;
+    else
+      ok = false;
   }
   return ok;
 }
 
 // Gravity also needs every material's density (reported at the load's key).
-bool read_gravity(Reader& r, const YAML::Node& b, const YAML::Node& key, const std::string& lw,
-                  const FormingCase& spec, CaseLoad& load) {
+bool read_gravity(Reader& r, const YAML::Node& b, const YAML::Node& key, const std::string& lw, const FormingCase& spec,
+                  CaseLoad& load) {
   bool ok = true;
   const YAML::Node a = b["acceleration"];
   if (a.IsDefined()) {
-    if (const auto g = vector3(r, a, lw + " acceleration", "mm/s^2")) load.vector = *g; else ok = false;
+    if (const auto g = vector3(r, a, lw + " acceleration", "mm/s^2"))
+      load.vector = *g;
+    else
+      ok = false;
   } else {
     load.vector = Vec3(0.0, 0.0, -9810.0);
   }
@@ -334,17 +377,24 @@ bool read_gravity(Reader& r, const YAML::Node& b, const YAML::Node& key, const s
 bool read_edge_force(Reader& r, const YAML::Node& b, const std::string& lw, CaseLoad& load) {
   bool ok = true;
   if (const YAML::Node e = r.required(b, "edge", lw); e.IsDefined()) {
-    if (const auto side = side_of(r, e, lw + " edge", false)) load.side = *side; else ok = false;
-  } else ok = false;
+    if (const auto side = side_of(r, e, lw + " edge", false))
+      load.side = *side;
+    else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-    if (const auto v = vector3(r, f, lw + " force", "N, total over the edge")) load.vector = *v; else ok = false;
-  } else ok = false;
+    if (const auto v = vector3(r, f, lw + " force", "N, total over the edge"))
+      load.vector = *v;
+    else
+      ok = false;
+  } else
+    ok = false;
   return ok;
 }
 
 // The node must lie on the ply's grid (0..elements each way).
-bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, const FormingCase& spec,
-                      CaseLoad& load) {
+bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, const FormingCase& spec, CaseLoad& load) {
   bool ok = true;
   if (const YAML::Node nd = r.required(b, "node", lw); nd.IsDefined()) {
     if (pair_of(r, nd, lw + " node [i, j]")) {
@@ -355,21 +405,31 @@ bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, con
       if (i && j) {
         load.node_i = *i;
         load.node_j = *j;
-      } else ok = false;
-    } else ok = false;
-  } else ok = false;
+      } else
+        ok = false;
+    } else
+      ok = false;
+  } else
+    ok = false;
   if (const YAML::Node l = b["layer"]; l.IsDefined()) {
-    if (l.IsScalar() && l.Scalar() == "bottom") load.layer = 0;
-    else if (l.IsScalar() && l.Scalar() == "top") load.layer = 1;
-    else if (l.IsScalar() && l.Scalar() == "both") load.layer = -1;
+    if (l.IsScalar() && l.Scalar() == "bottom")
+      load.layer = 0;
+    else if (l.IsScalar() && l.Scalar() == "top")
+      load.layer = 1;
+    else if (l.IsScalar() && l.Scalar() == "both")
+      load.layer = -1;
     else {
       r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
       ok = false;
     }
   }
   if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-    if (const auto v = vector3(r, f, lw + " force", "N")) load.vector = *v; else ok = false;
-  } else ok = false;
+    if (const auto v = vector3(r, f, lw + " force", "N"))
+      load.vector = *v;
+    else
+      ok = false;
+  } else
+    ok = false;
   return ok;
 }
 
@@ -406,19 +466,28 @@ void read_load(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   if (!r.mapping(b, lw, keys)) return;
   bool ok = load.kind == CaseLoad::Kind::kGravity || ply_of(r, b, lw, spec, load.ply, load.ply_index);
   switch (load.kind) {
-    case CaseLoad::Kind::kPressure: ok = read_pressure(r, b, lw, load) && ok; break;
-    case CaseLoad::Kind::kGravity: ok = read_gravity(r, b, kv->first, lw, spec, load) && ok; break;
-    case CaseLoad::Kind::kEdgeForce: ok = read_edge_force(r, b, lw, load) && ok; break;
-    case CaseLoad::Kind::kPointForce: ok = read_point_force(r, b, lw, spec, load) && ok; break;
+    case CaseLoad::Kind::kPressure:
+      ok = read_pressure(r, b, lw, load) && ok;
+      break;
+    case CaseLoad::Kind::kGravity:
+      ok = read_gravity(r, b, kv->first, lw, spec, load) && ok;
+      break;
+    case CaseLoad::Kind::kEdgeForce:
+      ok = read_edge_force(r, b, lw, load) && ok;
+      break;
+    case CaseLoad::Kind::kPointForce:
+      ok = read_point_force(r, b, lw, spec, load) && ok;
+      break;
   }
   if (!ramp_of(r, b, lw, load.ramp)) ok = false;
   if (ok) spec.loads.push_back(load);
 }
 
 void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
-  if (!r.mapping(n, "solver", {"steps", "max_iterations", "tolerance", "line_search", "min_increment",
-                               "constraint_tolerance", "analysis", "end_time", "time_step", "integrator", "rho_inf",
-                               "control", "arc_length", "stop_displacement", "process_time"}))
+  if (!r.mapping(n, "solver",
+                 {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
+                  "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
+                  "stop_displacement", "process_time"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -434,7 +503,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (!a.IsDefined())
       r.problem(ProblemKind::kMissing, n["control"],
                 "solver control arc_length: give arc_length (the path length per step, mm)");
-    else if (const auto v = r.positive(a, "solver arc_length", "mm")) s.arc_length = *v;
+    else if (const auto v = r.positive(a, "solver arc_length", "mm"))
+      s.arc_length = *v;
     if (n["stop_displacement"].IsDefined())
       if (const auto v = r.positive(n["stop_displacement"], "solver stop_displacement", "mm")) s.stop_displacement = *v;
   } else {
@@ -452,7 +522,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (n["end_time"].IsDefined())
     if (const auto v = r.positive(n["end_time"], "solver end_time", "s")) s.end_time = *v;
   if (n["process_time"].IsDefined())
-    if (const auto v = r.positive(n["process_time"], "solver process_time", "s, of the whole load")) s.process_time = *v;
+    if (const auto v = r.positive(n["process_time"], "solver process_time", "s, of the whole load"))
+      s.process_time = *v;
   if (n["time_step"].IsDefined())
     if (const auto v = r.positive(n["time_step"], "solver time_step", "s")) s.time_step = *v;
   if (const YAML::Node i = n["integrator"]; i.IsDefined()) {
@@ -467,19 +538,20 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (v && !(*v >= 0.0 && *v <= 1.0))
       r.problem(ProblemKind::kOutOfRange, n["rho_inf"],
                 "solver rho_inf: expected a spectral radius in [0, 1], found " + n["rho_inf"].Scalar());
-    else if (v) s.rho_inf = *v;
+    else if (v)
+      s.rho_inf = *v;
   }
   for (const char* key : {"end_time", "time_step", "integrator", "rho_inf"})
     if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !n["analysis"].IsScalar()))
-      r.problem(ProblemKind::kUnsupported, n[key],
-                std::string("solver ") + key + ": only used with analysis: dynamic");
+      r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
   if (n["constraint_tolerance"].IsDefined()) {
     const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
     if (v && !(*v > 0.0 && *v < 0.1))
-      r.problem(ProblemKind::kOutOfRange, n["constraint_tolerance"],
-                "solver constraint_tolerance: expected a value in (0, 0.1), found " +
-                    n["constraint_tolerance"].Scalar());
-    else if (v) s.constraint_tolerance = *v;
+      r.problem(
+          ProblemKind::kOutOfRange, n["constraint_tolerance"],
+          "solver constraint_tolerance: expected a value in (0, 0.1), found " + n["constraint_tolerance"].Scalar());
+    else if (v)
+      s.constraint_tolerance = *v;
   }
   if (n["steps"].IsDefined())
     if (const auto v = r.integer(n["steps"], "solver steps", 1, 100000)) s.steps = *v;
@@ -490,7 +562,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (v && (*v <= 0.0 || *v >= 1.0))
       r.problem(ProblemKind::kOutOfRange, n["tolerance"],
                 "solver tolerance: expected a relative residual in (0, 1), found " + n["tolerance"].Scalar());
-    else if (v) s.tolerance = *v;
+    else if (v)
+      s.tolerance = *v;
   }
   if (n["line_search"].IsDefined())
     if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;
@@ -499,7 +572,8 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
     if (v && !(*v > 0.0 && *v <= 1.0))
       r.problem(ProblemKind::kOutOfRange, n["min_increment"],
                 "solver min_increment: expected a fraction of a step in (0, 1], found " + n["min_increment"].Scalar());
-    else if (v) s.min_increment = *v;
+    else if (v)
+      s.min_increment = *v;
   }
 }
 
@@ -542,8 +616,10 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
   }
   if (!r.mapping(root, "case", kTopKeys)) return;
   if (const YAML::Node u = root["units"]; u.IsDefined()) {
-    if (u.IsScalar()) spec.units = u.Scalar();
-    else r.problem(ProblemKind::kWrongType, u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
+    if (u.IsScalar())
+      spec.units = u.Scalar();
+    else
+      r.problem(ProblemKind::kWrongType, u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
   }
   if (const YAML::Node ms = r.required(root, "materials", "case"); ms.IsDefined()) {
     if (!ms.IsMap()) {
@@ -600,7 +676,8 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
         failed_laminates.insert(l["name"].Scalar());
   const auto laminate_ply = [&failed_laminates](const CaseProblem& p) {
     const std::size_t dot = p.name.rfind('.');
-    return p.kind == ProblemKind::kUnknownPly && dot != std::string::npos && failed_laminates.count(p.name.substr(0, dot));
+    return p.kind == ProblemKind::kUnknownPly && dot != std::string::npos &&
+           failed_laminates.count(p.name.substr(0, dot));
   };
   // A condition or load naming a ply that exists but was bad: the ply's own problem is enough.
   auto drop_unknown_ply_problems = [&](std::size_t from) {
@@ -638,8 +715,7 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
     read_contacts(r, cs, spec);
     drop_unknown_ply_problems(before);
     std::set<std::string> tool_names;
-    if (ts_names(root, tool_names))
-      drop_unknown_names(problems, before, ProblemKind::kUnknownTool, tool_names);
+    if (ts_names(root, tool_names)) drop_unknown_names(problems, before, ProblemKind::kUnknownTool, tool_names);
   }
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
 }

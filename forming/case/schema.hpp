@@ -68,12 +68,12 @@ struct CaseMaterial {
   enum class Kind { kNeoHookean, kTransverselyIsotropic };
   std::string name;
   Kind kind = Kind::kNeoHookean;
-  NeoHookeanParams neo_hookean;      // kNeoHookean
-  TransverselyIsotropicParams ti;    // kTransverselyIsotropic (compressible)
-  std::string given_as;              // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
-  double density = 0.0;              // t/mm^3 (0 = not given; gravity and dynamics need it)
-  bool incompressible = false;       // element-mean J = 1, exact (augmented Lagrangian)
-  bool inextensible = false;         // element-mean I4 = 1 (transversely isotropic only)
+  NeoHookeanParams neo_hookean;    // kNeoHookean
+  TransverselyIsotropicParams ti;  // kTransverselyIsotropic (compressible)
+  std::string given_as;            // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
+  double density = 0.0;            // t/mm^3 (0 = not given; gravity and dynamics need it)
+  bool incompressible = false;     // element-mean J = 1, exact (augmented Lagrangian)
+  bool inextensible = false;       // element-mean I4 = 1 (transversely isotropic only)
   SourcePlace place;
 };
 
@@ -117,10 +117,10 @@ struct CaseLoad {
   enum class Kind { kPressure, kGravity, kEdgeForce, kPointForce };
   Kind kind = Kind::kPressure;
   std::string ply;
-  int ply_index = -1;       // -1 for gravity (all plies)
-  bool top = true;          // kPressure face
-  double value = 0.0;       // kPressure, MPa
-  bool follower = true;     // kPressure
+  int ply_index = -1;           // -1 for gravity (all plies)
+  bool top = true;              // kPressure face
+  double value = 0.0;           // kPressure, MPa
+  bool follower = true;         // kPressure
   PlySide side = PlySide::kX1;  // kEdgeForce
   int node_i = 0, node_j = 0;   // kPointForce
   int layer = -1;               // kPointForce: 0 bottom, 1 top, -1 both
@@ -130,30 +130,30 @@ struct CaseLoad {
 };
 
 struct CaseSolver {
-  int steps = 10;             // load steps (load factor k / steps)
-  int max_iterations = 25;    // Newton iterations per attempt
-  double tolerance = 1e-8;    // residual, relative to the force scale
+  int steps = 10;           // load steps (load factor k / steps)
+  int max_iterations = 25;  // Newton iterations per attempt
+  double tolerance = 1e-8;  // residual, relative to the force scale
   bool line_search = true;
-  double min_increment = 1e-4;  // smallest sub-increment (fraction of a step) before giving up
+  double min_increment = 1e-4;         // smallest sub-increment (fraction of a step) before giving up
   double constraint_tolerance = 1e-8;  // |mean J - 1|, |mean (I4 - 1)/2| after the multiplier updates
   // analysis: dynamic (inertia; forming/solve/dynamic_solver.hpp). The load factor is
   // then t / end_time and the steps are output intervals of end_time / steps.
   bool dynamic = false;
-  double end_time = 1.0;         // s
-  double time_step = 0.0;        // s, first (and largest) time step; 0 = end_time / (10 steps)
+  double end_time = 1.0;                         // s
+  double time_step = 0.0;                        // s, first (and largest) time step; 0 = end_time / (10 steps)
   std::string integrator = "generalized-alpha";  // | hht-alpha | newmark
-  double rho_inf = 0.8;          // generalised-alpha high-frequency spectral radius
+  double rho_inf = 0.8;                          // generalised-alpha high-frequency spectral radius
   // control: arc_length (static only): the load factor is an unknown and each step
   // advances a fixed path length (mm) through limit points
   // (forming/solve/arc_length.hpp); steps is then the maximum number of arc-length
   // steps, the run ends past lambda 1.
-  double arc_length = 0.0;       // mm; 0 = load control
+  double arc_length = 0.0;         // mm; 0 = load control
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
   // Load control: the process time of the load factor (t = lambda process_time, s):
   // tools move with it and friction takes its slip rates over it.
-  double process_time = 1.0;     // s
-  SourcePlace analysis_place;      // of the value of "analysis" (cross-field problems); 0: not given
-  SourcePlace control_place;       // of the value of "control"; 0: not given
+  double process_time = 1.0;   // s
+  SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
+  SourcePlace control_place;   // of the value of "control"; 0: not given
 };
 
 // A laminate: plies of one rectangle and mesh stacked bottom first, each its own body
@@ -161,23 +161,23 @@ struct CaseSolver {
 // neighbours (top of ply k against the bottom of ply k + 1; in spec.contacts).
 struct CaseLaminate {
   std::string name;
-  std::string layup;            // as given (a string), or "list" for an explicit list
-  std::vector<double> angles;   // degrees, bottom first
-  int first_ply = 0;            // index of ply 1 in spec.plies
+  std::string layup;           // as given (a string), or "list" for an explicit list
+  std::vector<double> angles;  // degrees, bottom first
+  int first_ply = 0;           // index of ply 1 in spec.plies
   SourcePlace place;
 };
 
 // The laws of one contact pair (forming/contact/contact_law.hpp).
 struct CaseContactLaw {
-  NormalLaw normal;    // stiffness S_n (N/mm^3), augmented + tolerance (mm)
+  NormalLaw normal;      // stiffness S_n (N/mm^3), augmented + tolerance (mm)
   FrictionLaw friction;  // viscous c_f (N s/mm^3), coulomb mu, stick_velocity (mm/s), engage_gap (mm)
-  int points = 6;      // contact points per face direction
+  int points = 6;        // contact points per face direction
 };
 
 struct CaseTool {
   std::string name;
-  RigidTool tool;      // shape at rest and motion
-  std::string file;    // mesh tools: the STL as resolved (relative to the case file)
+  RigidTool tool;    // shape at rest and motion
+  std::string file;  // mesh tools: the STL as resolved (relative to the case file)
   SourcePlace place;
 };
 
@@ -186,11 +186,11 @@ struct CaseTool {
 struct CaseContact {
   int ply = -1;
   bool top = true;
-  int tool = -1;        // index into spec.tools, or -1
-  int with = -1;        // index into spec.plies, or -1
+  int tool = -1;  // index into spec.tools, or -1
+  int with = -1;  // index into spec.plies, or -1
   bool with_top = false;
   CaseContactLaw law;
-  std::string label;    // "lam.1/lam.2", "lam.4/punch"
+  std::string label;  // "lam.1/lam.2", "lam.4/punch"
   SourcePlace place;
 };
 

@@ -31,11 +31,16 @@ inline SourcePlace place_of(const YAML::Node& n) {
 inline std::string describe(const YAML::Node& n) {
   if (!n.IsDefined()) return "nothing";
   switch (n.Type()) {
-    case YAML::NodeType::Null: return "null";
-    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a mapping";
-    default: return "nothing";
+    case YAML::NodeType::Null:
+      return "null";
+    case YAML::NodeType::Scalar:
+      return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    default:
+      return "nothing";
   }
 }
 
@@ -113,8 +118,7 @@ class Reader {
     }
     if (v < lo || v > hi) {
       problem(ProblemKind::kOutOfRange, n,
-              what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " +
-                  s);
+              what + ": expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + s);
       return std::nullopt;
     }
     return static_cast<int>(v);
@@ -161,7 +165,7 @@ inline bool pair_of(Reader& r, const YAML::Node& n, const std::string& what) {
 // The required key "ply" of a condition or load: its name and index; false (with a
 // problem recorded) when missing, not a name or not a ply of the case.
 inline bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, const FormingCase& spec, std::string& name,
-            int& index) {
+                   int& index) {
   const YAML::Node p = r.required(b, "ply", what);
   if (!p.IsDefined()) return false;
   const auto text = r.text(p, what + " ply");

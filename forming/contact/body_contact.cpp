@@ -26,7 +26,7 @@ BodyContact::BodyContact(std::string name, const Model& model, ContactSurface sl
     throw InputError("contact " + this->name() + ": both surfaces belong to body " + std::to_string(master_.body()) +
                      " (self-contact is not supported)");
   reach_ = this->options().search_distance > 0.0 ? this->options().search_distance
-                                                  : this->slave().thickness() + master_.thickness();
+                                                 : this->slave().thickness() + master_.thickness();
 }
 
 std::unique_ptr<SurfaceContact::Prepared> BodyContact::prepare(const Eigen::Ref<const VecX>& x,

@@ -50,25 +50,25 @@ namespace sf::forming {
 inline constexpr int kMaxPointFunctions = 32;  // 16 slave + 16 master
 
 struct PointKinematics {
-  int n = 0;        // local functions
-  int n_slave = 0;  // the first n_slave are the slave face's
+  int n = 0;                                              // local functions
+  int n_slave = 0;                                        // the first n_slave are the slave face's
   std::array<double, kMaxPointFunctions> phi{};           // N_a, -M_b
   std::array<double, kMaxPointFunctions> rho1{}, rho2{};  // M_b,1, M_b,2 (0 on slave)
-  double gap = 0.0;                    // mm
-  Vec3 normal = Vec3::UnitZ();         // unit
-  Vec3 gap_gradient = Vec3::UnitZ();   // dg/dx_s (tool); = normal for a body
+  double gap = 0.0;                                       // mm
+  Vec3 normal = Vec3::UnitZ();                            // unit
+  Vec3 gap_gradient = Vec3::UnitZ();                      // dg/dx_s (tool); = normal for a body
   bool tool = true;
-  Mat3 dn_dx = Mat3::Zero();           // tool: d normal / d x_s, 1/mm
+  Mat3 dn_dx = Mat3::Zero();  // tool: d normal / d x_s, 1/mm
   // Body: the master's geometry at the foot point.
   Mat32 T = Mat32::Zero();
   Mat2 M_inv = Mat2::Zero(), H_inv = Mat2::Zero(), kappa = Mat2::Zero();
 };
 
 struct PointRates {
-  bool have = false;                // no rates: friction gives nothing
-  Vec3 relative = Vec3::Zero();     // v_rel, mm/s
-  double inv_dt = 0.0;              // quasi-static: 1 / (t - t_prev); dynamic: 0
-  Vec3 master_d1 = Vec3::Zero();    // m_1, m_2: d v_m / d zeta (body master only)
+  bool have = false;              // no rates: friction gives nothing
+  Vec3 relative = Vec3::Zero();   // v_rel, mm/s
+  double inv_dt = 0.0;            // quasi-static: 1 / (t - t_prev); dynamic: 0
+  Vec3 master_d1 = Vec3::Zero();  // m_1, m_2: d v_m / d zeta (body master only)
   Vec3 master_d2 = Vec3::Zero();
 };
 
@@ -90,9 +90,9 @@ struct LocalContribution {
 
 // What the point carries (outputs, reactions).
 struct PointState {
-  double pressure = 0.0;            // MPa
-  Vec3 slip_rate = Vec3::Zero();    // v_T, mm/s
-  Vec3 shear = Vec3::Zero();        // friction traction on the slave, -c v_T, MPa
+  double pressure = 0.0;          // MPa
+  Vec3 slip_rate = Vec3::Zero();  // v_T, mm/s
+  Vec3 shear = Vec3::Zero();      // friction traction on the slave, -c v_T, MPa
 };
 
 PointState add_contact_point(const PointKinematics& k, const PointLaw& law, const PointRates& rates, double weight,

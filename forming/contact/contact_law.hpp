@@ -37,9 +37,9 @@
 namespace sf::forming {
 
 struct NormalLaw {
-  double stiffness = 0.0;   // S_n, N/mm^3 (> 0)
-  bool augmented = false;   // augmented Lagrangian (Uzawa) on top of the penalty
-  double tolerance = 0.0;   // mm, augmented: largest penetration accepted (> 0)
+  double stiffness = 0.0;  // S_n, N/mm^3 (> 0)
+  bool augmented = false;  // augmented Lagrangian (Uzawa) on top of the penalty
+  double tolerance = 0.0;  // mm, augmented: largest penetration accepted (> 0)
   // Throws sf::InputError naming the field ("contact normal stiffness: ...").
   void validate() const;
 };

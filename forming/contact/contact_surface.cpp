@@ -20,12 +20,18 @@ struct FaceAxes {
 
 FaceAxes face_axes(BrickFace f) {
   switch (f) {
-    case BrickFace::kBottom: return {2, 0.0, 1, 0};
-    case BrickFace::kTop: return {2, 1.0, 0, 1};
-    case BrickFace::kXi1Min: return {0, 0.0, 2, 1};
-    case BrickFace::kXi1Max: return {0, 1.0, 1, 2};
-    case BrickFace::kXi2Min: return {1, 0.0, 0, 2};
-    case BrickFace::kXi2Max: return {1, 1.0, 2, 0};
+    case BrickFace::kBottom:
+      return {2, 0.0, 1, 0};
+    case BrickFace::kTop:
+      return {2, 1.0, 0, 1};
+    case BrickFace::kXi1Min:
+      return {0, 0.0, 2, 1};
+    case BrickFace::kXi1Max:
+      return {0, 1.0, 1, 2};
+    case BrickFace::kXi2Min:
+      return {1, 0.0, 0, 2};
+    case BrickFace::kXi2Max:
+      return {1, 1.0, 2, 0};
   }
   return {2, 1.0, 0, 1};
 }
@@ -72,8 +78,8 @@ FaceBasis::FaceBasis(BrickFace face) : face_(face) {
     const std::array<int, 3> index = {2 * a + k1, 2 * b + k2, c};  // H in xi1, H in xi2, L in xi3
     // The fixed direction's factor: H_i(0) = [i == 0], H_i(1) = [i == 2], L_c(v) = [c == v].
     const int fixed = index[static_cast<std::size_t>(ax.fixed_dir)];
-    const bool active = ax.fixed_dir == 2 ? fixed == static_cast<int>(ax.fixed_at)
-                                          : fixed == (ax.fixed_at == 0.0 ? 0 : 2);
+    const bool active =
+        ax.fixed_dir == 2 ? fixed == static_cast<int>(ax.fixed_at) : fixed == (ax.fixed_at == 0.0 ? 0 : 2);
     if (!active) continue;
     brick_[static_cast<std::size_t>(n_)] = k;
     is_[static_cast<std::size_t>(n_)] = index[static_cast<std::size_t>(ax.s_dir)];
@@ -131,8 +137,8 @@ ContactSurface::ContactSurface(const Model& model, int body, const std::vector<s
   if (faces.empty()) throw InputError("contact surface: no faces");
   const PlyMesh& ply = model.ply(body);
   thickness_ = ply.thickness();
-  for (BrickFace f : {BrickFace::kBottom, BrickFace::kTop, BrickFace::kXi1Min, BrickFace::kXi1Max,
-                      BrickFace::kXi2Min, BrickFace::kXi2Max})
+  for (BrickFace f : {BrickFace::kBottom, BrickFace::kTop, BrickFace::kXi1Min, BrickFace::kXi1Max, BrickFace::kXi2Min,
+                      BrickFace::kXi2Max})
     bases_.emplace_back(f);
   std::map<std::pair<Index, Index>, int> edge_count;
   for (const auto& [e, f] : faces) {
@@ -184,7 +190,8 @@ ContactSurface ContactSurface::whole_face(const Model& model, int body, bool top
   if (body < 0 || body >= model.n_bodies())
     throw InputError("contact surface: body " + std::to_string(body) + " is not in the model");
   std::vector<std::pair<Index, BrickFace>> faces;
-  for (Index e = 0; e < model.ply(body).n_elements(); ++e) faces.emplace_back(e, top ? BrickFace::kTop : BrickFace::kBottom);
+  for (Index e = 0; e < model.ply(body).n_elements(); ++e)
+    faces.emplace_back(e, top ? BrickFace::kTop : BrickFace::kBottom);
   return ContactSurface(model, body, faces);
 }
 

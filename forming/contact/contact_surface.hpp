@@ -39,7 +39,7 @@ namespace sf::forming {
 
 // Values and (s, t)-derivatives of the active functions of one face kind at a point.
 struct FaceBasisValues {
-  int n = 0;                                  // active functions (16 or 8)
+  int n = 0;  // active functions (16 or 8)
   std::array<double, 16> value{}, ds{}, dt{}, dss{}, dst{}, dtt{};
 };
 
@@ -109,9 +109,9 @@ class ContactSurface {
  private:
   int body_ = 0;
   double thickness_ = 0.0;
-  std::vector<FaceBasis> bases_;        // one per BrickFace kind, in enum order
+  std::vector<FaceBasis> bases_;  // one per BrickFace kind, in enum order
   std::vector<SurfaceFace> faces_;
-  std::vector<std::size_t> kind_;       // index into bases_ per face
+  std::vector<std::size_t> kind_;  // index into bases_ per face
 };
 
 // Axis-aligned box of a face's Bezier control points.

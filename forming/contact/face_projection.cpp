@@ -8,8 +8,8 @@
 namespace sf::forming {
 namespace {
 
-constexpr double kTrust = 0.5;        // largest zeta step
-constexpr double kZetaTol = 1e-13;    // converged step
+constexpr double kTrust = 0.5;      // largest zeta step
+constexpr double kZetaTol = 1e-13;  // converged step
 constexpr int kMaxIterations = 40;
 constexpr int kMaxHalvings = 50;
 

@@ -21,11 +21,11 @@ namespace sf::forming {
 
 struct FaceFoot {
   Vec2 zeta = Vec2::Zero();
-  Vec3 x = Vec3::Zero();                                   // x(zeta)
-  Vec3 x1 = Vec3::Zero(), x2 = Vec3::Zero();               // x,s  x,t
+  Vec3 x = Vec3::Zero();                      // x(zeta)
+  Vec3 x1 = Vec3::Zero(), x2 = Vec3::Zero();  // x,s  x,t
   Vec3 x11 = Vec3::Zero(), x12 = Vec3::Zero(), x22 = Vec3::Zero();
-  double distance = 0.0;                                    // |p - x|
-  int exit_edge = -1;      // the bound that stopped it with an outward gradient, or -1
+  double distance = 0.0;  // |p - x|
+  int exit_edge = -1;     // the bound that stopped it with an outward gradient, or -1
   bool converged = false;
 };
 

@@ -56,9 +56,12 @@ ToolMotion ToolMotion::table(std::vector<std::pair<double, Vec3>> points) {
 
 Vec3 ToolMotion::displacement(double t) const {
   switch (kind_) {
-    case Kind::kFixed: return Vec3::Zero();
-    case Kind::kRamped: return value_ * ramp_value(ramp_, t / duration_);
-    case Kind::kVelocity: return value_ * t;
+    case Kind::kFixed:
+      return Vec3::Zero();
+    case Kind::kRamped:
+      return value_ * ramp_value(ramp_, t / duration_);
+    case Kind::kVelocity:
+      return value_ * t;
     case Kind::kTable: {
       if (t <= table_.front().first) return table_.front().second;
       if (t >= table_.back().first) return table_.back().second;
@@ -74,9 +77,12 @@ Vec3 ToolMotion::displacement(double t) const {
 
 Vec3 ToolMotion::velocity(double t) const {
   switch (kind_) {
-    case Kind::kFixed: return Vec3::Zero();
-    case Kind::kRamped: return value_ * ramp_rate(ramp_, t / duration_) / duration_;
-    case Kind::kVelocity: return value_;
+    case Kind::kFixed:
+      return Vec3::Zero();
+    case Kind::kRamped:
+      return value_ * ramp_rate(ramp_, t / duration_) / duration_;
+    case Kind::kVelocity:
+      return value_;
     case Kind::kTable: {
       if (table_.size() < 2 || t < table_.front().first || t >= table_.back().first) return Vec3::Zero();
       const auto it = std::upper_bound(table_.begin(), table_.end(), t,
@@ -92,12 +98,17 @@ Vec3 ToolMotion::velocity(double t) const {
 std::string ToolMotion::describe() const {
   std::ostringstream os;
   switch (kind_) {
-    case Kind::kFixed: return "fixed";
+    case Kind::kFixed:
+      return "fixed";
     case Kind::kRamped:
       os << "ramped " << vec(value_) << " mm over " << duration_ << " s (" << to_string(ramp_) << ")";
       break;
-    case Kind::kVelocity: os << "constant velocity " << vec(value_) << " mm/s"; break;
-    case Kind::kTable: os << "table of " << table_.size() << " points"; break;
+    case Kind::kVelocity:
+      os << "constant velocity " << vec(value_) << " mm/s";
+      break;
+    case Kind::kTable:
+      os << "table of " << table_.size() << " points";
+      break;
   }
   return os.str();
 }

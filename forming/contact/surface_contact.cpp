@@ -94,8 +94,8 @@ double SurfaceContact::engage_gap() const {
   return options_.friction.engage_gap >= 0.0 ? options_.friction.engage_gap : kEngage * slave_.thickness();
 }
 
-void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
-                              InteractionSums* sums, std::vector<ContactPointRecord>* records) const {
+void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums* sums,
+                              std::vector<ContactPointRecord>* records) const {
   const bool tangent = sums && sums->stiffness;
   const bool damping = sums && sums->damping && context.velocity;
   // Rates: velocities, or finite differences from the previous state.

@@ -46,17 +46,17 @@ struct ContactOptions {
 
 // What one contact point carries, for outputs and reactions.
 struct ContactPointRecord {
-  Index face = 0;                  // slave face
-  Vec2 st = Vec2::Zero();          // its face coordinates
-  Vec3 position = Vec3::Zero();    // current, mm
-  bool partner = false;            // has a foot point on the partner within reach
-  double gap = 0.0;                // mm (partner only)
-  double pressure = 0.0;           // MPa
-  Vec3 normal = Vec3::Zero();      // the partner's outward normal there
-  Vec3 slip_rate = Vec3::Zero();   // mm/s
-  Vec3 shear = Vec3::Zero();       // friction traction on the slave, MPa
-  Vec3 slip = Vec3::Zero();        // accumulated (committed), mm
-  double weight = 0.0;             // mm^2
+  Index face = 0;                 // slave face
+  Vec2 st = Vec2::Zero();         // its face coordinates
+  Vec3 position = Vec3::Zero();   // current, mm
+  bool partner = false;           // has a foot point on the partner within reach
+  double gap = 0.0;               // mm (partner only)
+  double pressure = 0.0;          // MPa
+  Vec3 normal = Vec3::Zero();     // the partner's outward normal there
+  Vec3 slip_rate = Vec3::Zero();  // mm/s
+  Vec3 shear = Vec3::Zero();      // friction traction on the slave, MPa
+  Vec3 slip = Vec3::Zero();       // accumulated (committed), mm
+  double weight = 0.0;            // mm^2
 };
 
 class SurfaceContact : public Interaction {
@@ -67,8 +67,7 @@ class SurfaceContact : public Interaction {
 
   std::string name() const override { return name_; }
   bool needs_velocity() const override { return options_.friction.active(); }
-  void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
-              InteractionSums& sums) const override;
+  void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums& sums) const override;
   void commit(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
   MultiplierUpdate update_multipliers(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
 
@@ -120,9 +119,9 @@ class SurfaceContact : public Interaction {
   ContactOptions options_;
   quadrature::TensorRule<2> rule_;
   std::vector<std::vector<FaceBasisValues>> point_basis_;  // per face: the basis at each point
-  std::vector<double> weight_;                               // per point: Gauss weight x reference area
-  std::vector<double> lambda_;                               // per point, MPa
-  std::vector<Vec3> slip_;                                   // per point, mm
+  std::vector<double> weight_;                             // per point: Gauss weight x reference area
+  std::vector<double> lambda_;                             // per point, MPa
+  std::vector<Vec3> slip_;                                 // per point, mm
   double dissipated_ = 0.0;
   int updates_ = 0;
 };

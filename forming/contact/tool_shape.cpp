@@ -11,7 +11,7 @@
 namespace sf::forming {
 namespace {
 
-constexpr int kAround = 48;   // tessellation segments around a shape of revolution
+constexpr int kAround = 48;  // tessellation segments around a shape of revolution
 constexpr int kFilletSegments = 8;
 
 void require_positive(double v, const std::string& what) {
@@ -79,8 +79,8 @@ ToolPoint rounded_corner(const Coordinate& u, const Coordinate& w, double r) {
     const Vec3 n = (u.value * u.gradient + w.value * w.gradient) / sd;
     t.gap = sd - r;
     t.normal = n;
-    t.normal_gradient = (u.gradient * u.gradient.transpose() + u.value * u.hessian + w.gradient * w.gradient.transpose() +
-                         w.value * w.hessian - n * n.transpose()) /
+    t.normal_gradient = (u.gradient * u.gradient.transpose() + u.value * u.hessian +
+                         w.gradient * w.gradient.transpose() + w.value * w.hessian - n * n.transpose()) /
                         sd;
   } else {
     const Coordinate& c = (w.value <= 0.0 && (u.value > 0.0 || u.value > w.value)) ? u : w;
@@ -133,7 +133,9 @@ ToolTessellation revolve(const Vec3& p, const Vec3& a, const std::vector<std::pa
     const std::vector<Index>& r0 = rings[i];
     const std::vector<Index>& r1 = rings[i + 1];
     for (int k = 0; k < kAround; ++k) {
-      const auto at = [](const std::vector<Index>& r, int j) { return r[r.size() == 1 ? 0 : std::size_t(j % kAround)]; };
+      const auto at = [](const std::vector<Index>& r, int j) {
+        return r[r.size() == 1 ? 0 : std::size_t(j % kAround)];
+      };
       const Index a0 = at(r0, k), a1 = at(r0, k + 1), b0 = at(r1, k), b1 = at(r1, k + 1);
       if (a0 != a1) out.triangles.push_back({a0, a1, b1});
       if (b0 != b1) out.triangles.push_back({a0, b1, b0});
@@ -220,7 +222,8 @@ class Sphere final : public ToolShape {
 
 class Cylinder final : public ToolShape {
  public:
-  Cylinder(const Vec3& point, const Vec3& axis, double radius) : p_(point), a_(unit(axis, "cylinder axis")), r_(radius) {
+  Cylinder(const Vec3& point, const Vec3& axis, double radius)
+      : p_(point), a_(unit(axis, "cylinder axis")), r_(radius) {
     require_finite(point, "cylinder point");
     require_positive(radius, "cylinder radius");
   }

@@ -79,10 +79,10 @@ std::shared_ptr<const ToolShape> make_sphere(const Vec3& centre, double radius);
 std::shared_ptr<const ToolShape> make_cylinder(const Vec3& point, const Vec3& axis, double radius);
 std::shared_ptr<const ToolShape> make_punch(const Vec3& tip, const Vec3& axis, double radius, double fillet);
 struct DieOpening {
-  bool slot = false;                 // false: circular opening
-  double radius = 0.0;               // circle, mm
-  double half_width = 0.0;           // slot, mm
-  Vec3 along = Vec3::UnitY();        // slot direction (in the top face)
+  bool slot = false;           // false: circular opening
+  double radius = 0.0;         // circle, mm
+  double half_width = 0.0;     // slot, mm
+  Vec3 along = Vec3::UnitY();  // slot direction (in the top face)
 };
 std::shared_ptr<const ToolShape> make_die(const Vec3& centre, const Vec3& normal, const DieOpening& opening,
                                           double edge_radius);

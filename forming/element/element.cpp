@@ -56,7 +56,7 @@ struct ConstraintAccumulator {
   double int_j = 0.0, int_t = 0.0;  // integrals of J - 1 and (I4 - 1)/2
   Eigen::Matrix<double, ND, 1> grad_j = Eigen::Matrix<double, ND, 1>::Zero();
   Eigen::Matrix<double, ND, 1> grad_t = Eigen::Matrix<double, ND, 1>::Zero();
-  MatX hess_j;                                                     // ND x ND
+  MatX hess_j;                                                                      // ND x ND
   Eigen::Matrix<double, NF, NF> hess_t_ss = Eigen::Matrix<double, NF, NF>::Zero();  // integral s s^T
 
   ConstraintAccumulator(const ConstraintTerms& c, const Vec3& fibre, bool tangent)
@@ -78,8 +78,7 @@ struct ConstraintAccumulator {
         for (int l = 0; l < NF; ++l)
           for (int j = 0; j < D; ++j)
             for (int k = 0; k < NF; ++k)
-              for (int i = 0; i < D; ++i)
-                hess_j(D * k + i, D * l + j) += w * (n(k, i) * n(l, j) - n(k, j) * n(l, i));
+              for (int i = 0; i < D; ++i) hess_j(D * k + i, D * l + j) += w * (n(k, i) * n(l, j) - n(k, j) * n(l, i));
       }
     }
     if (inextensible) {
@@ -126,8 +125,7 @@ struct ConstraintAccumulator {
 template <class Basis, int D>
 ElementResult integrate(const Eigen::Matrix<double, Basis::kNumFunctions, D>& X_e,
                         const Eigen::Matrix<double, Basis::kNumFunctions, D>& x_e, const Material& material,
-                        const quadrature::TensorRule<D>& rule, bool want_tangent,
-                        const ConstraintTerms& constraints) {
+                        const quadrature::TensorRule<D>& rule, bool want_tangent, const ConstraintTerms& constraints) {
   constexpr int NF = Basis::kNumFunctions;
   constexpr int ND = D * NF;
   constraints.validate();
@@ -309,14 +307,13 @@ template <int W>
   }
 }
 
-#define SF_BRICK_KERNEL_VARIANTS(attr, suffix, W)                                                                 \
-  attr double point_kinematics_##suffix(const double* dxi, const double* X, const double* x, double* gt,          \
-                                        double* F) {                                                              \
-    return point_kinematics<W>(dxi, X, x, gt, F);                                                                \
-  }                                                                                                               \
-  attr void point_rows_##suffix(const double* gt, const double* F, const double* S, const double* CC, double dv,  \
-                                bool tangent, double* f, double* b, double* d, double* ga, double* gb) {         \
-    point_rows<W>(gt, F, S, CC, dv, tangent, f, b, d, ga, gb);                                                   \
+#define SF_BRICK_KERNEL_VARIANTS(attr, suffix, W)                                                                     \
+  attr double point_kinematics_##suffix(const double* dxi, const double* X, const double* x, double* gt, double* F) { \
+    return point_kinematics<W>(dxi, X, x, gt, F);                                                                     \
+  }                                                                                                                   \
+  attr void point_rows_##suffix(const double* gt, const double* F, const double* S, const double* CC, double dv,      \
+                                bool tangent, double* f, double* b, double* d, double* ga, double* gb) {              \
+    point_rows<W>(gt, F, S, CC, dv, tangent, f, b, d, ga, gb);                                                        \
   }
 SF_BRICK_KERNEL_VARIANTS(SF_SIMD_AVX512, avx512, 8)
 SF_BRICK_KERNEL_VARIANTS(SF_SIMD_AVX2, avx2, 4)
@@ -368,9 +365,8 @@ double BrickKernel::tangent_flops() const {
   return force_flops() + rows + linalg::add_atb_lower_flops(kNd, 6 * nq) + linalg::add_atb_lower_flops(kNf, 3 * nq);
 }
 
-void BrickKernel::evaluate(const BrickParams& X_e, const BrickParams& x_e, const Material& material,
-                           bool want_tangent, const ConstraintTerms& constraints, BrickScratch& scratch,
-                           ElementResult& out) const {
+void BrickKernel::evaluate(const BrickParams& X_e, const BrickParams& x_e, const Material& material, bool want_tangent,
+                           const ConstraintTerms& constraints, BrickScratch& scratch, ElementResult& out) const {
   constraints.validate();
   const Vec3 a0 = material.fibre_direction();
   if (constraints.inextensible && !(a0.norm() > 0.0))

@@ -127,9 +127,9 @@ struct ElementResult {
     kInverted,           // det F <= 0 at a Gauss point: the current state is not admissible
   };
   Status status = Status::kOk;
-  double energy = 0.0;  // N mm (= integral of W over the element)
-  VecX force;           // D NF, N (internal force, dE/dx)
-  MatX tangent;         // D NF x D NF, N/mm (empty unless asked for)
+  double energy = 0.0;     // N mm (= integral of W over the element)
+  VecX force;              // D NF, N (internal force, dE/dx)
+  MatX tangent;            // D NF x D NF, N/mm (empty unless asked for)
   double min_det_f = 0.0;  // smallest det F over the Gauss points
   // Constraint terms (zero unless ConstraintTerms::active(); the energy, force and
   // tangent above already include them):

@@ -30,9 +30,9 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 struct MaterialResponse {
-  double energy = 0.0;        // W, MPa (energy per unit reference volume)
-  Mat3 stress = Mat3::Zero();  // S, second Piola-Kirchhoff, MPa
-  Mat6 tangent = Mat6::Zero(); // CC = 4 d2W/dCdC in Voigt form, MPa
+  double energy = 0.0;          // W, MPa (energy per unit reference volume)
+  Mat3 stress = Mat3::Zero();   // S, second Piola-Kirchhoff, MPa
+  Mat6 tangent = Mat6::Zero();  // CC = 4 d2W/dCdC in Voigt form, MPa
 };
 
 class Material {
@@ -46,8 +46,8 @@ class Material {
 };
 
 // Symmetric 3x3 <-> Voigt (11, 22, 33, 12, 23, 13).
-Vec6 voigt_stress(const Mat3& s);          // plain components
-Vec6 voigt_strain(const Mat3& e);          // shear components doubled
+Vec6 voigt_stress(const Mat3& s);  // plain components
+Vec6 voigt_strain(const Mat3& e);  // shear components doubled
 Mat3 from_voigt_stress(const Vec6& v);
 
 // Fibre direction of a ply from its layup angle theta (degrees, in the ply plane x-y,

@@ -41,8 +41,7 @@ NeoHookeanParams NeoHookeanParams::from_shear_bulk(double mu, double kappa) {
 void NeoHookeanParams::validate() const {
   require_positive(kNeoHookean, "mu", mu);
   require_finite(kNeoHookean, "lambda", lambda);
-  if (!(bulk_modulus() > 0.0))
-    bad_parameter(kNeoHookean, "lambda", "lambda > -2 mu/3 (positive bulk modulus)", lambda);
+  if (!(bulk_modulus() > 0.0)) bad_parameter(kNeoHookean, "lambda", "lambda > -2 mu/3 (positive bulk modulus)", lambda);
 }
 
 NeoHookean::NeoHookean(const NeoHookeanParams& params) : params_(params) { params_.validate(); }

@@ -28,8 +28,7 @@ Mat6 d2_i5(const Vec3& a) {
     const int i = kVoigtPair[I][0], j = kVoigtPair[I][1];
     for (int K = 0; K < 6; ++K) {
       const int k = kVoigtPair[K][0], l = kVoigtPair[K][1];
-      m(I, K) = 0.5 * (a[i] * a[k] * d(j, l) + a[i] * a[l] * d(j, k) + a[j] * a[k] * d(i, l) +
-                       a[j] * a[l] * d(i, k));
+      m(I, K) = 0.5 * (a[i] * a[k] * d(j, l) + a[i] * a[l] * d(j, k) + a[j] * a[k] * d(i, l) + a[j] * a[l] * d(i, k));
     }
   }
   return m;
@@ -54,10 +53,10 @@ void TransverselyIsotropicParams::validate() const {
   // positive definite exactly when E_L > 0 (Sherman-Morrison on the fibre term).
   const double e_l = small_strain_moduli(*this).E_L;
   if (!(e_l > 0.0))
-    bad_parameter(kTi, "kappa_f",
-                  "a value giving a positive fibre modulus E_L (found E_L = " + fmt(e_l) +
-                      " MPa; mu_L is far below mu_T)",
-                  kappa_f);
+    bad_parameter(
+        kTi, "kappa_f",
+        "a value giving a positive fibre modulus E_L (found E_L = " + fmt(e_l) + " MPa; mu_L is far below mu_T)",
+        kappa_f);
 }
 
 TransverselyIsotropicModuli small_strain_moduli(const TransverselyIsotropicParams& p) {
@@ -88,8 +87,7 @@ void TransverselyIsotropicEngineering::validate() const {
   if (incompressible) {
     require_finite(kTiEng, "G_T", G_T);
     if (G_T != 0.0)
-      bad_parameter(kTiEng, "G_T",
-                    "0 for the incompressible law (G_T follows: E_f E_T / (4 E_f - E_T))", G_T);
+      bad_parameter(kTiEng, "G_T", "0 for the incompressible law (G_T follows: E_f E_T / (4 E_f - E_T))", G_T);
   } else {
     require_positive(kTiEng, "G_T", G_T);
   }
@@ -101,12 +99,10 @@ TransverselyIsotropicParams TransverselyIsotropicEngineering::to_params() const 
   p.incompressible = incompressible;
   p.mu_L = G_L;
   if (incompressible) {
-    if (!(E_T < 4.0 * E_f))
-      bad_parameter(kTiEng, "E_T", "E_T < 4 E_f for the incompressible law", E_T);
+    if (!(E_T < 4.0 * E_f)) bad_parameter(kTiEng, "E_T", "E_T < 4 E_f for the incompressible law", E_T);
     p.mu_T = E_f * E_T / (4.0 * E_f - E_T);
     p.kappa_f = 0.5 * (E_f + p.mu_T - 4.0 * G_L);
-    if (!(p.kappa_f >= 0.0))
-      bad_parameter(kTiEng, "G_L", "G_L <= (E_f + G_T)/4 with G_T = " + fmt(p.mu_T), G_L);
+    if (!(p.kappa_f >= 0.0)) bad_parameter(kTiEng, "G_L", "G_L <= (E_f + G_T)/4 with G_T = " + fmt(p.mu_T), G_L);
   } else {
     const double mu = G_T;
     const double nu = E_T / (2.0 * G_T) - 1.0;  // transverse Poisson ratio nu_TT
@@ -142,20 +138,18 @@ TransverselyIsotropicParams TransverselyIsotropicEngineering::to_params() const 
       }
     }
     if (!found)
-      bad_parameter(kTiEng, "E_T",
-                    "a value reachable with E_f = " + fmt(E_f) +
-                        " and G_T = " + fmt(G_T) + " (no positive definite lambda)",
-                    E_T);
+      bad_parameter(
+          kTiEng, "E_T",
+          "a value reachable with E_f = " + fmt(E_f) + " and G_T = " + fmt(G_T) + " (no positive definite lambda)",
+          E_T);
     if (!(p.kappa_f >= 0.0))
-      bad_parameter(kTiEng, "G_L",
-                    "a smaller value (kappa_f = " + fmt(p.kappa_f) + " < 0)", G_L);
+      bad_parameter(kTiEng, "G_L", "a smaller value (kappa_f = " + fmt(p.kappa_f) + " < 0)", G_L);
   }
   p.validate();
   return p;
 }
 
-TransverselyIsotropic::TransverselyIsotropic(const TransverselyIsotropicParams& params,
-                                             const Vec3& a0)
+TransverselyIsotropic::TransverselyIsotropic(const TransverselyIsotropicParams& params, const Vec3& a0)
     : params_(params) {
   params_.validate();
   const double n = a0.norm();
@@ -164,8 +158,7 @@ TransverselyIsotropic::TransverselyIsotropic(const TransverselyIsotropicParams& 
 }
 
 std::string TransverselyIsotropic::name() const {
-  return params_.incompressible ? "transversely isotropic (incompressible)"
-                                : "transversely isotropic (compressible)";
+  return params_.incompressible ? "transversely isotropic (incompressible)" : "transversely isotropic (compressible)";
 }
 
 MaterialResponse TransverselyIsotropic::evaluate(const Mat3& C, bool want_tangent) const {
@@ -180,10 +173,9 @@ MaterialResponse TransverselyIsotropic::evaluate(const Mat3& C, bool want_tangen
   const Mat3 ab = a * b.transpose();
 
   MaterialResponse r;
-  r.energy = 0.5 * p.mu_T * (C.trace() - 3.0) + 0.5 * c * (i5 - 2.0 * i4 + 1.0) +
-             0.25 * p.kappa_f * (i4 - 1.0) * (i4 - 1.0);
-  r.stress = p.mu_T * Mat3::Identity() + c * (ab + ab.transpose() - 2.0 * A) +
-             p.kappa_f * (i4 - 1.0) * A;
+  r.energy =
+      0.5 * p.mu_T * (C.trace() - 3.0) + 0.5 * c * (i5 - 2.0 * i4 + 1.0) + 0.25 * p.kappa_f * (i4 - 1.0) * (i4 - 1.0);
+  r.stress = p.mu_T * Mat3::Identity() + c * (ab + ab.transpose() - 2.0 * A) + p.kappa_f * (i4 - 1.0) * A;
   if (want_tangent) r.tangent = 2.0 * p.kappa_f * outer(A, A) + 2.0 * c * d2_i5(a);
 
   if (!p.incompressible) {

@@ -70,8 +70,8 @@ struct TransverselyIsotropicParams {
   double mu_L = 0.0;     // longitudinal shear modulus G_L, MPa (> 0)
   double kappa_f = 0.0;  // fibre-stretch modulus, MPa (>= 0)
   bool incompressible = true;
-  double lambda = 0.0;   // compressible only: Lame's first parameter of the matrix, MPa
-                         // (matrix bulk modulus lambda + 2 mu_T / 3 > 0)
+  double lambda = 0.0;  // compressible only: Lame's first parameter of the matrix, MPa
+                        // (matrix bulk modulus lambda + 2 mu_T / 3 > 0)
 
   // Throws sf::InputError naming the bad parameter ("transversely isotropic mu_T: ...");
   // also rejects constants whose small-strain stiffness is not positive definite

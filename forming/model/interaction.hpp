@@ -63,11 +63,11 @@ struct InteractionContext {
 // Running sums of one assembly that interactions add to.
 struct InteractionSums {
   bool ok = true;
-  std::string message;                             // why the state is inadmissible
-  double energy = 0.0;                             // N mm
-  VecX force;                                      // n_dofs, N
-  linalg::TripletAssembler* stiffness = nullptr;   // d force / dx, or null: not wanted
-  linalg::TripletAssembler* damping = nullptr;     // d force / dv, or null: not wanted
+  std::string message;                            // why the state is inadmissible
+  double energy = 0.0;                            // N mm
+  VecX force;                                     // n_dofs, N
+  linalg::TripletAssembler* stiffness = nullptr;  // d force / dx, or null: not wanted
+  linalg::TripletAssembler* damping = nullptr;    // d force / dv, or null: not wanted
 };
 
 // Reaction on a tool: the resultant force the bodies exert on it (N) and where the tool

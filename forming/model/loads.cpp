@@ -160,7 +160,8 @@ ExternalLoad LoadSet::assemble(const Model& model, const Eigen::Ref<const VecX>&
       const BrickPositions Xe = ply.element_parameters(e, fields.reference[bf.body]);
       Eigen::Matrix<double, kBrickDofs, 1> fe = Eigen::Matrix<double, kBrickDofs, 1>::Zero();
       for (int q = 0; q < rule.size(); ++q) {
-        const basis::BrickValues bv = basis::BicubicHermiteLinear::evaluate(rule.points[q], basis::kValues | basis::kFirst);
+        const basis::BrickValues bv =
+            basis::BicubicHermiteLinear::evaluate(rule.points[q], basis::kValues | basis::kFirst);
         const Mat3 g = Xe.transpose() * bv.first;
         const double dv = rule.weights[q] * g.determinant();
         for (int kf = 0; kf < kBrickFunctions; ++kf) fe.segment<3>(3 * kf) += (dv * bv.value[kf]) * bf.force_density;
@@ -192,8 +193,10 @@ ExternalLoad RampedLoads::at(const Model& model, double lambda, const VecX& x, b
     ExternalLoad l = set.assemble(model, x, factor, want_tangent);
     out.force += l.force;
     if (l.tangent.size() == 0) continue;
-    if (out.tangent.size() == 0) out.tangent = std::move(l.tangent);
-    else out.tangent += l.tangent;
+    if (out.tangent.size() == 0)
+      out.tangent = std::move(l.tangent);
+    else
+      out.tangent += l.tangent;
   }
   return out;
 }

@@ -94,8 +94,9 @@ std::vector<Model::ConstraintState> Model::constraint_state(int body, const Eige
   if (!b.constraints.active()) return out;
   const MatX xb = PlyMesh::unflatten(x.segment(b.offset, b.ply.n_dofs()));
   for (Index e = 0; e < b.ply.n_elements(); ++e) {
-    const ElementResult r = brick_element(b.ply.element_parameters(e, b.ply.reference()), b.ply.element_parameters(e, xb),
-                                          *b.material, brick_rule_, false, element_constraints(b, e));
+    const ElementResult r =
+        brick_element(b.ply.element_parameters(e, b.ply.reference()), b.ply.element_parameters(e, xb), *b.material,
+                      brick_rule_, false, element_constraints(b, e));
     out.push_back({r.g_J, r.g_T, r.p_eff, r.T_eff, r.volume});
   }
   return out;
@@ -149,7 +150,8 @@ Assembly Model::assemble(const Eigen::Ref<const VecX>& x, const InteractionConte
 
 linalg::PatternAssembler Model::make_pattern(const std::vector<bool>& active, bool symmetric) const {
   SF_ASSERT(static_cast<Index>(active.size()) == n_dofs_, "one flag per dof");
-  return linalg::PatternAssembler(n_dofs_, active, entries_, symmetric ? linalg::Storage::kLower : linalg::Storage::kFull);
+  return linalg::PatternAssembler(n_dofs_, active, entries_,
+                                  symmetric ? linalg::Storage::kLower : linalg::Storage::kFull);
 }
 
 namespace {
@@ -209,7 +211,8 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
         double* xe = w.x_e.data();  // column-major 32 x 3: entry 3 k + i at k + 32 i
         for (int a = 0; a < m; ++a) {
           const int l = en.local[static_cast<std::size_t>(a)];
-          xe[l / 3 + kBrickFunctions * (l % 3)] += en.coefs[static_cast<std::size_t>(a)] * xp[en.dofs[static_cast<std::size_t>(a)]];
+          xe[l / 3 + kBrickFunctions * (l % 3)] +=
+              en.coefs[static_cast<std::size_t>(a)] * xp[en.dofs[static_cast<std::size_t>(a)]];
         }
         try {
           kernel_.evaluate(reference_params_[static_cast<std::size_t>(g)], w.x_e, *b.material, need_k,
@@ -307,11 +310,12 @@ Assembly Model::assemble_reference(const Eigen::Ref<const VecX>& x, const Intera
     for (Index e = 0; e < b.ply.n_elements(); ++e) {
       const BrickParams X_e = b.ply.element_parameters(e, b.ply.reference());
       const BrickParams x_e = b.ply.element_parameters(e, xb);
-      const ElementResult r = brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent, element_constraints(b, e));
+      const ElementResult r =
+          brick_element(X_e, x_e, *b.material, brick_rule_, want_tangent, element_constraints(b, e));
       if (!r.ok()) {
         out.ok = false;
-        out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " +
-                      to_string(r.status) + " (min det F " + short_number(r.min_det_f) + ")";
+        out.message = "body " + std::to_string(body) + " element " + std::to_string(e) + ": " + to_string(r.status) +
+                      " (min det F " + short_number(r.min_det_f) + ")";
         out.energy = std::numeric_limits<double>::infinity();
         return out;
       }

@@ -44,11 +44,11 @@ namespace sf::forming {
 
 // Result of assembling the model at a state.
 struct Assembly {
-  bool ok = true;                // false: an element or interaction found the state inadmissible (see message)
-  std::string message;           // empty when ok
-  double energy = 0.0;           // stored energy: elements + interactions, N mm
-  double strain_energy = 0.0;    // the elements' part, N mm
-  VecX force;                    // f, n_dofs, N
+  bool ok = true;              // false: an element or interaction found the state inadmissible (see message)
+  std::string message;         // empty when ok
+  double energy = 0.0;         // stored energy: elements + interactions, N mm
+  double strain_energy = 0.0;  // the elements' part, N mm
+  VecX force;                  // f, n_dofs, N
   // |f| of the elements alone, N: the force scale of a state where interactions (contact)
   // balance the elements without external loads, so |f| itself is only the residual.
   double element_force_norm = 0.0;
@@ -99,9 +99,7 @@ class Model {
   const Material& material(int body) const { return *bodies_[body].material; }
   Index offset(int body) const { return bodies_[body].offset; }
   // Global dof of (body, ply node, parameter d, coordinate).
-  Index dof(int body, Index node, int d, int coord) const {
-    return offset(body) + PlyMesh::dof(node, d, coord);
-  }
+  Index dof(int body, Index node, int d, int coord) const { return offset(body) + PlyMesh::dof(node, d, coord); }
   const ElementRule& rule() const { return rule_; }
 
   // Global dofs of brick e of `body`, expanded per (function, map term, coordinate):

@@ -32,8 +32,7 @@ class NodeSpring final : public Interaction {
   NodeSpring(const Model& model, BodyNode a, BodyNode b, double stiffness, double rest_length);
 
   std::string name() const override { return "node spring"; }
-  void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
-              InteractionSums& sums) const override;
+  void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums& sums) const override;
 
   // Current length l (mm) and tension k (l - l0) (N, positive when stretched) at x.
   double length(const Eigen::Ref<const VecX>& x) const;

@@ -30,24 +30,20 @@ Vec3 node_normal(const MatX& geometry, Index node) {
 
 // The checks both constructors make of the ply's own numbers.
 void check_ply_parameters(double thickness, double layup_angle_deg) {
-  require(std::isfinite(thickness) && thickness > 0.0, "thickness: expected a positive length (mm)",
-          thickness);
-  require(std::isfinite(layup_angle_deg), "layup angle: expected a finite angle (degrees)",
-          layup_angle_deg);
+  require(std::isfinite(thickness) && thickness > 0.0, "thickness: expected a positive length (mm)", thickness);
+  require(std::isfinite(layup_angle_deg), "layup angle: expected a finite angle (degrees)", layup_angle_deg);
 }
 
 }  // namespace
 
-PlyMesh::PlyMesh(mesh::SurfaceMesh surface, double thickness, double layup_angle_deg,
-                 PlyPlacement placement)
+PlyMesh::PlyMesh(mesh::SurfaceMesh surface, double thickness, double layup_angle_deg, PlyPlacement placement)
     : surface_(std::move(surface)), thickness_(thickness), layup_angle_deg_(layup_angle_deg) {
   check_ply_parameters(thickness, layup_angle_deg);
-  require(surface_.n_nodes() > 0 && surface_.n_elements() > 0,
-          "surface: expected at least one element; nodes", static_cast<double>(surface_.n_nodes()));
+  require(surface_.n_nodes() > 0 && surface_.n_elements() > 0, "surface: expected at least one element; nodes",
+          static_cast<double>(surface_.n_nodes()));
   const MatX& g = surface_.geometry();
   const Vec3 n0 = node_normal(g, 0);
-  require(n0.norm() > 0.0, "surface: expected independent tangents d/ds1, d/ds2 at node 0; |d1 x d2|",
-          n0.norm());
+  require(n0.norm() > 0.0, "surface: expected independent tangents d/ds1, d/ds2 at node 0; |d1 x d2|", n0.norm());
   const Vec3 normal = n0.normalized();
   // Flatness: every parameter row other than the values lies in the plane, every
   // value on it.
@@ -87,15 +83,14 @@ PlyMesh::PlyMesh(mesh::SurfaceMesh surface, const MatX& bottom, const MatX& top,
   check_ply_parameters(thickness, layup_angle_deg);
   require(bottom.rows() == surface_.n_dofs() && bottom.cols() == 3,
           "bottom geometry: expected surface.n_dofs() x 3 rows; rows", static_cast<double>(bottom.rows()));
-  require(top.rows() == surface_.n_dofs() && top.cols() == 3,
-          "top geometry: expected surface.n_dofs() x 3 rows; rows", static_cast<double>(top.rows()));
+  require(top.rows() == surface_.n_dofs() && top.cols() == 3, "top geometry: expected surface.n_dofs() x 3 rows; rows",
+          static_cast<double>(top.rows()));
   reference_.resize(n_params(), 3);
   reference_.topRows(surface_.n_dofs()) = bottom;
   reference_.bottomRows(surface_.n_dofs()) = top;
   surface_.geometry() = bottom;
   const Vec3 n0 = node_normal(bottom, 0);
-  require(n0.norm() > 0.0, "bottom geometry: expected independent tangents at node 0; |d1 x d2|",
-          n0.norm());
+  require(n0.norm() > 0.0, "bottom geometry: expected independent tangents at node 0; |d1 x d2|", n0.norm());
   set_fibre(n0.normalized());
 }
 
@@ -122,8 +117,8 @@ BrickMap PlyMesh::element_map(Index e) const {
   return map;
 }
 
-Eigen::Matrix<double, kBrickFunctions, 3> PlyMesh::element_parameters(
-    Index e, const Eigen::Ref<const MatX>& field) const {
+Eigen::Matrix<double, kBrickFunctions, 3> PlyMesh::element_parameters(Index e,
+                                                                      const Eigen::Ref<const MatX>& field) const {
   SF_ASSERT(field.rows() == n_params() && field.cols() == 3, "field must be n_params x 3");
   const BrickMap map = element_map(e);
   Eigen::Matrix<double, kBrickFunctions, 3> u = Eigen::Matrix<double, kBrickFunctions, 3>::Zero();

@@ -82,8 +82,7 @@ class PlyMesh {
   // parameters, bottom = xi3 = 0); surface().geometry() becomes `bottom` (the surface's
   // scale factors are kept). `thickness` is recorded (outputs), not used for the
   // geometry; the ply plane for the layup angle is the normal at surface node 0.
-  PlyMesh(mesh::SurfaceMesh surface, const MatX& bottom, const MatX& top, double thickness,
-          double layup_angle_deg);
+  PlyMesh(mesh::SurfaceMesh surface, const MatX& bottom, const MatX& top, double thickness, double layup_angle_deg);
 
   // Topology and scale factors; its geometry is the surface the ply was built from
   // (bottom or mid-surface), reference() holds both layers.
@@ -106,8 +105,7 @@ class PlyMesh {
 
   BrickMap element_map(Index e) const;
   // xi-parameters (32 x 3) of brick e for a position field (n_params x 3).
-  Eigen::Matrix<double, kBrickFunctions, 3> element_parameters(Index e,
-                                                                const Eigen::Ref<const MatX>& field) const;
+  Eigen::Matrix<double, kBrickFunctions, 3> element_parameters(Index e, const Eigen::Ref<const MatX>& field) const;
 
   // Reference geometry X: n_params x 3, mm.
   const MatX& reference() const { return reference_; }

@@ -10,9 +10,12 @@ namespace sf::forming {
 
 std::string to_string(EdgeCondition::Kind kind) {
   switch (kind) {
-    case EdgeCondition::Kind::kClamp: return "clamp";
-    case EdgeCondition::Kind::kDisplacement: return "displacement";
-    case EdgeCondition::Kind::kSymmetry: return "symmetry";
+    case EdgeCondition::Kind::kClamp:
+      return "clamp";
+    case EdgeCondition::Kind::kDisplacement:
+      return "displacement";
+    case EdgeCondition::Kind::kSymmetry:
+      return "symmetry";
   }
   return "?";
 }

@@ -53,7 +53,7 @@ struct EdgeCondition {
   Kind kind = Kind::kClamp;
   PlySide side = PlySide::kX0;
   std::array<std::optional<double>, 3> displacement{};  // kDisplacement: mm per component; empty = free
-  Ramp ramp = Ramp::kLinear;                             // kDisplacement
+  Ramp ramp = Ramp::kLinear;                            // kDisplacement
 };
 // "clamp", "displacement", "symmetry" (the case-file names).
 std::string to_string(EdgeCondition::Kind kind);
@@ -66,7 +66,7 @@ struct PrescribedParameter {
   int coord = 0;
   double displacement = 0.0;  // mm for d = 0, 0 for derivative parameters
   Ramp ramp = Ramp::kLinear;
-  int condition = -1;         // index of the condition that prescribed it (the first one)
+  int condition = -1;  // index of the condition that prescribed it (the first one)
 };
 
 // Two conditions (indices, earlier < later) prescribing some parameter differently.

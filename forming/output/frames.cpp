@@ -41,8 +41,8 @@ io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane
         for (int j = 0; j < ns; ++j)
           for (int i = 0; i < ns; ++i) {
             mesh.add_cell(io::CellType::kHexahedron,
-                          {pid(i, j, k), pid(i + 1, j, k), pid(i + 1, j + 1, k), pid(i, j + 1, k),
-                           pid(i, j, k + 1), pid(i + 1, j, k + 1), pid(i + 1, j + 1, k + 1), pid(i, j + 1, k + 1)});
+                          {pid(i, j, k), pid(i + 1, j, k), pid(i + 1, j + 1, k), pid(i, j + 1, k), pid(i, j, k + 1),
+                           pid(i + 1, j, k + 1), pid(i + 1, j + 1, k + 1), pid(i, j + 1, k + 1)});
             const Vec3 xi((i + 0.5) / ns, (j + 0.5) / ns, (k + 0.5) / nt);
             const BrickPoint s = sample_brick(Xe, xe, xi);
             const Mat3 C = s.F.transpose() * s.F;

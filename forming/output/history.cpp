@@ -40,8 +40,9 @@ ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX
 namespace {
 
 std::vector<std::string> history_columns(const Model& model) {
-  std::vector<std::string> cols = {"step", "load_factor", "tool_ux", "tool_uy", "tool_uz", "tool_fx", "tool_fy",
-                                   "tool_fz", "strain_energy", "newton_iterations", "cutbacks", "residual"};
+  std::vector<std::string> cols = {"step",          "load_factor",       "tool_ux",  "tool_uy",
+                                   "tool_uz",       "tool_fx",           "tool_fy",  "tool_fz",
+                                   "strain_energy", "newton_iterations", "cutbacks", "residual"};
   std::vector<ToolReaction> tools;
   const VecX X = model.reference_positions();
   for (int i = 0; i < model.n_interactions(); ++i)

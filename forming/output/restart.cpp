@@ -53,8 +53,9 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
   }
   if (j.value("format", "") != "simform-restart-1") throw InputError(path + ": not a simform restart file");
   if (j.value("fingerprint", "") != model_fingerprint(spec, model))
-    throw InputError(path + ": written for a different model (plies, meshes or materials changed since; only solver, "
-                            "loads and output settings may change for a restart)");
+    throw InputError(path +
+                     ": written for a different model (plies, meshes or materials changed since; only solver, "
+                     "loads and output settings may change for a restart)");
   RestartState s;
   s.step = j.at("step").get<int>();
   s.load_factor = j.at("load_factor").get<double>();

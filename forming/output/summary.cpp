@@ -20,7 +20,9 @@ nlohmann::json loads_json(const FormingCase& spec) {
         e = {{"edge_force_N", {l.vector.x(), l.vector.y(), l.vector.z()}}, {"ply", l.ply}, {"edge", to_string(l.side)}};
         break;
       case CaseLoad::Kind::kPointForce:
-        e = {{"point_force_N", {l.vector.x(), l.vector.y(), l.vector.z()}}, {"ply", l.ply}, {"node", {l.node_i, l.node_j}}};
+        e = {{"point_force_N", {l.vector.x(), l.vector.y(), l.vector.z()}},
+             {"ply", l.ply},
+             {"node", {l.node_i, l.node_j}}};
         break;
     }
     e["ramp"] = to_string(l.ramp);
@@ -49,7 +51,7 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
       mj["mu_L"] = m.ti.mu_L;
       mj["kappa_f"] = m.ti.kappa_f;
       mj["lambda"] = m.ti.lambda;
-      mj["small_strain"] = {{"E_L", mod.E_L}, {"E_T", mod.E_T}, {"G_L", mod.G_L},
+      mj["small_strain"] = {{"E_L", mod.E_L}, {"E_T", mod.E_T},     {"G_L", mod.G_L},
                             {"G_T", mod.G_T}, {"nu_LT", mod.nu_LT}, {"nu_TT", mod.nu_TT}};
     }
     j["materials"].push_back(mj);
@@ -95,9 +97,9 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
   j["command_line"] = run.command_line;
   j["inputs"] = {{"case", spec.file}};
   j["parameters"] = parameters_json(spec, model);
-  j["analysis"] = dynamic ? "dynamic (" + spec.solver.integrator + ", no contact)"
-                 : run.follower_loads ? "quasi-static, follower loads (no contact)"
-                                      : "quasi-static (no contact)";
+  j["analysis"] = dynamic              ? "dynamic (" + spec.solver.integrator + ", no contact)"
+                  : run.follower_loads ? "quasi-static, follower loads (no contact)"
+                                       : "quasi-static (no contact)";
   if (dynamic) j["time"] = {{"end_time_s", spec.solver.end_time}, {"time_s", run.load_factor * spec.solver.end_time}};
   j["multiplier_updates"] = run.multiplier_updates;
   j["status"] = run.status;
@@ -108,9 +110,8 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
   j["load_factor"] = run.load_factor;
   j["final_residual"] = run.final_residual;
   j["newton_iterations"] = run.newton_iterations;
-  j["tool_edge"] = {{"edge", run.tool_label},
-                    {"displacement", vec_json(run.tool_displacement)},
-                    {"force", vec_json(run.tool_force)}};
+  j["tool_edge"] = {
+      {"edge", run.tool_label}, {"displacement", vec_json(run.tool_displacement)}, {"force", vec_json(run.tool_force)}};
   j["max_displacement"] = vec_json(run.max_displacement);
   j["loads"] = loads_json(spec);
   j["timings_s"] = {{"build", run.seconds_build},

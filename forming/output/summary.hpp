@@ -29,23 +29,23 @@ namespace sf::forming {
 // What summary.json says about the run (the case and the model give the rest).
 struct RunSummary {
   std::string command_line;
-  std::string status;              // "converged" | "stopped" | "not_converged"
+  std::string status;  // "converged" | "stopped" | "not_converged"
   std::string message;
-  bool follower_loads = false;     // some load follows the deformation
-  double load_factor = 0.0;        // of the last converged step (dynamic: time / end_time)
-  double final_residual = 0.0;     // N
+  bool follower_loads = false;  // some load follows the deformation
+  double load_factor = 0.0;     // of the last converged step (dynamic: time / end_time)
+  double final_residual = 0.0;  // N
   int newton_iterations = 0;
   int multiplier_updates = 0;
   bool restarted = false;
   double restart_load_factor = 0.0;
   int steps_converged = 0;
   std::string tool_label;
-  Vec3 tool_displacement = Vec3::Zero();  // mm
-  Vec3 tool_force = Vec3::Zero();         // N
-  Vec3 max_displacement = Vec3::Zero();   // mm
+  Vec3 tool_displacement = Vec3::Zero();               // mm
+  Vec3 tool_force = Vec3::Zero();                      // N
+  Vec3 max_displacement = Vec3::Zero();                // mm
   std::vector<std::pair<double, std::string>> frames;  // written frames (load factor, file)
   double seconds_build = 0.0, seconds_solve = 0.0, seconds_write = 0.0, seconds_total = 0.0;
-  std::string grid_out;            // the grid file written, or empty
+  std::string grid_out;  // the grid file written, or empty
 };
 
 // The "parameters" block.

@@ -120,8 +120,7 @@ std::string RunRecorder::progress_line(const StepInfo& step) const {
       os << "  t " << step.time << " s";
     else
       os << "  load factor " << step.load_factor;
-    os << "  Newton " << step.iterations
-       << (step.cutbacks ? " (" + std::to_string(step.cutbacks) + " cut-backs)" : "");
+    os << "  Newton " << step.iterations << (step.cutbacks ? " (" + std::to_string(step.cutbacks) + " cut-backs)" : "");
   }
   os << "  |r| " << sci(step.residual) << " N  max |u| " << sci(report_.max_displacement.norm()) << " mm";
   return os.str();

@@ -60,8 +60,8 @@ class RunRecorder final : public StepObserver {
   // reactions (rates over the last step, or the velocities of a dynamic run).
   InteractionContext context() const;
 
-  SteppingState last_;        // the last converged state (the start until a step converges)
-  SteppingState previous_;    // the one before it
+  SteppingState last_;                            // the last converged state (the start until a step converges)
+  SteppingState previous_;                        // the one before it
   double last_time_ = 0.0, previous_time_ = 0.0;  // s
   bool have_previous_ = false;
   double start_load_factor_ = 0.0;

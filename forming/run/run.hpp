@@ -31,13 +31,13 @@
 namespace sf::forming {
 
 struct RunOptions {
-  std::string out_dir;     // required
-  std::string grid_out;    // empty: no grid file
-  int grid_marks = 21;     // marks per side (>= 2)
-  std::string grid_ply;    // empty: the first ply
-  bool quiet = false;      // no progress lines on stderr
-  bool restart = false;    // continue from out_dir/restart.json (the last written step)
-  int stop_after = 0;      // > 0: stop cleanly after this many steps of this run (restart later)
+  std::string out_dir;   // required
+  std::string grid_out;  // empty: no grid file
+  int grid_marks = 21;   // marks per side (>= 2)
+  std::string grid_ply;  // empty: the first ply
+  bool quiet = false;    // no progress lines on stderr
+  bool restart = false;  // continue from out_dir/restart.json (the last written step)
+  int stop_after = 0;    // > 0: stop cleanly after this many steps of this run (restart later)
   std::string command_line = "simform run";
   // Throws sf::UsageError naming the option.
   void validate() const;
@@ -51,7 +51,7 @@ struct RunReport {
   double load_factor = 0.0;
   double final_residual = 0.0;  // N
   int total_iterations = 0;
-  int multiplier_updates = 0;  // Uzawa updates of the constraint multipliers
+  int multiplier_updates = 0;             // Uzawa updates of the constraint multipliers
   Vec3 tool_displacement = Vec3::Zero();  // last converged step, mm
   Vec3 tool_force = Vec3::Zero();         // N
   Vec3 max_displacement = Vec3::Zero();   // displacement of largest magnitude over the nodes, mm

@@ -46,10 +46,10 @@ struct ArcState {
 
 // An attempted step: the increment from the last converged point and how it went.
 struct ArcStep {
-  VecX dx;              // free dofs, mm
+  VecX dx;  // free dofs, mm
   double dlambda = 0.0;
-  int iterations = 0;   // residual evaluations after the predictor (the last one converged)
-  double rnorm = 0.0;   // |r_f| of the last one, N
+  int iterations = 0;  // residual evaluations after the predictor (the last one converged)
+  double rnorm = 0.0;  // |r_f| of the last one, N
   bool converged = false;
   std::string failure;
 };
@@ -185,7 +185,8 @@ ArcLengthResult solve_arc_length(const Model& model, const Eigen::Ref<const VecX
                      std::to_string(n));
   std::vector<bool> free_dof = model.used_dofs();
   for (const PrescribedDof& p : prescribed) {
-    if (p.dof < 0 || p.dof >= n) throw InputError("arc-length: prescribed dof " + std::to_string(p.dof) + " out of range");
+    if (p.dof < 0 || p.dof >= n)
+      throw InputError("arc-length: prescribed dof " + std::to_string(p.dof) + " out of range");
     free_dof[p.dof] = false;
   }
   Continuation path(model, load, unsymmetric, options, free_dof);

@@ -34,13 +34,13 @@
 namespace sf::forming {
 
 struct ArcLengthOptions {
-  double arc_length = 0.1;      // first Delta l, mm
-  double min_arc = 1e-6;        // give up below this, mm
-  double max_arc = 1.0;         // mm
-  int max_steps = 200;          // converged steps
-  int max_attempts = 400;       // attempted steps (converged + cut back)
-  int max_iterations = 20;      // Newton iterations per attempt
-  int easy_iterations = 5;      // grow Delta l after a step converging in at most this many
+  double arc_length = 0.1;         // first Delta l, mm
+  double min_arc = 1e-6;           // give up below this, mm
+  double max_arc = 1.0;            // mm
+  int max_steps = 200;             // converged steps
+  int max_attempts = 400;          // attempted steps (converged + cut back)
+  int max_iterations = 20;         // Newton iterations per attempt
+  int easy_iterations = 5;         // grow Delta l after a step converging in at most this many
   double residual_tol_rel = 1e-9;  // |r_f| relative to max(|f_int|, |lambda q|)
   double residual_tol_abs = 0.0;   // N
   double max_load_factor = 1e30;   // stop when lambda exceeds this

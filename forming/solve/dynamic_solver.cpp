@@ -65,12 +65,14 @@ void DynamicOptions::validate() const {
   if (!std::isfinite(start_time)) bad_option("start_time", "a finite time (s)", start_time);
   if (!(std::isfinite(end_time) && end_time > start_time))
     bad_option("end_time", "a finite time > start_time (s)", end_time);
-  if (!(std::isfinite(initial_dt) && initial_dt > 0.0)) bad_option("initial_dt", "a finite time step > 0 (s)", initial_dt);
+  if (!(std::isfinite(initial_dt) && initial_dt > 0.0))
+    bad_option("initial_dt", "a finite time step > 0 (s)", initial_dt);
   if (!(min_dt > 0.0 && min_dt <= initial_dt)) bad_option("min_dt", "a time step in (0, initial_dt] (s)", min_dt);
   if (!(std::isfinite(max_dt) && (max_dt == 0.0 || max_dt >= initial_dt)))
     bad_option("max_dt", "0 (= initial_dt) or a finite time step >= initial_dt (s)", max_dt);
   if (!(growth >= 1.0 && std::isfinite(growth))) bad_option("growth", "a finite factor >= 1", growth);
-  if (!(cutback_factor > 0.0 && cutback_factor < 1.0)) bad_option("cutback_factor", "a factor in (0, 1)", cutback_factor);
+  if (!(cutback_factor > 0.0 && cutback_factor < 1.0))
+    bad_option("cutback_factor", "a factor in (0, 1)", cutback_factor);
   if (easy_iterations < 1) bad_option("easy_iterations", "at least 1", easy_iterations);
   if (max_iterations < 1) bad_option("max_iterations", "at least 1", max_iterations);
   if (max_steps < 1) bad_option("max_steps", "at least 1", max_steps);
@@ -84,7 +86,8 @@ void DynamicOptions::validate() const {
       if (!(hht_alpha >= -1.0 / 3.0 && hht_alpha <= 0.0)) bad_option("hht_alpha", "a value in [-1/3, 0]", hht_alpha);
       break;
     case Integrator::kNewmark:
-      if (!(newmark_gamma >= 0.5 && newmark_gamma <= 1.0)) bad_option("newmark_gamma", "a value in [1/2, 1]", newmark_gamma);
+      if (!(newmark_gamma >= 0.5 && newmark_gamma <= 1.0))
+        bad_option("newmark_gamma", "a value in [1/2, 1]", newmark_gamma);
       if (!(newmark_beta > 0.0 && newmark_beta <= 1.0)) bad_option("newmark_beta", "a value in (0, 1]", newmark_beta);
       break;
   }
@@ -154,9 +157,7 @@ class StepClock {
     while (next_hit_ < hits_.size() && hits_[next_hit_] <= t) ++next_hit_;
     const double target = next_hit_ < hits_.size() ? hits_[next_hit_] : options_.end_time;
     const double remaining = target - t;
-    return remaining <= dt_ * (1.0 + kLandingTol) ? target
-           : remaining < 2.0 * dt_               ? t + 0.5 * remaining
-                                                 : t + dt_;
+    return remaining <= dt_ * (1.0 + kLandingTol) ? target : remaining < 2.0 * dt_ ? t + 0.5 * remaining : t + dt_;
   }
   void grow() { dt_ = std::min(max_dt_, dt_ * options_.growth); }
   // After a failed step of length h; false when dt falls below min_dt.
@@ -480,8 +481,8 @@ void TimeIntegration::newton(TimeStep& s, Balance& end, StepRecord& rec) {
       return;
     }
     if (rnorm > options_.divergence_factor * std::max(first_norm, 1e-300)) {
-      rec.failure = "diverged: |R| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) +
-                    " iterations";
+      rec.failure =
+          "diverged: |R| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
       return;
     }
     if (rec.iterations >= options_.max_iterations) {
@@ -555,10 +556,10 @@ void TimeIntegration::accept(const TimeStep& s, const Balance& end, VecX& reacti
 
 }  // namespace
 
-DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass,
-                            const Eigen::Ref<const VecX>& x0, const Eigen::Ref<const VecX>& v0,
-                            const std::vector<TimedDof>& prescribed, const ExternalForceFn& external,
-                            const DynamicOptions& options, const StepCallback& on_step) {
+DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass, const Eigen::Ref<const VecX>& x0,
+                            const Eigen::Ref<const VecX>& v0, const std::vector<TimedDof>& prescribed,
+                            const ExternalForceFn& external, const DynamicOptions& options,
+                            const StepCallback& on_step) {
   options.validate();
   DynamicResult result;
   DynamicReport& report = result.report;
@@ -581,8 +582,8 @@ DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass
   while (run.time() < options.end_time) {
     if (attempts >= options.max_steps) {
       report.status = SolveStatus::kStepFailed;
-      report.message = "max_steps (" + std::to_string(options.max_steps) + ") attempted time steps reached at t = " +
-                       detail::short_number(run.time());
+      report.message = "max_steps (" + std::to_string(options.max_steps) +
+                       ") attempted time steps reached at t = " + detail::short_number(run.time());
       break;
     }
     ++attempts;

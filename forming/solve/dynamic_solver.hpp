@@ -138,23 +138,23 @@ struct IntegratorParameters {
 };
 
 struct DynamicOptions {
-  double start_time = 0.0;   // s
-  double end_time = 1.0;     // s, > start_time
-  double initial_dt = 1e-3;  // s, > 0
-  double min_dt = 1e-12;     // s, cut back below this -> kStepFailed; (0, initial_dt]
-  double max_dt = 0.0;       // s, cap after regrowth; 0 = initial_dt; else >= initial_dt
-  double growth = 1.5;       // dt growth after an easy step, >= 1
-  double cutback_factor = 0.5;  // dt factor after a failed step, (0, 1)
-  int easy_iterations = 4;   // ... i.e. one converging in at most this many Newton solves
-  int max_iterations = 20;   // Newton solves per step
-  int max_steps = 1000000;   // attempted steps in total (converged + cut back)
+  double start_time = 0.0;        // s
+  double end_time = 1.0;          // s, > start_time
+  double initial_dt = 1e-3;       // s, > 0
+  double min_dt = 1e-12;          // s, cut back below this -> kStepFailed; (0, initial_dt]
+  double max_dt = 0.0;            // s, cap after regrowth; 0 = initial_dt; else >= initial_dt
+  double growth = 1.5;            // dt growth after an easy step, >= 1
+  double cutback_factor = 0.5;    // dt factor after a failed step, (0, 1)
+  int easy_iterations = 4;        // ... i.e. one converging in at most this many Newton solves
+  int max_iterations = 20;        // Newton solves per step
+  int max_steps = 1000000;        // attempted steps in total (converged + cut back)
   std::vector<double> hit_times;  // s, steps land exactly on these (outside (start, end] ignored)
 
   Integrator integrator = Integrator::kGeneralizedAlpha;
-  double rho_inf = 1.0;         // generalised-alpha spectral radius at dt -> inf, [0, 1]
-  double hht_alpha = -0.05;     // HHT alpha, [-1/3, 0]
-  double newmark_beta = 0.25;   // Newmark beta, (0, 1]; unconditionally stable if 2 beta >= gamma
-  double newmark_gamma = 0.5;   // Newmark gamma, [1/2, 1]
+  double rho_inf = 1.0;        // generalised-alpha spectral radius at dt -> inf, [0, 1]
+  double hht_alpha = -0.05;    // HHT alpha, [-1/3, 0]
+  double newmark_beta = 0.25;  // Newmark beta, (0, 1]; unconditionally stable if 2 beta >= gamma
+  double newmark_gamma = 0.5;  // Newmark gamma, [1/2, 1]
 
   double residual_tol_rel = 1e-8;  // relative to force_scale
   double residual_tol_abs = 0.0;   // N
@@ -197,9 +197,9 @@ struct DynamicResult {
 
 // Integrates M a + f_int(x) = f_ext(t, x) from (options.start_time, x0, v0) to
 // options.end_time. mass: n_dofs x n_dofs (mass_matrix); x0, v0: n_dofs.
-DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass,
-                            const Eigen::Ref<const VecX>& x0, const Eigen::Ref<const VecX>& v0,
-                            const std::vector<TimedDof>& prescribed, const ExternalForceFn& external,
-                            const DynamicOptions& options = {}, const StepCallback& on_step = {});
+DynamicResult solve_dynamic(const Model& model, const linalg::SparseMatrix& mass, const Eigen::Ref<const VecX>& x0,
+                            const Eigen::Ref<const VecX>& v0, const std::vector<TimedDof>& prescribed,
+                            const ExternalForceFn& external, const DynamicOptions& options = {},
+                            const StepCallback& on_step = {});
 
 }  // namespace sf::forming

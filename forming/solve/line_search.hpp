@@ -9,8 +9,8 @@ namespace sf::forming::detail {
 inline constexpr double kSufficientDecrease = 1e-4;
 
 struct LineSearch {
-  double step = -1.0;     // step to take along the Newton correction; < 0: no trial could be evaluated
-  bool stopped = false;   // norm_at asked to stop (a failure the caller reports)
+  double step = -1.0;    // step to take along the Newton correction; < 0: no trial could be evaluated
+  bool stopped = false;  // norm_at asked to stop (a failure the caller reports)
 };
 
 // Trials at steps 1, 1/2, 1/4, ... (max_halvings + 1 of them). norm_at(step, stop)

@@ -18,8 +18,7 @@ linalg::SparseMatrix mass_matrix(const Model& model, const std::vector<double>& 
   for (int b = 0; b < model.n_bodies(); ++b)
     if (!(std::isfinite(density[b]) && density[b] >= 0.0)) {
       std::ostringstream os;
-      os << "mass matrix density of body " << b << ": expected a finite value >= 0 (t/mm^3), found "
-         << density[b];
+      os << "mass matrix density of body " << b << ": expected a finite value >= 0 (t/mm^3), found " << density[b];
       throw InputError(os.str());
     }
   const quadrature::TensorRule<3> rule = model.rule().brick();
@@ -49,7 +48,8 @@ linalg::SparseMatrix mass_matrix(const Model& model, const std::vector<double>& 
         const double det_g = G.determinant();
         if (!(det_g > 0.0))
           throw InputError("mass matrix: body " + std::to_string(b) + " element " + std::to_string(e) +
-                           " has an inverted reference geometry (det G " + detail::short_number(det_g) + " at a Gauss point)");
+                           " has an inverted reference geometry (det G " + detail::short_number(det_g) +
+                           " at a Gauss point)");
         m_e.noalias() += (rho * rule.weights[q] * det_g) * (values[q].value * values[q].value.transpose());
       }
       const BrickMap map = ply.element_map(e);

@@ -47,8 +47,7 @@ void StaticOptions::validate() const {
   if (!(std::isfinite(clock.start) && std::isfinite(clock.end) && clock.end >= clock.start))
     throw InputError("static solver clock: expected finite times with end >= start (s)");
   if (!linalg::solver_available(linear_solver))
-    throw InputError("static solver linear_solver: '" + linalg::to_string(linear_solver) +
-                     "' is not compiled in");
+    throw InputError("static solver linear_solver: '" + linalg::to_string(linear_solver) + "' is not compiled in");
 }
 
 std::string StaticReport::brief() const {
@@ -70,8 +69,8 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     result.positions = x_start;
     result.reactions = VecX::Zero(model.n_dofs());
     result.report.status = SolveStatus::kInvalidStart;
-    result.report.message = "external force has " + std::to_string(f_ext.size()) + " entries, expected " +
-                            std::to_string(model.n_dofs());
+    result.report.message =
+        "external force has " + std::to_string(f_ext.size()) + " entries, expected " + std::to_string(model.n_dofs());
     return result;
   }
   const VecX dead = f_ext.size() == 0 ? VecX::Zero(model.n_dofs()) : f_ext;
@@ -143,7 +142,7 @@ class LoadStepping {
   const LoadFunction& load_;
   const StaticOptions& options_;
   TangentSolver solver_;
-  VecX rates_from_, last_rates_from_;          // where the interactions' rates start (clock)
+  VecX rates_from_, last_rates_from_;  // where the interactions' rates start (clock)
   double rates_time_ = 0.0, last_rates_time_ = 0.0;
   std::vector<char> kind_;
   VecX target_;
@@ -273,8 +272,8 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       return;
     }
     if (!std::isfinite(rnorm) || rnorm > options_.divergence_factor * std::max(first_norm, 1e-300)) {
-      rec.failure = "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) +
-                    " iterations";
+      rec.failure =
+          "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
       return;
     }
     if (rec.iterations >= options_.max_iterations) {
@@ -351,8 +350,8 @@ double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx,
 }  // namespace
 
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
-                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load_at,
-                          bool unsymmetric, const StaticOptions& options) {
+                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load_at, bool unsymmetric,
+                          const StaticOptions& options) {
   options.validate();
   const Index n = model.n_dofs();
   StaticResult result;
@@ -451,8 +450,9 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
         rep.converged = false;
         r.report.status = SolveStatus::kStepFailed;
         r.report.message = "constraints not met after " + std::to_string(uzawa.max_updates) +
-                           " multiplier updates (max |mean J - 1| " + detail::short_number(rep.max_g_J) + ", max |mean (I4 - 1)/2| " +
-                           detail::short_number(rep.max_g_T) + ", tolerance " + detail::short_number(uzawa.tolerance) + ")";
+                           " multiplier updates (max |mean J - 1| " + detail::short_number(rep.max_g_J) +
+                           ", max |mean (I4 - 1)/2| " + detail::short_number(rep.max_g_T) + ", tolerance " +
+                           detail::short_number(uzawa.tolerance) + ")";
         break;
       }
       for (int b = 0; b < model.n_bodies(); ++b) {
@@ -465,7 +465,9 @@ StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>
         model.set_multipliers(b, std::move(p), std::move(t));
       }
       ++rep.updates;
-      const LoadFunction full = [&load](double, const VecX& x, bool want_tangent) { return load(1.0, x, want_tangent); };
+      const LoadFunction full = [&load](double, const VecX& x, bool want_tangent) {
+        return load(1.0, x, want_tangent);
+      };
       const StaticResult again = solve_static(model, r.positions, prescribed, full, unsymmetric, repeat);
       const int iterations = r.report.total_iterations + again.report.total_iterations;
       r = again;

@@ -54,20 +54,20 @@ struct ProcessClock {
 };
 
 struct StaticOptions {
-  double initial_increment = 1.0;  // first load-factor increment, (0, 1]
-  double max_increment = 1.0;      // cap after regrowth, (0, 1]
-  double min_increment = 1e-6;     // cut back below this -> kStepFailed
-  double growth = 1.5;             // increment growth after an easy step, >= 1
-  int easy_iterations = 5;         // ... i.e. one converging in at most this many iterations
-  int max_iterations = 25;         // Newton iterations per step (predictor included)
-  int max_steps = 1000;            // attempted steps in total (converged + cut back)
-  double residual_tol_rel = 1e-10; // relative to force_scale
-  double residual_tol_abs = 0.0;   // N
-  double divergence_factor = 1e8;  // |r| growing past this times the step's first |r| fails
+  double initial_increment = 1.0;   // first load-factor increment, (0, 1]
+  double max_increment = 1.0;       // cap after regrowth, (0, 1]
+  double min_increment = 1e-6;      // cut back below this -> kStepFailed
+  double growth = 1.5;              // increment growth after an easy step, >= 1
+  int easy_iterations = 5;          // ... i.e. one converging in at most this many iterations
+  int max_iterations = 25;          // Newton iterations per step (predictor included)
+  int max_steps = 1000;             // attempted steps in total (converged + cut back)
+  double residual_tol_rel = 1e-10;  // relative to force_scale
+  double residual_tol_abs = 0.0;    // N
+  double divergence_factor = 1e8;   // |r| growing past this times the step's first |r| fails
   bool line_search = true;
-  int max_line_search = 8;         // halvings of the corrector step
+  int max_line_search = 8;  // halvings of the corrector step
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
-  ProcessClock clock;              // time and rates the interactions see
+  ProcessClock clock;  // time and rates the interactions see
   // Throws sf::InputError naming the option ("static solver max_iterations: ...").
   void validate() const;
 };
@@ -109,8 +109,8 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
 // K_int - load.tangent. `unsymmetric`: the load's tangent is not symmetric (follower
 // pressure), so the linear solves use an unsymmetric factorisation (UMFPACK).
 StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_start,
-                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load,
-                          bool unsymmetric, const StaticOptions& options = {});
+                          const std::vector<PrescribedDof>& prescribed, const LoadFunction& load, bool unsymmetric,
+                          const StaticOptions& options = {});
 // solve_static() repeated with Uzawa updates of `model`'s multipliers (see UzawaOptions).
 // Each repeat starts from the previous solution with the same targets and loads.
 StaticResult solve_static_constrained(Model& model, const Eigen::Ref<const VecX>& x_start,

@@ -17,8 +17,8 @@ namespace sf::forming {
 
 // One attempted step: a load step of the static solver, a time step of the dynamic one.
 struct StepRecord {
-  double target = 0.0;                 // load factor (static) or time (dynamic, s) it aims at
-  double increment = 0.0;              // its load-factor increment or time step (s)
+  double target = 0.0;     // load factor (static) or time (dynamic, s) it aims at
+  double increment = 0.0;  // its load-factor increment or time step (s)
   bool converged = false;
   int iterations = 0;                  // Newton solves (predictor included)
   std::vector<double> residual_norms;  // |r_f| after the predictor and after each correction, N
@@ -39,7 +39,7 @@ std::string to_string(SolveStatus status);
 struct StepHistory {
   using Status = SolveStatus;
   Status status = Status::kStepFailed;
-  std::string message;            // why it stopped early (empty when converged)
+  std::string message;  // why it stopped early (empty when converged)
   int n_converged_steps = 0;
   int n_cutbacks = 0;
   int total_iterations = 0;       // Newton solves of every attempt, converged or not

@@ -110,8 +110,9 @@ class LoadStepper final : public Stepper {
       commit_interactions(problem_.model, r.positions, at_end);
       state.x = r.positions;
       state.load_factor = lambda;
-      const StepInfo info{Control::kLoad, k, n, lambda, lambda * T, r.report.total_iterations, r.report.n_cutbacks,
-                          r.report.last_residual()};
+      const StepInfo info{
+          Control::kLoad,          k, n, lambda, lambda * T, r.report.total_iterations, r.report.n_cutbacks,
+          r.report.last_residual()};
       if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
         out.status = SteppingReport::Status::kStopped;
         return out;
@@ -156,8 +157,9 @@ class DynamicStepper final : public Stepper {
       state.x = r.positions;
       state.v = r.velocities;
       state.load_factor = lambda;
-      const StepInfo info{Control::kDynamic, k, n, lambda, lambda * end_time, r.report.total_iterations,
-                          r.report.n_cutbacks, r.report.last_residual()};
+      const StepInfo info{
+          Control::kDynamic,       k, n, lambda, lambda * end_time, r.report.total_iterations, r.report.n_cutbacks,
+          r.report.last_residual()};
       if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
         out.status = SteppingReport::Status::kStopped;
         return out;

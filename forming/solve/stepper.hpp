@@ -44,15 +44,15 @@ enum class Control { kLoad, kDynamic, kArcLength };
 // Solver settings of a run, translated once from the case (forming/case/build.hpp).
 struct StepperSettings {
   Control control = Control::kLoad;
-  int steps = 10;                  // output steps (arc length: the most steps)
-  StaticOptions statics;           // kLoad
-  UzawaOptions uzawa;              // kLoad with constrained bodies
-  double process_time = 1.0;       // kLoad: s per unit load factor (t = lambda process_time)
+  int steps = 10;                   // output steps (arc length: the most steps)
+  StaticOptions statics;            // kLoad
+  UzawaOptions uzawa;               // kLoad with constrained bodies
+  double process_time = 1.0;        // kLoad: s per unit load factor (t = lambda process_time)
   int max_multiplier_updates = 30;  // kLoad: augmented-Lagrangian repeats of a step
-  DynamicOptions dynamics;         // kDynamic: per output interval (its times are set per step)
-  double end_time = 1.0;           // kDynamic, s
-  ArcLengthOptions arc;            // kArcLength
-  double stop_displacement = 0.0;  // kArcLength: also end when max |u| reaches this, mm (0: off)
+  DynamicOptions dynamics;          // kDynamic: per output interval (its times are set per step)
+  double end_time = 1.0;            // kDynamic, s
+  ArcLengthOptions arc;             // kArcLength
+  double stop_displacement = 0.0;   // kArcLength: also end when max |u| reaches this, mm (0: off)
 };
 
 // The state stepping starts from and, as it goes, the last converged state.
@@ -65,13 +65,13 @@ struct SteppingState {
 // A converged step as the observer sees it.
 struct StepInfo {
   Control control = Control::kLoad;
-  int index = 0;             // k, 1-based
-  int n_steps = 0;           // requested steps (arc length: the most)
+  int index = 0;    // k, 1-based
+  int n_steps = 0;  // requested steps (arc length: the most)
   double load_factor = 0.0;
-  double time = 0.0;         // s: load factor x end_time (dynamic) or x process_time (load control); 0 for arc length
-  int iterations = 0;        // Newton iterations of the step
-  int cutbacks = 0;          // cut-backs inside the step
-  double residual = 0.0;     // |r_f| at its end, N
+  double time = 0.0;      // s: load factor x end_time (dynamic) or x process_time (load control); 0 for arc length
+  int iterations = 0;     // Newton iterations of the step
+  int cutbacks = 0;       // cut-backs inside the step
+  double residual = 0.0;  // |r_f| at its end, N
 };
 
 enum class StepAction { kContinue, kStop };
@@ -87,10 +87,10 @@ class StepObserver {
 struct SteppingReport {
   enum class Status { kFinished, kStopped, kFailed };
   Status status = Status::kFinished;
-  std::string message;       // kFailed: names the step and what to try
-  std::string step_failure;  // kFailed in a load or time step: "step k failed: <solver message>"
-  bool nothing_left = false;  // the start state was already at the last step (a finished run restarted)
-  int total_iterations = 0;   // Newton iterations (load and time steps: failed attempts included)
+  std::string message;         // kFailed: names the step and what to try
+  std::string step_failure;    // kFailed in a load or time step: "step k failed: <solver message>"
+  bool nothing_left = false;   // the start state was already at the last step (a finished run restarted)
+  int total_iterations = 0;    // Newton iterations (load and time steps: failed attempts included)
   int multiplier_updates = 0;  // Uzawa updates of the constraint multipliers
   int contact_updates = 0;     // augmented-Lagrangian repeats of steps for interactions
 };

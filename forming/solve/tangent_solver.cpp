@@ -10,8 +10,8 @@ TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric) {
   if (symmetric_auto && linalg::solver_available(SolverKind::kCholmod)) {
     spd_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmod,
                                                   linalg::MatrixProperty::kSymmetricPositiveDefinite);
-    general_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmodLdlt,
-                                                      linalg::MatrixProperty::kSymmetricIndefinite);
+    general_ =
+        std::make_unique<linalg::LinearSolver>(SolverKind::kCholmodLdlt, linalg::MatrixProperty::kSymmetricIndefinite);
     lower_ = true;
     return;
   }

@@ -20,7 +20,7 @@ struct FreeDofs {
   FreeDofs() = default;
   explicit FreeDofs(const std::vector<bool>& free);
   Index size() const { return static_cast<Index>(index.size()); }
-  VecX restrict(const VecX& v) const;  // the free entries of v (n_dofs)
+  VecX restrict(const VecX& v) const;     // the free entries of v (n_dofs)
   VecX expand(const VecX& v_free) const;  // n_dofs, zero on the other dofs
 };
 

@@ -32,9 +32,12 @@ void ScanOptions::validate() const {
 
 std::string to_string(Verdict v) {
   switch (v) {
-    case Verdict::kStable: return "stable";
-    case Verdict::kNeutral: return "neutral";
-    case Verdict::kBuckles: return "buckles";
+    case Verdict::kStable:
+      return "stable";
+    case Verdict::kNeutral:
+      return "neutral";
+    case Verdict::kBuckles:
+      return "buckles";
   }
   return "?";
 }
@@ -105,8 +108,9 @@ StabilityResult analyse_stability(const TrellisFlow& flow, const ScanOptions& sc
   // ---- verdict (relative to the thickness: the sign of the smallest resolved tension)
   const double scale = std::max(std::abs(s.fibres[0].tension), std::abs(s.fibres[1].tension));
   const double tol = 1e-9 * scale;
-  r.verdict = m.resolved_tension < -tol ? Verdict::kBuckles : m.resolved_tension > tol ? Verdict::kStable
-                                                                                         : Verdict::kNeutral;
+  r.verdict = m.resolved_tension < -tol  ? Verdict::kBuckles
+              : m.resolved_tension > tol ? Verdict::kStable
+                                         : Verdict::kNeutral;
   const std::string where = fmt::format("wave direction {:.1f} deg, crests along {:.1f} deg", m.theta_deg, m.crest_deg);
   switch (r.verdict) {
     case Verdict::kBuckles:
@@ -144,8 +148,8 @@ StabilityResult analyse_stability(const TrellisFlow& flow, const ScanOptions& sc
   double t_max = std::max(2.0, 2.0 * cot + 1.0);
   if (std::isfinite(m.tau)) t_max = std::max(t_max, 1.25 * std::abs(m.tau));
   constexpr int kMapKappa = 24, kMapTau = 56;
-  r.thickening_map = stability_map(FlowKind::kThickening, flow.fibre_angle, std::log10(k_lo), std::log10(k_hi),
-                                   -t_max, t_max, kMapKappa, kMapTau);
+  r.thickening_map = stability_map(FlowKind::kThickening, flow.fibre_angle, std::log10(k_lo), std::log10(k_hi), -t_max,
+                                   t_max, kMapKappa, kMapTau);
   r.thinning_map = stability_map(FlowKind::kThinning, flow.fibre_angle, std::log10(k_lo), std::log10(k_hi), -t_max,
                                  t_max, kMapKappa, kMapTau);
 

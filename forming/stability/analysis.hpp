@@ -23,16 +23,16 @@ struct ScanOptions {
 
 // One row of growth_rate.csv.
 struct ModeRow {
-  double theta_deg = 0.0;         // wave direction n, degrees from x1
-  double crest_deg = 0.0;         // crests run along theta + 90 deg
-  double wavelength = 0.0;        // mm
-  double wave_number = 0.0;       // K = 2 pi / wavelength, 1/mm
-  double kappa = 0.0;             // (K h)^2
-  double resolved_tension = 0.0;  // T_n, MPa
-  double growth_rate = 0.0;       // G, 1/s
-  double growth_rate_rel = 0.0;   // G - D33, 1/s
+  double theta_deg = 0.0;          // wave direction n, degrees from x1
+  double crest_deg = 0.0;          // crests run along theta + 90 deg
+  double wavelength = 0.0;         // mm
+  double wave_number = 0.0;        // K = 2 pi / wavelength, 1/mm
+  double kappa = 0.0;              // (K h)^2
+  double resolved_tension = 0.0;   // T_n, MPa
+  double growth_rate = 0.0;        // G, 1/s
+  double growth_rate_rel = 0.0;    // G - D33, 1/s
   double newtonian_sinuous = 0.0;  // G of the same sheet without fibres (same rates), 1/s
-  bool normal_to_fibre = false;   // an exceptional direction (sheet.hpp)
+  bool normal_to_fibre = false;    // an exceptional direction (sheet.hpp)
 };
 
 enum class Verdict {
@@ -43,8 +43,8 @@ enum class Verdict {
 std::string to_string(Verdict v);
 
 struct MostUnstableMode {
-  double theta_deg = 0.0;  // wave direction, degrees from x1, in [0, 180)
-  double crest_deg = 0.0;  // crest direction
+  double theta_deg = 0.0;         // wave direction, degrees from x1, in [0, 180)
+  double crest_deg = 0.0;         // crest direction
   double resolved_tension = 0.0;  // smallest eigenvalue of the fibre stress tensor, MPa
   double growth_rate = 0.0;       // G, 1/s (every wavelength)
   double growth_rate_rel = 0.0;   // G - D33, 1/s
@@ -54,7 +54,7 @@ struct MostUnstableMode {
 
 struct StabilityMap {
   FlowKind kind = FlowKind::kThickening;
-  double fibre_angle = 0.0;  // chi, rad
+  double fibre_angle = 0.0;         // chi, rad
   std::vector<double> log10_kappa;  // grid, ascending
   std::vector<double> tau;          // grid, ascending
   std::vector<double> growth;       // Gamma = G / |gamma_dot|, tau-major: [i_tau * n_kappa + i_kappa]

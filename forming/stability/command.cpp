@@ -188,9 +188,7 @@ void add_stability_command(sf::cli::Program& program) {
             ->check(CLI::Range(4, 36000));
         app.add_flag("--no-plots", args->no_plots, "Skip the PNG pictures");
       },
-      [args, prog] {
-        return run(*args, prog->common().quiet);
-      });
+      [args, prog] { return run(*args, prog->common().quiet); });
 }
 
 }  // namespace sf::forming::stability

@@ -18,11 +18,16 @@ namespace {
 std::string describe(const YAML::Node& n) {
   if (!n.IsDefined()) return "nothing";
   switch (n.Type()) {
-    case YAML::NodeType::Null: return "null";
-    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a mapping";
-    default: return "nothing";
+    case YAML::NodeType::Null:
+      return "null";
+    case YAML::NodeType::Scalar:
+      return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    default:
+      return "nothing";
   }
 }
 
@@ -35,7 +40,9 @@ class Reader {
     if (m.is_null()) return file_;
     return file_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
   }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const { throw InputError(at(n) + ": " + message); }
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const {
+    throw InputError(at(n) + ": " + message);
+  }
 
   void mapping(const YAML::Node& n, const std::string& what, const std::vector<std::string>& allowed) const {
     if (!n.IsMap()) fail(n, what + ": expected a mapping (key: value), found " + describe(n));
@@ -47,7 +54,8 @@ class Reader {
         for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
         fail(it->first, what + ": unknown key '" + key + "' (expected one of: " + list + ")");
       }
-      if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail(it->first, what + ": key '" + key + "' given twice");
+      if (std::find(seen.begin(), seen.end(), key) != seen.end())
+        fail(it->first, what + ": key '" + key + "' given twice");
       seen.push_back(key);
     }
   }
@@ -171,7 +179,8 @@ StabilityInput read_stability_input(const std::string& path) {
     if (const YAML::Node w = n["wavelengths"]; w.IsDefined()) {
       const std::vector<double> v = r.numbers(w, "scan.wavelengths (min, max in mm)", 2);
       if (!(v[0] > 0.0) || !(v[1] > v[0]))
-        r.fail(w, "scan.wavelengths: expected 0 < min < max (mm), found [" + w[0].Scalar() + ", " + w[1].Scalar() + "]");
+        r.fail(w,
+               "scan.wavelengths: expected 0 < min < max (mm), found [" + w[0].Scalar() + ", " + w[1].Scalar() + "]");
       s.scan.min_wavelength = v[0];
       s.scan.max_wavelength = v[1];
     }

@@ -23,10 +23,10 @@
 namespace sf::forming::stability {
 
 struct StabilityInput {
-  TrellisSpec spec;    // the *_at fields hold FILE:LINE:COLUMN of each value read
+  TrellisSpec spec;  // the *_at fields hold FILE:LINE:COLUMN of each value read
   ScanOptions scan;
   bool has_fibres = false, has_viscosity = false, has_thickness = false;
-  std::string units;   // the optional note
+  std::string units;  // the optional note
 };
 
 // Reads and checks the structure of the file. Throws sf::InputError.

@@ -33,9 +33,12 @@ const char* kUnitsLine =
 
 std::string source_name(TrellisFlow::Source s) {
   switch (s) {
-    case TrellisFlow::Source::kRatesAndTensions: return "rates and tensions";
-    case TrellisFlow::Source::kShearRateAndTensions: return "trellis shear rate and tensions";
-    case TrellisFlow::Source::kTractions: return "tractions";
+    case TrellisFlow::Source::kRatesAndTensions:
+      return "rates and tensions";
+    case TrellisFlow::Source::kShearRateAndTensions:
+      return "trellis shear rate and tensions";
+    case TrellisFlow::Source::kTractions:
+      return "tractions";
   }
   return "?";
 }
@@ -75,8 +78,13 @@ nlohmann::json summary_json(const StabilityResult& r, const OutputOptions& o, co
   j["model"] =
       "Newtonian fluid reinforced by two families of inextensible fibres through the thickness, homogeneous trellis "
       "flow, free surfaces; linear stability of buckles exp(i K n.x) (docs/theory/stability.md)";
-  j["units"] = {{"length", "mm"}, {"time", "s"}, {"stress", "MPa"}, {"viscosity", "MPa s"},
-                {"rate", "1/s"},  {"angle", "deg"}, {"note", "or any consistent set, as given"}};
+  j["units"] = {{"length", "mm"},
+                {"time", "s"},
+                {"stress", "MPa"},
+                {"viscosity", "MPa s"},
+                {"rate", "1/s"},
+                {"angle", "deg"},
+                {"note", "or any consistent set, as given"}};
   j["inputs"] = {{"fibre_angles_deg", {f.fibre_angles_deg[0], f.fibre_angles_deg[1]}},
                  {"viscosity", s.viscosity},
                  {"thickness", s.thickness},
@@ -104,9 +112,11 @@ nlohmann::json summary_json(const StabilityResult& r, const OutputOptions& o, co
   j["verdict"] = to_string(r.verdict);
   j["verdict_line"] = r.verdict_line;
   const double diff = std::abs(r.check.growth_rate - r.check_closed_form);
-  const double scale = std::max({std::abs(r.check_closed_form), std::abs(s.rate33()),
-                                 std::abs(m.resolved_tension) / s.viscosity, 1e-300});
-  j["numerical_check"] = {{"method", "Legendre-Galerkin through the thickness; eigenvalues of the convected evolution on the admissible displacements"},
+  const double scale = std::max(
+      {std::abs(r.check_closed_form), std::abs(s.rate33()), std::abs(m.resolved_tension) / s.viscosity, 1e-300});
+  j["numerical_check"] = {{"method",
+                           "Legendre-Galerkin through the thickness; eigenvalues of the convected evolution on the "
+                           "admissible displacements"},
                           {"degree", r.scan.spectral_degree},
                           {"wave_direction_deg", m.theta_deg},
                           {"wave_number", r.check_wave_number},
@@ -122,8 +132,9 @@ nlohmann::json summary_json(const StabilityResult& r, const OutputOptions& o, co
         {{"wave_direction_deg", e.theta_deg},
          {"closed_form_limit", e.closed_form_limit},
          {"buckle_instantaneous_growth_rate", e.instantaneous},
-         {"note", "crests along a fibre family: no normal mode in the ideal model; the buckle's instantaneous rate "
-                  "at the check wave number"}});
+         {"note",
+          "crests along a fibre family: no normal mode in the ideal model; the buckle's instantaneous rate "
+          "at the check wave number"}});
   j["scan"] = {{"wavelength_min", r.scan.min_wavelength},
                {"wavelength_max", r.scan.max_wavelength},
                {"n_wavelengths", r.scan.n_wavelengths},
@@ -141,13 +152,16 @@ render::Chart map_chart(const StabilityResult& r, const StabilityMap& map) {
   const bool thick = map.kind == FlowKind::kThickening;
   render::Chart c;
   c.title = std::string("Stability map, ") + (thick ? "thickening" : "thinning") + " trellis flow";
-  c.subtitle = fmt::format("fibre families {:.1f} deg apart: G / |shear rate| = {}|cot chi| - tau = {:+.3g} - tau, "
-                           "for every kappa",
-                           map.fibre_angle / kDeg, thick ? "" : "-", map.boundary_tau);
+  c.subtitle = fmt::format(
+      "fibre families {:.1f} deg apart: G / |shear rate| = {}|cot chi| - tau = {:+.3g} - tau, "
+      "for every kappa",
+      map.fibre_angle / kDeg, thick ? "" : "-", map.boundary_tau);
   c.x_label = "log10 kappa,  kappa = (K h)^2  [-]";
   c.y_label = "tau = T_n / (mu |shear rate|)  [-]";
-  c.footnote = "T_n: fibre tension resolved in the wave direction; K: wave number; h: thickness; G: convected growth "
-               "rate; D33 " + std::string(thick ? "> 0" : "< 0");
+  c.footnote =
+      "T_n: fibre tension resolved in the wave direction; K: wave number; h: thickness; G: convected growth "
+      "rate; D33 " +
+      std::string(thick ? "> 0" : "< 0");
   c.include_origin = false;
   // The grid values are cell centres; the axes run to the outer cell edges.
   const std::size_t nk = map.log10_kappa.size(), nt = map.tau.size();
@@ -181,11 +195,11 @@ render::Chart map_chart(const StabilityResult& r, const StabilityMap& map) {
       start = ik;
     }
   }
-  c.extra_legend = {
-      {render::LegendEntry::Kind::kSwatch, kUnstable, "buckles: G > 0 and G - D33 > 0"},
-      {render::LegendEntry::Kind::kSwatch, kStable, "stable: G <= 0 and G - D33 <= 0"},
-      {render::LegendEntry::Kind::kSwatch, kMixed,
-       thick ? "G > 0 >= G - D33: grows only with the thickness" : "G <= 0 < G - D33: shrinks slower than the thickness"}};
+  c.extra_legend = {{render::LegendEntry::Kind::kSwatch, kUnstable, "buckles: G > 0 and G - D33 > 0"},
+                    {render::LegendEntry::Kind::kSwatch, kStable, "stable: G <= 0 and G - D33 <= 0"},
+                    {render::LegendEntry::Kind::kSwatch, kMixed,
+                     thick ? "G > 0 >= G - D33: grows only with the thickness"
+                           : "G <= 0 < G - D33: shrinks slower than the thickness"}};
   render::ChartSeries boundary;
   boundary.label = fmt::format("G = 0: tau = {:+.3g}", map.boundary_tau);
   boundary.style = render::ChartSeries::Style::kLine;
@@ -267,8 +281,8 @@ std::vector<std::string> write_stability_outputs(const StabilityResult& result, 
     render::write_chart_png(map_chart(result, result.thickening_map), size, out.path("stability_map_thickening.png"));
     render::write_chart_png(map_chart(result, result.thinning_map), size, out.path("stability_map_thinning.png"));
     render::write_chart_png(direction_chart(result), size, out.path("growth_rate_direction.png"));
-    files.insert(files.end(), {"stability_map_thickening.png", "stability_map_thinning.png",
-                               "growth_rate_direction.png"});
+    files.insert(files.end(),
+                 {"stability_map_thickening.png", "stability_map_thinning.png", "growth_rate_direction.png"});
   }
   io::write_json(out.path("summary.json"), summary_json(result, options, files));
   out.commit();

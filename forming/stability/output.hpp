@@ -20,7 +20,7 @@
 namespace sf::forming::stability {
 
 struct OutputOptions {
-  std::string out_dir;       // required
+  std::string out_dir;  // required
   bool plots = true;
   std::string command_line;  // recorded in summary.json
   std::string input_file;    // "" when everything came from options

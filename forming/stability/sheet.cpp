@@ -63,8 +63,8 @@ double sinh_minus_identity(double q) {
   return std::sinh(q) - q;
 }
 
-NewtonianGrowthRates newtonian_sheet_growth_rates(const Mat2& rate, double viscosity, double thickness,
-                                                  double theta, double wave_number) {
+NewtonianGrowthRates newtonian_sheet_growth_rates(const Mat2& rate, double viscosity, double thickness, double theta,
+                                                  double wave_number) {
   const Vec2 n = wave_direction(theta);
   const double s_n = n.dot(2.0 * viscosity * (rate + rate.trace() * Mat2::Identity()) * n);
   const double q = wave_number * thickness;

@@ -37,9 +37,9 @@ struct Fibre {
 
 // Background state of the sheet; plain data, checked by validate().
 struct SheetState {
-  Mat2 rate = Mat2::Zero();  // in-plane rate of deformation D (symmetric), 1/s
-  double viscosity = 1.0;    // mu > 0, MPa s
-  double thickness = 1.0;    // h > 0, mm
+  Mat2 rate = Mat2::Zero();   // in-plane rate of deformation D (symmetric), 1/s
+  double viscosity = 1.0;     // mu > 0, MPa s
+  double thickness = 1.0;     // h > 0, mm
   std::vector<Fibre> fibres;  // none (Newtonian sheet) or two non-parallel families
 
   // D33 = -(D11 + D22), 1/s.
@@ -83,8 +83,8 @@ struct NewtonianGrowthRates {
   double sinuous = 0.0;   // 1/s
   double varicose = 0.0;  // 1/s
 };
-NewtonianGrowthRates newtonian_sheet_growth_rates(const Mat2& rate, double viscosity, double thickness,
-                                                  double theta, double wave_number);
+NewtonianGrowthRates newtonian_sheet_growth_rates(const Mat2& rate, double viscosity, double thickness, double theta,
+                                                  double wave_number);
 // sinh(q) - q and sinh(q) + q without cancellation for small q (q >= 0).
 double sinh_minus_identity(double q);
 

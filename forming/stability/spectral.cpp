@@ -111,7 +111,7 @@ Mat9 symmetriser() {
 }
 
 struct NullSpace {
-  MatC basis;        // orthonormal columns
+  MatC basis;           // orthonormal columns
   MatC pseudo_inverse;  // minimum-norm least-squares solution operator
 };
 NullSpace null_space(const MatC& c, double tolerance) {
@@ -145,10 +145,11 @@ void SpectralOptions::validate() const {
 
 std::string SpectralReport::brief() const {
   const char* s = status == Status::kOk ? "ok" : status == Status::kNotNormalMode ? "not a normal mode" : "failed";
-  return fmt::format("spectral: {}; G = {:.10g} 1/s; {} state(s), {} velocity dofs; constraint residual {:.1e}, "
-                     "invariance residual {:.1e}{}{}",
-                     s, growth_rate, n_state, n_velocity, constraint_residual, invariance_residual,
-                     message.empty() ? "" : "; ", message);
+  return fmt::format(
+      "spectral: {}; G = {:.10g} 1/s; {} state(s), {} velocity dofs; constraint residual {:.1e}, "
+      "invariance residual {:.1e}{}{}",
+      s, growth_rate, n_state, n_velocity, constraint_residual, invariance_residual, message.empty() ? "" : "; ",
+      message);
 }
 
 SpectralReport solve_spectral(const SheetState& sheet, double theta, double wave_number,
@@ -319,9 +320,10 @@ SpectralReport solve_spectral(const SheetState& sheet, double theta, double wave
   if (report.invariance_residual > options.invariance_tolerance) {
     report.status = SpectralReport::Status::kNotNormalMode;
     report.growth_rate = report.buckle_growth_rate;
-    report.message = "the flow carries admissible displacements out of the admissible space (a wave direction "
-                     "normal to a fibre family: the buckle excites shear along the crests); growth_rate is the "
-                     "buckle's instantaneous rate";
+    report.message =
+        "the flow carries admissible displacements out of the admissible space (a wave direction "
+        "normal to a fibre family: the buckle excites shear along the crests); growth_rate is the "
+        "buckle's instantaneous rate";
     return report;
   }
   report.eigenvalues = sorted_eigenvalues(m);

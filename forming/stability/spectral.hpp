@@ -34,11 +34,11 @@
 namespace sf::forming::stability {
 
 struct SpectralOptions {
-  int degree = 24;          // N, polynomial degree through the thickness, 2..29
-  bool with_fibres = true;  // false: ignore the sheet's fibres (Newtonian sheet)
-  double rank_tolerance = 1e-10;        // relative singular value counted as zero
-  double invariance_tolerance = 1e-8;   // relative; above it the state is no normal mode
-  void validate() const;                // throws std::invalid_argument
+  int degree = 24;                     // N, polynomial degree through the thickness, 2..29
+  bool with_fibres = true;             // false: ignore the sheet's fibres (Newtonian sheet)
+  double rank_tolerance = 1e-10;       // relative singular value counted as zero
+  double invariance_tolerance = 1e-8;  // relative; above it the state is no normal mode
+  void validate() const;               // throws std::invalid_argument
 };
 
 struct SpectralReport {
@@ -51,14 +51,14 @@ struct SpectralReport {
   Status status = Status::kFailed;
   std::string message;
   double growth_rate = std::numeric_limits<double>::quiet_NaN();  // 1/s
-  std::vector<std::complex<double>> eigenvalues;  // all modes, largest real part first, 1/s
+  std::vector<std::complex<double>> eigenvalues;                  // all modes, largest real part first, 1/s
   // Instantaneous growth rate of the buckle state xi = e3 (uniform through the thickness), 1/s;
   // growth_rate when the status is kNotNormalMode.
   double buckle_growth_rate = std::numeric_limits<double>::quiet_NaN();
   double sinuous = std::numeric_limits<double>::quiet_NaN();   // Newtonian sheet only, 1/s
   double varicose = std::numeric_limits<double>::quiet_NaN();  // Newtonian sheet only, 1/s
-  int n_state = 0;                   // dimension of the admissible displacement space
-  int n_velocity = 0;                // dimension of the admissible velocity space
+  int n_state = 0;                                             // dimension of the admissible displacement space
+  int n_velocity = 0;                                          // dimension of the admissible velocity space
   double constraint_residual = 0.0;  // |C u - E xi| / |E| of the velocity constraints (consistency)
   double invariance_residual = 0.0;  // relative part of d(xi)/dt outside the admissible states
 

@@ -24,8 +24,7 @@ Vec2 perp(const Vec2& v) { return {-v.y(), v.x()}; }
 std::string num(double v) { return fmt::format("{:.6g}", v); }
 
 void check_positive(double v, const std::string& where, const std::string& what, const std::string& unit) {
-  if (!std::isfinite(v) || !(v > 0.0))
-    bad(where, "expected a positive " + what + " (" + unit + "), found " + num(v));
+  if (!std::isfinite(v) || !(v > 0.0)) bad(where, "expected a positive " + what + " (" + unit + "), found " + num(v));
 }
 
 void check_finite(const double* v, int n, const std::string& where, const std::string& what) {
@@ -62,11 +61,10 @@ TrellisFlow build_trellis_flow(const TrellisSpec& spec) {
   const Vec2 b = unit_at(spec.fibre_angles_deg[1]);
   const double sin_chi = std::abs(a.x() * b.y() - a.y() * b.x());
   if (sin_chi < std::sin(kMinFibreAngleDeg * kDeg))
-    bad(spec.fibres_at, "the fibre families at " + num(spec.fibre_angles_deg[0]) + " and " +
-                            num(spec.fibre_angles_deg[1]) + " deg are parallel (a degenerate pair: " +
-                            num(std::asin(std::min(1.0, sin_chi)) / kDeg) +
-                            " deg apart); a trellis flow needs two families at least " + num(kMinFibreAngleDeg) +
-                            " deg from parallel");
+    bad(spec.fibres_at,
+        "the fibre families at " + num(spec.fibre_angles_deg[0]) + " and " + num(spec.fibre_angles_deg[1]) +
+            " deg are parallel (a degenerate pair: " + num(std::asin(std::min(1.0, sin_chi)) / kDeg) +
+            " deg apart); a trellis flow needs two families at least " + num(kMinFibreAngleDeg) + " deg from parallel");
   flow.fibre_angles_deg = spec.fibre_angles_deg;
   flow.fibre_angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
   const Vec2 bis = (a + b).normalized();
@@ -88,8 +86,8 @@ TrellisFlow build_trellis_flow(const TrellisSpec& spec) {
     bad(spec.rate33_at, "D33 is checked against the in-plane rates; give them too (" + spec.rates_at + ")");
   if (spec.tractions) {
     if (spec.tensions)
-      bad(spec.tractions_at, "give either the fibre tensions (" + spec.tensions_at +
-                                 ") or the tractions that determine them, not both");
+      bad(spec.tractions_at,
+          "give either the fibre tensions (" + spec.tensions_at + ") or the tractions that determine them, not both");
     if (kin)
       bad(spec.tractions_at, "the tractions determine the trellis rate as well; leave out " +
                                  (spec.rates ? spec.rates_at : spec.shear_rate_at));
@@ -144,9 +142,8 @@ TrellisFlow build_trellis_flow(const TrellisSpec& spec) {
     check_finite(&*spec.rate33, 1, spec.rate33_at, "D33 (1/s)");
     const double expect = -(d[0] + d[1]);
     if (std::abs(*spec.rate33 - expect) > kRateTolerance * std::max(size, std::abs(*spec.rate33)))
-      bad(spec.rate33_at, "D33 = " + num(*spec.rate33) +
-                              " 1/s violates incompressibility: with D11 = " + num(d[0]) + " and D22 = " + num(d[1]) +
-                              " it must be -(D11 + D22) = " + num(expect) + " 1/s");
+      bad(spec.rate33_at, "D33 = " + num(*spec.rate33) + " 1/s violates incompressibility: with D11 = " + num(d[0]) +
+                              " and D22 = " + num(d[1]) + " it must be -(D11 + D22) = " + num(expect) + " 1/s");
   }
   const double stretch_a = a.dot(given * a);
   const double stretch_b = b.dot(given * b);
@@ -154,13 +151,12 @@ TrellisFlow build_trellis_flow(const TrellisSpec& spec) {
     // The trellis rate nearest to the given one (Frobenius), as a suggestion.
     const double g = (given.cwiseProduct(unit)).sum() / unit.squaredNorm();
     const Mat2 near = g * unit;
-    bad(spec.rates_at,
-        "(D11, D22, D12) = (" + num(d[0]) + ", " + num(d[1]) + ", " + num(d[2]) +
-            ") 1/s stretches the fibres (a.D.a = " + num(stretch_a) + ", b.D.b = " + num(stretch_b) +
-            " 1/s), but inextensible fibres at " + num(spec.fibre_angles_deg[0]) + " and " +
-            num(spec.fibre_angles_deg[1]) + " deg allow only trellis rates, multiples of (" + num(unit(0, 0)) + ", " +
-            num(unit(1, 1)) + ", " + num(unit(0, 1)) + "); the nearest is (" + num(near(0, 0)) + ", " +
-            num(near(1, 1)) + ", " + num(near(0, 1)) + ")");
+    bad(spec.rates_at, "(D11, D22, D12) = (" + num(d[0]) + ", " + num(d[1]) + ", " + num(d[2]) +
+                           ") 1/s stretches the fibres (a.D.a = " + num(stretch_a) + ", b.D.b = " + num(stretch_b) +
+                           " 1/s), but inextensible fibres at " + num(spec.fibre_angles_deg[0]) + " and " +
+                           num(spec.fibre_angles_deg[1]) + " deg allow only trellis rates, multiples of (" +
+                           num(unit(0, 0)) + ", " + num(unit(1, 1)) + ", " + num(unit(0, 1)) + "); the nearest is (" +
+                           num(near(0, 0)) + ", " + num(near(1, 1)) + ", " + num(near(0, 1)) + ")");
   }
   // Within tolerance: the nearest trellis rate (Frobenius projection onto the family).
   flow.shear_rate = (given.cwiseProduct(unit)).sum() / unit.squaredNorm();

@@ -53,13 +53,13 @@ struct TrellisSpec {
 struct TrellisFlow {
   enum class Source { kRatesAndTensions, kShearRateAndTensions, kTractions };
 
-  SheetState sheet;                        // two families: [0] = a, [1] = b
+  SheetState sheet;                          // two families: [0] = a, [1] = b
   std::array<double, 2> fibre_angles_deg{};  // as given
-  double fibre_angle = 0.0;    // chi in (0, pi): angle between the families, rad
-  double bisector_deg = 0.0;   // direction of a + b (inside chi), degrees from x1
-  double shear_rate = 0.0;     // gamma_dot = -d(chi)/dt, 1/s
+  double fibre_angle = 0.0;                  // chi in (0, pi): angle between the families, rad
+  double bisector_deg = 0.0;                 // direction of a + b (inside chi), degrees from x1
+  double shear_rate = 0.0;                   // gamma_dot = -d(chi)/dt, 1/s
   Source source = Source::kRatesAndTensions;
-  double projection = 0.0;     // |D_given - D_used| / |D_given| (0 unless rates were given)
+  double projection = 0.0;  // |D_given - D_used| / |D_given| (0 unless rates were given)
 
   // D33 > 0: the sheet thickens; D33 < 0: it thins (D33 = gamma_dot cot chi). |D33| below
   // 1e-12 |D| (roundoff, e.g. at chi = 90 deg) counts as neither.

@@ -65,8 +65,8 @@ bool find_target(const cv::Mat& img, const CalibrationTarget& t, Points2& pts, s
     if (t.kind == TargetKind::kChessboard) {
       // FAST_CHECK: an image without a board is given up on quickly instead of searched for
       // seconds.
-      ok = cv::findChessboardCorners(img, size, pts,
-                                     cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
+      ok = cv::findChessboardCorners(
+          img, size, pts, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
       if (ok) {
         // Refinement window: a quarter of the smallest corner spacing.
         double spacing = 1e9;
@@ -123,9 +123,9 @@ double angle_deg(const Mat3& a, const Mat3& b) {
 struct CameraData {
   CameraReport report;
   cv::Mat K, D;
-  std::vector<int> views;            // image index of each used view
-  std::vector<Points2> points;       // per used view
-  std::vector<cv::Mat> rvecs, tvecs; // per used view
+  std::vector<int> views;             // image index of each used view
+  std::vector<Points2> points;        // per used view
+  std::vector<cv::Mat> rvecs, tvecs;  // per used view
   Camera camera;
 };
 
@@ -189,10 +189,10 @@ CalibrationResult calibrate_rig(const std::vector<std::vector<std::string>>& ima
       if (e) std::rethrow_exception(e);
     for (std::size_t k = 1; k < n; ++k)
       if (sizes[k] != sizes[0])
-        throw InputError(fmt::format("{}: {} x {} pixels, but {} (the first image of camera {}) is {} x {}: one camera's "
-                                     "images must all have the same size",
-                                     images[c][k], sizes[k].first, sizes[k].second, images[c][0], c, sizes[0].first,
-                                     sizes[0].second));
+        throw InputError(fmt::format(
+            "{}: {} x {} pixels, but {} (the first image of camera {}) is {} x {}: one camera's "
+            "images must all have the same size",
+            images[c][k], sizes[k].first, sizes[k].second, images[c][0], c, sizes[0].first, sizes[0].second));
     cd.report.width = sizes[0].first;
     cd.report.height = sizes[0].second;
     for (std::size_t k = 0; k < n; ++k) {
@@ -224,9 +224,10 @@ CalibrationResult calibrate_rig(const std::vector<std::vector<std::string>>& ima
       try {
         cd.report.rms_px = cv::calibrateCamera(objs, cd.points, size, cd.K, cd.D, cd.rvecs, cd.tvecs, flags, crit);
       } catch (const cv::Exception& e) {
-        throw InputError(fmt::format("camera {}: the calibration failed ({}); are the target views varied enough "
-                                     "(tilted boards, different positions)?",
-                                     c, e.msg));
+        throw InputError(
+            fmt::format("camera {}: the calibration failed ({}); are the target views varied enough "
+                        "(tilted boards, different positions)?",
+                        c, e.msg));
       }
       std::vector<double> rms;
       for (std::size_t v = 0; v < cd.points.size(); ++v)
@@ -275,9 +276,10 @@ CalibrationResult calibrate_rig(const std::vector<std::vector<std::string>>& ima
     StereoReport sr;
     sr.camera = static_cast<Index>(c);
     if (images[c].size() != images[0].size())
-      throw InputError(fmt::format("camera {} has {} images and camera 0 has {}: the cameras' images are paired by "
-                                   "their sorted order, so each camera needs one image per pose",
-                                   c, images[c].size(), images[0].size()));
+      throw InputError(
+          fmt::format("camera {} has {} images and camera 0 has {}: the cameras' images are paired by "
+                      "their sorted order, so each camera needs one image per pose",
+                      c, images[c].size(), images[0].size()));
     // Pairs: views found in both, with their board poses.
     struct Pair {
       int image;

@@ -34,18 +34,18 @@ struct CalibrationTarget {
 
 struct CalibrateOptions {
   CalibrationTarget target;
-  bool fix_k3 = true;          // estimate k1 k2 p1 p2 only (k3 = 0), the usual for normal lenses
+  bool fix_k3 = true;  // estimate k1 k2 p1 p2 only (k3 = 0), the usual for normal lenses
   bool zero_tangential = false;
-  bool fix_aspect = false;     // fx = fy
-  int min_views = 3;           // per camera
-  void validate() const;       // throws sf::UsageError naming the option
+  bool fix_aspect = false;  // fx = fy
+  int min_views = 3;        // per camera
+  void validate() const;    // throws sf::UsageError naming the option
 };
 
 struct ImageReport {
   std::string name;
   bool found = false;
-  double rms_px = 0;    // reprojection error of the target points (when found)
-  std::string note;     // why not found / why left out
+  double rms_px = 0;  // reprojection error of the target points (when found)
+  std::string note;   // why not found / why left out
 };
 
 struct CameraReport {
@@ -53,19 +53,19 @@ struct CameraReport {
   int width = 0, height = 0;
   std::vector<ImageReport> images;
   int n_used = 0;
-  double rms_px = 0;    // overall reprojection error of the camera's calibration
+  double rms_px = 0;  // overall reprojection error of the camera's calibration
 };
 
 struct StereoReport {
-  Index camera = 0;     // camera c, placed relative to camera 0
+  Index camera = 0;  // camera c, placed relative to camera 0
   int n_pairs = 0;
   double rms_px = 0;
-  double baseline = 0;  // distance between the camera centres (rig units)
+  double baseline = 0;               // distance between the camera centres (rig units)
   std::vector<std::string> dropped;  // pairs left out, with why
 };
 
 struct CalibrationResult {
-  Rig rig;                         // world frame = camera 0
+  Rig rig;  // world frame = camera 0
   std::vector<CameraReport> cameras;
   std::vector<StereoReport> stereo;
 };

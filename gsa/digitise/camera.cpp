@@ -110,8 +110,8 @@ double number(const nlohmann::json& j, const char* key, const std::string& file,
   if (!v.is_number()) bad(file, where + key, "expected a number, found " + v.dump());
   const double x = v.get<double>();
   if (!std::isfinite(x) || (positive && !(x > 0)))
-    bad(file, where + key, std::string("expected a ") + (positive ? "positive " : "finite ") + "number, found " +
-                               v.dump());
+    bad(file, where + key,
+        std::string("expected a ") + (positive ? "positive " : "finite ") + "number, found " + v.dump());
   return x;
 }
 
@@ -122,8 +122,9 @@ nlohmann::json rig_to_json(const Rig& rig) {
   j["format"] = "sheetform camera rig";
   j["version"] = 1;
   j["units"] = rig.units;
-  j["model"] = "pinhole + Brown-Conrady (OpenCV k1 k2 p1 p2 k3); x_cam = R X + t; pixel (0,0) = centre of the "
-               "top-left pixel";
+  j["model"] =
+      "pinhole + Brown-Conrady (OpenCV k1 k2 p1 p2 k3); x_cam = R X + t; pixel (0,0) = centre of the "
+      "top-left pixel";
   nlohmann::json cams = nlohmann::json::array();
   for (const Camera& c : rig.cameras) {
     nlohmann::json cj;
@@ -133,8 +134,11 @@ nlohmann::json rig_to_json(const Rig& rig) {
     cj["fy"] = c.fy;
     cj["cx"] = c.cx;
     cj["cy"] = c.cy;
-    cj["distortion"] = {{"k1", c.distortion.k1}, {"k2", c.distortion.k2}, {"p1", c.distortion.p1},
-                        {"p2", c.distortion.p2}, {"k3", c.distortion.k3}};
+    cj["distortion"] = {{"k1", c.distortion.k1},
+                        {"k2", c.distortion.k2},
+                        {"p1", c.distortion.p1},
+                        {"p2", c.distortion.p2},
+                        {"k3", c.distortion.k3}};
     cj["R"] = io::to_json(c.R);
     cj["t"] = {c.t.x(), c.t.y(), c.t.z()};
     cams.push_back(cj);
@@ -159,8 +163,8 @@ Rig rig_from_json(const nlohmann::json& j, const std::string& file) {
     const auto& cj = cams[k];
     if (!cj.is_object()) bad(file, "cameras[" + std::to_string(k) + "]", "expected an object");
     Camera c;
-    c.name = cj.contains("name") && cj.at("name").is_string() ? cj.at("name").get<std::string>()
-                                                                : "cam" + std::to_string(k);
+    c.name =
+        cj.contains("name") && cj.at("name").is_string() ? cj.at("name").get<std::string>() : "cam" + std::to_string(k);
     if (!cj.contains("image_size") || !cj.at("image_size").is_array() || cj.at("image_size").size() != 2 ||
         !cj.at("image_size")[0].is_number_integer() || !cj.at("image_size")[1].is_number_integer() ||
         cj.at("image_size")[0].get<long>() < 1 || cj.at("image_size")[1].get<long>() < 1)

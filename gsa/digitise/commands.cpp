@@ -76,7 +76,8 @@ std::vector<std::string> expand_images(const std::string& spec, const std::strin
   if (fs::is_directory(spec, ec)) {
     for (const auto& e : fs::directory_iterator(spec, ec))
       if (e.is_regular_file() && is_image_name(e.path())) out.push_back(e.path().string());
-    if (out.empty()) throw InputError(spec + ": no image files (png, tif, jpg, bmp, pgm) in this folder (" + what + ")");
+    if (out.empty())
+      throw InputError(spec + ": no image files (png, tif, jpg, bmp, pgm) in this folder (" + what + ")");
   } else if (spec.find_first_of("*?[") != std::string::npos) {
     const fs::path p(spec);
     const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
@@ -115,10 +116,14 @@ struct CalibrateArgs {
 
 int run_calibrate(const CalibrateArgs& a, bool quiet) {
   CalibrateOptions o;
-  if (a.target == "chessboard") o.target.kind = TargetKind::kChessboard;
-  else if (a.target == "circles") o.target.kind = TargetKind::kCircles;
-  else if (a.target == "acircles") o.target.kind = TargetKind::kAsymmetricCircles;
-  else throw UsageError("--target: expected chessboard, circles or acircles, found '" + a.target + "'");
+  if (a.target == "chessboard")
+    o.target.kind = TargetKind::kChessboard;
+  else if (a.target == "circles")
+    o.target.kind = TargetKind::kCircles;
+  else if (a.target == "acircles")
+    o.target.kind = TargetKind::kAsymmetricCircles;
+  else
+    throw UsageError("--target: expected chessboard, circles or acircles, found '" + a.target + "'");
   std::tie(o.target.cols, o.target.rows) =
       parse_pair(a.pattern, "--pattern", "COLSxROWS (inner corners of a chessboard, circles of a grid), e.g. 9x6");
   o.target.spacing = a.spacing;
@@ -145,21 +150,22 @@ int run_calibrate(const CalibrateArgs& a, bool quiet) {
     const Camera& cam = r.rig.cameras[c];
     int found = 0;
     for (const ImageReport& ir : cr.images) found += ir.found ? 1 : 0;
-    cli::status(quiet, fmt::format("gsa: cam{} ({}, {} x {}): target in {} of {} images, {} used; RMS reprojection {} "
-                                   "px; fx {} fy {} cx {} cy {} px; k1 {} k2 {} p1 {} p2 {} k3 {}",
-                                   c, a.cameras[c], cr.width, cr.height, found, cr.images.size(), cr.n_used,
-                                   fixed(cr.rms_px, 3), fixed(cam.fx, 2), fixed(cam.fy, 2), fixed(cam.cx, 2),
-                                   fixed(cam.cy, 2), fixed(cam.distortion.k1, 5), fixed(cam.distortion.k2, 5),
-                                   fixed(cam.distortion.p1, 6), fixed(cam.distortion.p2, 6),
-                                   fixed(cam.distortion.k3, 5)));
+    cli::status(quiet,
+                fmt::format("gsa: cam{} ({}, {} x {}): target in {} of {} images, {} used; RMS reprojection {} "
+                            "px; fx {} fy {} cx {} cy {} px; k1 {} k2 {} p1 {} p2 {} k3 {}",
+                            c, a.cameras[c], cr.width, cr.height, found, cr.images.size(), cr.n_used,
+                            fixed(cr.rms_px, 3), fixed(cam.fx, 2), fixed(cam.fy, 2), fixed(cam.cx, 2), fixed(cam.cy, 2),
+                            fixed(cam.distortion.k1, 5), fixed(cam.distortion.k2, 5), fixed(cam.distortion.p1, 6),
+                            fixed(cam.distortion.p2, 6), fixed(cam.distortion.k3, 5)));
     for (const ImageReport& ir : cr.images)
       cli::status(quiet, "gsa:   " + ir.name + ": " +
                              (ir.found ? fixed(ir.rms_px, 3) + " px" + (ir.note.empty() ? "" : " (" + ir.note + ")")
                                        : ir.note));
   }
   for (const StereoReport& s : r.stereo) {
-    cli::status(quiet, fmt::format("gsa: cam{} relative to cam0: {} image pairs, RMS reprojection {} px, baseline {} {}",
-                                   s.camera, s.n_pairs, fixed(s.rms_px, 3), fixed(s.baseline, 3), a.units));
+    cli::status(quiet,
+                fmt::format("gsa: cam{} relative to cam0: {} image pairs, RMS reprojection {} px, baseline {} {}",
+                            s.camera, s.n_pairs, fixed(s.rms_px, 3), fixed(s.baseline, 3), a.units));
     for (const std::string& d : s.dropped) cli::status(quiet, "gsa:   left out " + d);
   }
   make_parent(a.out);
@@ -188,8 +194,7 @@ std::string set_summary(const SetResult& s) {
 
 void report_views(const SetResult& s, bool quiet) {
   for (const ViewReport& v : s.views) {
-    std::string line = fmt::format("gsa: {}: {} marks labelled ({} candidates){}", v.name, v.n_labelled,
-                                   v.n_candidates,
+    std::string line = fmt::format("gsa: {}: {} marks labelled ({} candidates){}", v.name, v.n_labelled, v.n_candidates,
                                    v.has_reference ? fmt::format(", reference mark at ({:.1f}, {:.1f})",
                                                                  v.reference_pixel.x(), v.reference_pixel.y())
                                                    : ", no reference mark");
@@ -201,12 +206,18 @@ void report_views(const SetResult& s, bool quiet) {
 
 int run_digitise(const DigitiseArgs& a, bool quiet) {
   DigitiseOptions o;
-  if (a.marks == "dots") o.detect.kind = MarkKind::kDots;
-  else if (a.marks == "lines") o.detect.kind = MarkKind::kLines;
-  else throw UsageError("--marks: expected dots or lines, found '" + a.marks + "'");
-  if (a.centre == "centroid") o.detect.centre = CentreMethod::kCentroid;
-  else if (a.centre == "ellipse") o.detect.centre = CentreMethod::kEllipse;
-  else throw UsageError("--centre: expected centroid or ellipse, found '" + a.centre + "'");
+  if (a.marks == "dots")
+    o.detect.kind = MarkKind::kDots;
+  else if (a.marks == "lines")
+    o.detect.kind = MarkKind::kLines;
+  else
+    throw UsageError("--marks: expected dots or lines, found '" + a.marks + "'");
+  if (a.centre == "centroid")
+    o.detect.centre = CentreMethod::kCentroid;
+  else if (a.centre == "ellipse")
+    o.detect.centre = CentreMethod::kEllipse;
+  else
+    throw UsageError("--centre: expected centroid or ellipse, found '" + a.centre + "'");
   if (a.frame != "grid" && a.frame != "rig") throw UsageError("--frame: expected grid or rig, found '" + a.frame + "'");
   if (a.undeformed_rotate % 90 != 0)
     throw UsageError("--undeformed-rotate: expected 0, 90, 180 or 270 degrees, found " +
@@ -223,8 +234,9 @@ int run_digitise(const DigitiseArgs& a, bool quiet) {
   if (!a.undeformed.empty() && a.pitch > 0)
     throw UsageError("give either --undeformed IMAGES (the flat blank) or --pitch MM (its printed pitch), not both");
   if (a.undeformed.empty() && !(a.pitch > 0))
-    throw UsageError("give --undeformed IMAGES (photographs of the flat blank) or --pitch MM (the printed pitch) for "
-                     "the undeformed positions");
+    throw UsageError(
+        "give --undeformed IMAGES (photographs of the flat blank) or --pitch MM (the printed pitch) for "
+        "the undeformed positions");
   if (!a.undeformed_seed.empty() && a.undeformed.empty())
     throw UsageError("--undeformed-seed: only with --undeformed images");
   const Rig rig = read_rig(a.calibration);
@@ -300,16 +312,19 @@ int run_digitise(const DigitiseArgs& a, bool quiet) {
     j["calibration"] = a.calibration;
     j["units"] = units;
     j["marks"] = a.marks;
-    if (und) j["undeformed"] = und->to_json();
-    else j["undeformed"] = {{"nominal_pitch", a.pitch}};
+    if (und)
+      j["undeformed"] = und->to_json();
+    else
+      j["undeformed"] = {{"nominal_pitch", a.pitch}};
     j["deformed"] = def.to_json();
     j["grid_rows"] = rows.size();
     j["rows_with_both_states"] = both;
     make_parent(a.report);
     io::write_json(a.report, j);
   }
-  cli::status(quiet, fmt::format("gsa: wrote {}: {} marks, {} with both states{}", a.out == "-" ? "the grid to stdout" : a.out,
-                                 rows.size(), both, a.report.empty() ? "" : "; report in " + a.report));
+  cli::status(quiet,
+              fmt::format("gsa: wrote {}: {} marks, {} with both states{}", a.out == "-" ? "the grid to stdout" : a.out,
+                          rows.size(), both, a.report.empty() ? "" : "; report in " + a.report));
   return cli::kExitOk;
 }
 
@@ -328,13 +343,20 @@ int run_synth_images(const SynthImagesArgs& a, bool quiet) {
   synth::ExampleOptions o;
   std::tie(o.width, o.height) = parse_pair(a.size, "--size", "WIDTHxHEIGHT in pixels, e.g. 1632x1224");
   if (o.width < 320 || o.height < 240) throw UsageError("--size: at least 320x240 pixels");
-  if (a.shape == "dome") o.shape = synth::SheetShape::kDome;
-  else if (a.shape == "bend") o.shape = synth::SheetShape::kBend;
-  else if (a.shape == "flat") o.shape = synth::SheetShape::kFlat;
-  else throw UsageError("--shape: expected dome, bend or flat, found '" + a.shape + "'");
-  if (a.marks == "dots") o.marks = synth::PatternKind::kDots;
-  else if (a.marks == "lines") o.marks = synth::PatternKind::kLines;
-  else throw UsageError("--marks: expected dots or lines, found '" + a.marks + "'");
+  if (a.shape == "dome")
+    o.shape = synth::SheetShape::kDome;
+  else if (a.shape == "bend")
+    o.shape = synth::SheetShape::kBend;
+  else if (a.shape == "flat")
+    o.shape = synth::SheetShape::kFlat;
+  else
+    throw UsageError("--shape: expected dome, bend or flat, found '" + a.shape + "'");
+  if (a.marks == "dots")
+    o.marks = synth::PatternKind::kDots;
+  else if (a.marks == "lines")
+    o.marks = synth::PatternKind::kLines;
+  else
+    throw UsageError("--marks: expected dots or lines, found '" + a.marks + "'");
   if (a.cameras < 2 || a.cameras > 3) throw UsageError("--cameras: 2 or 3");
   if (a.views < 3 || a.views > 16) throw UsageError("--views: 3 to 16 calibration views");
   if (!(a.noise >= 0) || !(a.blur >= 0)) throw UsageError("--noise, --blur: expected values >= 0");
@@ -415,7 +437,8 @@ void register_commands(sf::cli::Program& program) {
   const sf::cli::Program* prog = &program;
   auto cal = std::make_shared<CalibrateArgs>();
   program.add_command(
-      "calibrate", "Calibrate cameras (intrinsics, distortion, rig poses) from photographs of a chessboard or circle grid",
+      "calibrate",
+      "Calibrate cameras (intrinsics, distortion, rig poses) from photographs of a chessboard or circle grid",
       [cal](CLI::App& app) {
         app.add_option("cameras", cal->cameras,
                        "Per camera: a folder of images, a quoted pattern ('calib/cam0_*.png') or a comma-separated "
@@ -442,31 +465,44 @@ void register_commands(sf::cli::Program& program) {
             ->required()
             ->expected(1, -1);
         app.add_option("--undeformed", dig->undeformed, "Images of the flat blank, one per camera")->expected(1, -1);
-        app.add_option("--pitch", dig->pitch, "Printed grid pitch: nominal undeformed positions instead of --undeformed");
-        app.add_option("-o,--out", dig->out, "Grid file to write, or - for stdout (gsa analyse - reads it)")->required();
+        app.add_option("--pitch", dig->pitch,
+                       "Printed grid pitch: nominal undeformed positions instead of --undeformed");
+        app.add_option("-o,--out", dig->out, "Grid file to write, or - for stdout (gsa analyse - reads it)")
+            ->required();
         app.add_option("--report", dig->report, "Also write a JSON report: thresholds, rejected marks with reasons");
         app.add_option("--marks", dig->marks, "dots (default) or lines (junctions of a square line grid)");
         app.add_flag("--light-marks", dig->light_marks, "Marks lighter than the sheet");
         app.add_option("--centre", dig->centre, "Dot centres: centroid (default; grey-level) or ellipse");
-        app.add_option("--threshold", dig->threshold, "Contrast threshold of marks, fraction of the sheet's brightness (default 0.35)");
+        app.add_option("--threshold", dig->threshold,
+                       "Contrast threshold of marks, fraction of the sheet's brightness (default 0.35)");
         app.add_option("--mark-size", dig->mark_size, "Dot diameter or grid cell size in pixels (default: measured)");
-        app.add_option("--dot-diameter", dig->dot_diameter, "Printed dot diameter, for the perspective-bias correction (default: measured)");
-        app.add_flag("--no-bias-correction", dig->no_bias_correction, "Do not correct the perspective bias of dot centres");
-        app.add_option("--epipolar-tolerance", dig->epipolar, "Pixels off the epipolar line still consistent (default 2)");
-        app.add_option("--max-reprojection", dig->max_reprojection, "Marks with a larger RMS reprojection error (px) are dropped (default 1)");
-        app.add_option("--frame", dig->frame, "grid (default: per state, origin at mark (0,0), X along i, Z the normal) or rig (camera 0's frame)");
-        app.add_option("--seed", dig->seed, "X,Y: a pixel of camera 0's formed-part image at mark (0,0), when no reference mark is printed");
+        app.add_option("--dot-diameter", dig->dot_diameter,
+                       "Printed dot diameter, for the perspective-bias correction (default: measured)");
+        app.add_flag("--no-bias-correction", dig->no_bias_correction,
+                     "Do not correct the perspective bias of dot centres");
+        app.add_option("--epipolar-tolerance", dig->epipolar,
+                       "Pixels off the epipolar line still consistent (default 2)");
+        app.add_option("--max-reprojection", dig->max_reprojection,
+                       "Marks with a larger RMS reprojection error (px) are dropped (default 1)");
+        app.add_option(
+            "--frame", dig->frame,
+            "grid (default: per state, origin at mark (0,0), X along i, Z the normal) or rig (camera 0's frame)");
+        app.add_option("--seed", dig->seed,
+                       "X,Y: a pixel of camera 0's formed-part image at mark (0,0), when no reference mark is printed");
         app.add_option("--undeformed-seed", dig->undeformed_seed, "X,Y: the same mark in camera 0's flat-blank image");
-        app.add_option("--undeformed-rotate", dig->undeformed_rotate, "Turn the flat blank's labels by 90, 180 or 270 degrees (blank photographed turned)");
+        app.add_option("--undeformed-rotate", dig->undeformed_rotate,
+                       "Turn the flat blank's labels by 90, 180 or 270 degrees (blank photographed turned)");
         app.add_option("--units", dig->units, "Length unit written into the grid file (default: the rig's)");
       },
       [dig, prog] { return run_digitise(*dig, prog->common().quiet); });
 
   auto si = std::make_shared<SynthImagesArgs>();
   program.add_command(
-      "synth-images", "Render synthetic photographs of a gridded sheet (flat and formed) and calibration views, with the exact answer",
+      "synth-images",
+      "Render synthetic photographs of a gridded sheet (flat and formed) and calibration views, with the exact answer",
       [si](CLI::App& app) {
-        app.add_option("-o,--out", si->out, "Folder to write (calib/, flat/, formed/, truth.csv, rig_true.json)")->required();
+        app.add_option("-o,--out", si->out, "Folder to write (calib/, flat/, formed/, truth.csv, rig_true.json)")
+            ->required();
         app.add_option("--shape", si->shape, "Formed part: dome (default), bend or flat");
         app.add_option("--marks", si->marks, "dots (default) or lines");
         app.add_option("--size", si->size, "Image size WxH in pixels (default 1632x1224, 2 megapixels)");

@@ -160,12 +160,12 @@ struct Blob {
   int label = 0;
   cv::Rect box;
   Shape shape;
-  double area = 0;       // pixels above the threshold
-  double contrast = 0;   // median C over the blob
-  double peak = 0;       // 90th percentile of C over the blob: the ink's contrast
+  double area = 0;             // pixels above the threshold
+  double contrast = 0;         // median C over the blob
+  double peak = 0;             // 90th percentile of C over the blob: the ink's contrast
   Vec2 centre = Vec2::Zero();  // refined
-  double grey_area = 0;  // sum of (P - I) / P over the window: the dot's area times its contrast
-  double rim_residual = 0;  // RMS deviation of the window's rim from a plane / sheet level
+  double grey_area = 0;        // sum of (P - I) / P over the window: the dot's area times its contrast
+  double rim_residual = 0;     // RMS deviation of the window's rim from a plane / sheet level
 };
 
 // Grey-level centroid of a dot: weights (P - I) / P over a window that follows the blob's
@@ -308,9 +308,8 @@ DotDetection detect_dots(const Prepared& p, const DetectOptions& o, ViewMarks& v
       continue;
     }
     const int lab = b.label;
-    b.shape = pixel_shape(b.box, [&](int x, int y) {
-      return x >= 0 && y >= 0 && x < W && y < H && labels.at<int>(y, x) == lab;
-    });
+    b.shape = pixel_shape(
+        b.box, [&](int x, int y) { return x >= 0 && y >= 0 && x < W && y < H && labels.at<int>(y, x) == lab; });
     const double radius = std::sqrt(b.shape.a * b.shape.b);
     const double allowed = o.max_outline_residual + 0.35 / std::max(radius, 1.0);
     if (b.shape.outline_residual > allowed) {
@@ -319,8 +318,8 @@ DotDetection detect_dots(const Prepared& p, const DetectOptions& o, ViewMarks& v
       continue;
     }
     if (b.shape.b < o.min_axis_ratio * b.shape.a) {
-      v.rejected.push_back({c, fmt::format("too elongated (axis ratio {:.2f} < {})", b.shape.b / b.shape.a,
-                                           o.min_axis_ratio)});
+      v.rejected.push_back(
+          {c, fmt::format("too elongated (axis ratio {:.2f} < {})", b.shape.b / b.shape.a, o.min_axis_ratio)});
       continue;
     }
     std::vector<double> cs;
@@ -375,9 +374,11 @@ DotDetection detect_dots(const Prepared& p, const DetectOptions& o, ViewMarks& v
       if (nb.size() > 8) nb.resize(8);
       std::vector<double> a;
       for (const auto& e : nb) a.push_back(e.second);
-      if (a.size() >= 3 && out.dots[k].grey_area >= o.reference_area_ratio * median(a)) refs.push_back(static_cast<int>(k));
+      if (a.size() >= 3 && out.dots[k].grey_area >= o.reference_area_ratio * median(a))
+        refs.push_back(static_cast<int>(k));
     }
-    if (refs.size() == 1) out.reference = refs[0];
+    if (refs.size() == 1)
+      out.reference = refs[0];
     else if (refs.size() > 1) {
       out.reference_note = std::to_string(refs.size()) + " dots are reference-sized (at " + px(pts[refs[0]]) + ", " +
                            px(pts[refs[1]]) + "...): none used as the reference";
@@ -585,7 +586,9 @@ void report_unlabelled(const LatticeResult& lr, const std::vector<Vec2>& pts, co
 // `ratio` receives area / prediction.
 std::vector<char> area_outliers(const LatticeResult& lr, const std::vector<double>& area, Index exempt, double change,
                                 std::vector<double>& ratio) {
-  auto key = [](const Label& l) { return (static_cast<std::int64_t>(l.x()) << 32) ^ static_cast<std::uint32_t>(l.y()); };
+  auto key = [](const Label& l) {
+    return (static_cast<std::int64_t>(l.x()) << 32) ^ static_cast<std::uint32_t>(l.y());
+  };
   std::unordered_map<std::int64_t, Index> at;
   for (std::size_t k = 0; k < area.size(); ++k)
     if (lr.labels[k]) at[key(*lr.labels[k])] = static_cast<Index>(k);
@@ -618,9 +621,10 @@ void find_dots(const Prepared& p, const std::string& name, const DetectOptions& 
   const DotDetection det = detect_dots(p, o, v);
   v.n_candidates = det.n_blobs;
   if (static_cast<int>(det.dots.size()) < kMinMarks)
-    throw InputError(fmt::format("{}: too few grid marks ({} dots pass the size, shape and contrast tests out of {} "
-                                 "blobs; need {})",
-                                 name, det.dots.size(), det.n_blobs, kMinMarks));
+    throw InputError(
+        fmt::format("{}: too few grid marks ({} dots pass the size, shape and contrast tests out of {} "
+                    "blobs; need {})",
+                    name, det.dots.size(), det.n_blobs, kMinMarks));
   std::vector<Vec2> pts;
   for (const Blob& b : det.dots) pts.push_back(b.centre);
   if (!det.reference_note.empty()) v.thresholds["reference"] = det.reference_note;
@@ -697,7 +701,8 @@ void find_lines(const Prepared& p, const std::string& name, const DetectOptions&
     bool one = true;
     for (int d = 0; d < 8 && one; ++d) {
       const double t = 2 * kPi * d / 8;
-      const int x = static_cast<int>(std::lround(c.x() + r * std::cos(t))), y = static_cast<int>(std::lround(c.y() + r * std::sin(t)));
+      const int x = static_cast<int>(std::lround(c.x() + r * std::cos(t))),
+                y = static_cast<int>(std::lround(c.y() + r * std::sin(t)));
       if (x < 0 || y < 0 || x >= W || y >= H) {
         one = false;
         break;
@@ -728,8 +733,8 @@ void find_lines(const Prepared& p, const std::string& name, const DetectOptions&
     const int dot = it == dot_of_cell.end() ? -1 : it->second;
     if (dot >= 0) a += istats.at<int>(dot, cv::CC_STAT_AREA);
     if (a < o.area_low * med || a > o.area_high * med) {
-      v.rejected.push_back({c, fmt::format("cell area {:.0f} px outside [{:.0f}, {:.0f}] px", a, o.area_low * med,
-                                           o.area_high * med)});
+      v.rejected.push_back(
+          {c, fmt::format("cell area {:.0f} px outside [{:.0f}, {:.0f}] px", a, o.area_low * med, o.area_high * med)});
       continue;
     }
     const cv::Rect box(pstats.at<int>(k, cv::CC_STAT_LEFT), pstats.at<int>(k, cv::CC_STAT_TOP),
@@ -768,7 +773,8 @@ void find_lines(const Prepared& p, const std::string& name, const DetectOptions&
     v.reference_pixel = pts[ref];
     v.reference_lattice = Vec2(0.5, 0.5);
   } else {
-    if (n_refs > 1) v.thresholds["reference"] = std::to_string(n_refs) + " cells hold a dot: none used as the reference";
+    if (n_refs > 1)
+      v.thresholds["reference"] = std::to_string(n_refs) + " cells hold a dot: none used as the reference";
     seed = seed_index(pts, o.seed, name);
   }
   LatticeOptions lo;
@@ -822,7 +828,8 @@ void find_lines(const Prepared& p, const std::string& name, const DetectOptions&
     Vec2 q = a.sum / a.n;
     const Vec2 ai = a.ai / a.n, aj = a.aj / a.n;
     if (a.n < 2) {  // a grid corner: one cell alone places it too loosely to trust its label
-      v.rejected.push_back({q, fmt::format("junction ({}, {}): only one labelled cell next to it", ij.first, ij.second)});
+      v.rejected.push_back(
+          {q, fmt::format("junction ({}, {}): only one labelled cell next to it", ij.first, ij.second)});
       continue;
     }
     std::string why;
@@ -843,8 +850,8 @@ void find_lines(const Prepared& p, const std::string& name, const DetectOptions&
       bad = bad || (jn.q - mid).norm() > 0.25 * 0.5 * (f->second.q - b->second.q).norm();
     }
     if (bad) {
-      v.rejected.push_back({jn.q, fmt::format("junction ({}, {}): off the lines through its neighbours", ij.first,
-                                              ij.second)});
+      v.rejected.push_back(
+          {jn.q, fmt::format("junction ({}, {}): off the lines through its neighbours", ij.first, ij.second)});
       continue;
     }
     v.centres.push_back(jn.q);
@@ -878,12 +885,15 @@ ViewMarks find_marks(const GreyImage& image, const std::string& name, const Dete
                   {"reference_area_ratio", o.reference_area_ratio},
                   {"partial_area_change", o.partial_area_change},
                   {"lattice_tolerance", o.lattice_tolerance}};
-  if (o.kind == MarkKind::kDots) find_dots(p, name, o, v);
-  else find_lines(p, name, o, v);
+  if (o.kind == MarkKind::kDots)
+    find_dots(p, name, o, v);
+  else
+    find_lines(p, name, o, v);
   if (static_cast<int>(v.centres.size()) < kMinMarks)
-    throw InputError(fmt::format("{}: too few labelled grid marks ({}; need {}). {} candidates were found; see the "
-                                 "report for why the others were dropped",
-                                 name, v.centres.size(), kMinMarks, v.n_candidates));
+    throw InputError(
+        fmt::format("{}: too few labelled grid marks ({}; need {}). {} candidates were found; see the "
+                    "report for why the others were dropped",
+                    name, v.centres.size(), kMinMarks, v.n_candidates));
   return v;
 }
 

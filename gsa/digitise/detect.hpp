@@ -47,20 +47,20 @@ enum class CentreMethod { kCentroid, kEllipse };
 
 struct DetectOptions {
   MarkKind kind = MarkKind::kDots;
-  bool dark_marks = true;            // marks darker than the sheet (false: light marks)
-  double threshold = 0.35;           // contrast C above which a pixel belongs to a mark
-  double min_contrast = 0.25;        // a dot's median contrast must reach this
-  double mark_size_px = 0;           // dot diameter / cell size in pixels (0: measured)
-  double min_area_px = 8;            // smaller blobs are noise
-  double area_low = 0.3;             // blob area accepted in [area_low, area_high] x median
+  bool dark_marks = true;      // marks darker than the sheet (false: light marks)
+  double threshold = 0.35;     // contrast C above which a pixel belongs to a mark
+  double min_contrast = 0.25;  // a dot's median contrast must reach this
+  double mark_size_px = 0;     // dot diameter / cell size in pixels (0: measured)
+  double min_area_px = 8;      // smaller blobs are noise
+  double area_low = 0.3;       // blob area accepted in [area_low, area_high] x median
   double area_high = 3.5;
-  double max_outline_residual = 0.1; // RMS outline deviation from an ellipse / radius
-  double min_axis_ratio = 0.25;      // minor / major axis
-  double reference_area_ratio = 1.6; // reference dot: area / neighbours' median area
-  double partial_area_change = 0.1;  // dot dropped when |area / neighbours' - 1| exceeds this
+  double max_outline_residual = 0.1;  // RMS outline deviation from an ellipse / radius
+  double min_axis_ratio = 0.25;       // minor / major axis
+  double reference_area_ratio = 1.6;  // reference dot: area / neighbours' median area
+  double partial_area_change = 0.1;   // dot dropped when |area / neighbours' - 1| exceeds this
   CentreMethod centre = CentreMethod::kCentroid;
-  double lattice_tolerance = 0.3;    // see lattice.hpp
-  std::optional<Vec2> seed;          // a pixel near the mark to label (0, 0) when there is no reference
+  double lattice_tolerance = 0.3;  // see lattice.hpp
+  std::optional<Vec2> seed;        // a pixel near the mark to label (0, 0) when there is no reference
 
   // Throws sf::UsageError naming the option ("--threshold: ...") for values out of range.
   void validate() const;
@@ -76,11 +76,11 @@ struct ViewMarks {
   std::string name;
   int width = 0, height = 0;
   MarkKind kind = MarkKind::kDots;
-  std::vector<Vec2> centres;        // labelled marks, pixels
-  std::vector<Label> labels;        // their (i, j)
-  std::vector<double> areas;        // dot image areas, pixels^2 (lines: 0)
-  std::vector<Vec2> axis_i, axis_j; // local lattice step vectors, pixels
-  bool has_reference = false;       // labels are relative to the reference mark
+  std::vector<Vec2> centres;         // labelled marks, pixels
+  std::vector<Label> labels;         // their (i, j)
+  std::vector<double> areas;         // dot image areas, pixels^2 (lines: 0)
+  std::vector<Vec2> axis_i, axis_j;  // local lattice step vectors, pixels
+  bool has_reference = false;        // labels are relative to the reference mark
   Vec2 reference_pixel = Vec2::Zero();
   // Lattice coordinates of the reference: (0, 0) for a reference dot, (0.5, 0.5) for the
   // reference cell of a line grid.
@@ -89,7 +89,7 @@ struct ViewMarks {
   Index n_candidates = 0;           // blobs (dots) or cells (lines) found
   double mark_size_px = 0;          // measured (or given) mark size
   double median_area_px = 0;
-  nlohmann::json thresholds;        // what was applied (for the report)
+  nlohmann::json thresholds;  // what was applied (for the report)
 };
 
 // Finds and labels the marks of one image. Throws sf::InputError naming `name` when the

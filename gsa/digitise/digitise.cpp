@@ -47,17 +47,18 @@ nlohmann::json px(const Vec2& p) { return {std::round(p.x() * 100) / 100, std::r
 
 }  // namespace
 
-std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::string>& paths,
-                                       const std::string& option, const std::string& rig_name) {
+std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::string>& paths, const std::string& option,
+                                       const std::string& rig_name) {
   if (static_cast<Index>(paths.size()) != rig.n_cameras())
-    throw InputError(fmt::format("{}: {} image{} given, but the rig {} has {} camera{} (one image per camera, in the "
-                                 "rig's order: {})",
-                                 option, paths.size(), paths.size() == 1 ? "" : "s", rig_name, rig.n_cameras(),
-                                 rig.n_cameras() == 1 ? "" : "s", [&] {
-                                   std::string s;
-                                   for (const Camera& c : rig.cameras) s += (s.empty() ? "" : ", ") + c.name;
-                                   return s;
-                                 }()));
+    throw InputError(
+        fmt::format("{}: {} image{} given, but the rig {} has {} camera{} (one image per camera, in the "
+                    "rig's order: {})",
+                    option, paths.size(), paths.size() == 1 ? "" : "s", rig_name, rig.n_cameras(),
+                    rig.n_cameras() == 1 ? "" : "s", [&] {
+                      std::string s;
+                      for (const Camera& c : rig.cameras) s += (s.empty() ? "" : ", ") + c.name;
+                      return s;
+                    }()));
   // Read (decode) in parallel, one thread per image; errors reported in the rig's order.
   std::vector<NamedImage> out(paths.size());
   std::vector<std::exception_ptr> errors(paths.size());
@@ -79,9 +80,10 @@ std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::st
     const NamedImage& ni = out[k];
     const Camera& c = rig.cameras[k];
     if (ni.image.width != c.width || ni.image.height != c.height)
-      throw InputError(fmt::format("{}: {} x {} pixels, but camera {} of {} was calibrated at {} x {} (is it the "
-                                   "right camera, in the rig's order, and the full uncropped image?)",
-                                   paths[k], ni.image.width, ni.image.height, c.name, rig_name, c.width, c.height));
+      throw InputError(
+          fmt::format("{}: {} x {} pixels, but camera {} of {} was calibrated at {} x {} (is it the "
+                      "right camera, in the rig's order, and the full uncropped image?)",
+                      paths[k], ni.image.width, ni.image.height, c.name, rig_name, c.width, c.height));
   }
   return out;
 }
@@ -177,9 +179,9 @@ SetResult digitise_set(const Rig& rig, const std::vector<NamedImage>& images, co
       if (v != 0) {
         auto it = at0.find(key(L));
         if (it != at0.end()) {
-          const double d = epipolar_distance_px(E, cam.pixel_to_normalised(marks[v].centres[k]),
-                                                rig.cameras[0].pixel_to_normalised(marks[0].centres[it->second]),
-                                                rig.cameras[0]);
+          const double d =
+              epipolar_distance_px(E, cam.pixel_to_normalised(marks[v].centres[k]),
+                                   rig.cameras[0].pixel_to_normalised(marks[0].centres[it->second]), rig.cameras[0]);
           if (d > o.match.tolerance_px) {
             res.views[v].rejected.push_back(
                 {marks[v].centres[k], fmt::format("mark ({}, {}): {:.2f} px off the epipolar line of camera 0's mark "
@@ -275,9 +277,10 @@ SetResult digitise_set(const Rig& rig, const std::vector<NamedImage>& images, co
   }
   if (!res.marks.empty()) res.rms_px = std::sqrt(ss / res.marks.size());
   if (res.marks.size() < 4)
-    throw InputError(fmt::format("{}: too few marks triangulated ({}; need 4): the views share too few labelled "
-                                 "marks",
-                                 images[0].name, res.marks.size()));
+    throw InputError(
+        fmt::format("{}: too few marks triangulated ({}; need 4): the views share too few labelled "
+                    "marks",
+                    images[0].name, res.marks.size()));
   res.seconds = since(t0);
   return res;
 }
@@ -300,7 +303,8 @@ nlohmann::json SetResult::to_json() const {
     vj["used"] = v.n_used;
     vj["reference_mark"] = v.has_reference;
     if (v.has_reference) vj["reference_pixel"] = px(v.reference_pixel);
-    vj["labels_to_camera0"] = {{"symmetry", v.transform.symmetry}, {"offset", {v.transform.offset.x(), v.transform.offset.y()}}};
+    vj["labels_to_camera0"] = {{"symmetry", v.transform.symmetry},
+                               {"offset", {v.transform.offset.x(), v.transform.offset.y()}}};
     vj["epipolar_votes"] = {{"best", v.n_consistent}, {"runner_up", v.n_runner_up}};
     if (!v.dropped.empty()) vj["dropped"] = v.dropped;
     vj["thresholds"] = v.thresholds;

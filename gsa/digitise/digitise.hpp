@@ -27,12 +27,12 @@
 namespace sf::gsa::digitise {
 
 struct DigitiseOptions {
-  DetectOptions detect;            // detect.seed applies to camera 0's image only
+  DetectOptions detect;  // detect.seed applies to camera 0's image only
   MatchOptions match;
   TriangulationOptions triangulation;
-  bool bias_correction = true;     // dots: correct the perspective bias of centroids
-  double dot_diameter_mm = 0;      // for the bias correction; 0: measured from the images
-  int threads = 0;                 // views detected in parallel; 0: the hardware's count
+  bool bias_correction = true;  // dots: correct the perspective bias of centroids
+  double dot_diameter_mm = 0;   // for the bias correction; 0: measured from the images
+  int threads = 0;              // views detected in parallel; 0: the hardware's count
 
   // Throws sf::UsageError naming the option.
   void validate() const;
@@ -47,14 +47,14 @@ struct DigitisedMark {
 
 struct ViewReport {
   std::string name;
-  Index n_candidates = 0;      // blobs (dots) or cells (lines) found
-  Index n_labelled = 0;        // marks labelled in this view
-  Index n_used = 0;            // after the epipolar check
+  Index n_candidates = 0;  // blobs (dots) or cells (lines) found
+  Index n_labelled = 0;    // marks labelled in this view
+  Index n_used = 0;        // after the epipolar check
   bool has_reference = false;
   Vec2 reference_pixel = Vec2::Zero();
-  LabelTransform transform;    // this view's labels -> camera 0's
+  LabelTransform transform;                 // this view's labels -> camera 0's
   Index n_consistent = 0, n_runner_up = 0;  // epipolar votes (views other than camera 0)
-  std::string dropped;         // why the whole view was left out (three or more cameras)
+  std::string dropped;                      // why the whole view was left out (three or more cameras)
   nlohmann::json thresholds;
   std::vector<Rejection> rejected;
   double seconds = 0;
@@ -67,8 +67,8 @@ struct SetResult {
     Label ij;
     std::string why;
   };
-  std::vector<Failure> failed;        // labelled but not triangulated
-  bool has_reference = false;         // camera 0 saw the reference mark (labels relative to it)
+  std::vector<Failure> failed;  // labelled but not triangulated
+  bool has_reference = false;   // camera 0 saw the reference mark (labels relative to it)
   Vec2 reference_lattice = Vec2::Zero();
   MarkKind kind = MarkKind::kDots;
   double rms_px = 0, max_rms_px = 0;  // over the marks
@@ -76,13 +76,13 @@ struct SetResult {
   double max_bias_px = 0;             // largest perspective-bias correction applied
   double seconds = 0;
 
-  nlohmann::json to_json() const;     // the report (docs/digitise.md)
+  nlohmann::json to_json() const;  // the report (docs/digitise.md)
 };
 
 // Reads one image per camera, in the rig's camera order, checking count and sizes against
 // the rig. `option` names the command-line option in messages (e.g. "--deformed").
-std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::string>& paths,
-                                       const std::string& option, const std::string& rig_name);
+std::vector<NamedImage> read_image_set(const Rig& rig, const std::vector<std::string>& paths, const std::string& option,
+                                       const std::string& rig_name);
 
 // Digitises one set. Throws sf::InputError naming the image when a view holds no usable
 // grid or (two cameras) its labels cannot be matched to camera 0's.

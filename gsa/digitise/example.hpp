@@ -19,16 +19,16 @@
 namespace sf::gsa::digitise::synth {
 
 struct ExampleOptions {
-  int width = 1632, height = 1224;   // pixels (2.0 megapixels)
-  int n_cameras = 2;                 // 2 or 3
+  int width = 1632, height = 1224;  // pixels (2.0 megapixels)
+  int n_cameras = 2;                // 2 or 3
   SheetShape shape = SheetShape::kDome;
   PatternKind marks = PatternKind::kDots;  // kDots or kLines
-  int half_marks = 15;               // marks -15..15 per side (31 x 31)
-  double pitch = 5.0;                // mm
-  bool reference = true;             // print the reference mark
-  bool occlusion = false;            // an occluding flap over the part and a trimmed corner
-  bool uneven_lighting = true;       // a left-to-right fall-off and vignetting
-  int calibration_views = 12;        // chessboard views per camera
+  int half_marks = 15;                     // marks -15..15 per side (31 x 31)
+  double pitch = 5.0;                      // mm
+  bool reference = true;                   // print the reference mark
+  bool occlusion = false;                  // an occluding flap over the part and a trimmed corner
+  bool uneven_lighting = true;             // a left-to-right fall-off and vignetting
+  int calibration_views = 12;              // chessboard views per camera
   Effects effects{8, 0.7, 1.5 / 255.0, 1, 8, 0};
 };
 
@@ -67,8 +67,8 @@ std::pair<int, int> material_index(const Label& label, PatternKind marks, const 
 
 // Digitised marks against the exact ones.
 struct Comparison {
-  Index n = 0;            // marks compared
-  Index mislabelled = 0;  // marks more than a quarter pitch from their label's exact position
+  Index n = 0;                          // marks compared
+  Index mislabelled = 0;                // marks more than a quarter pitch from their label's exact position
   double rms = 0, max = 0;              // in the marks' frame (mm)
   double rms_rigid = 0, max_rigid = 0;  // after the best rigid motion of the marks onto the truth
 };

@@ -21,13 +21,18 @@ GreyImage read_image(const std::string& path) {
   } catch (const cv::Exception& e) {
     throw InputError(path + ": cannot read image (" + e.msg + ")");
   }
-  if (m.empty())
-    throw InputError(path + ": cannot read image (not an image format OpenCV reads, or a damaged file)");
+  if (m.empty()) throw InputError(path + ": cannot read image (not an image format OpenCV reads, or a damaged file)");
   double scale = 1.0;
   switch (m.depth()) {
-    case CV_8U: scale = 1.0 / 255.0; break;
-    case CV_16U: scale = 1.0 / 65535.0; break;
-    case CV_32F: scale = 1.0; break;
+    case CV_8U:
+      scale = 1.0 / 255.0;
+      break;
+    case CV_16U:
+      scale = 1.0 / 65535.0;
+      break;
+    case CV_32F:
+      scale = 1.0;
+      break;
     default:
       throw InputError(path + ": cannot read image (unsupported pixel depth; use 8- or 16-bit images)");
   }

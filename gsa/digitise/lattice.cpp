@@ -175,9 +175,12 @@ LatticeResult grow_lattice(const std::vector<Vec2>& P, Index seed, const Lattice
       const Label e = axis == 0 ? Label(1, 0) : Label(0, 1);
       const Index f = owner_of(L + e), b = owner_of(L - e);
       Vec2& a = axis == 0 ? res.axis_i[p] : res.axis_j[p];
-      if (f >= 0 && b >= 0) a = 0.5 * (P[f] - P[b]);
-      else if (f >= 0) a = P[f] - P[p];
-      else if (b >= 0) a = P[p] - P[b];
+      if (f >= 0 && b >= 0)
+        a = 0.5 * (P[f] - P[b]);
+      else if (f >= 0)
+        a = P[f] - P[p];
+      else if (b >= 0)
+        a = P[p] - P[b];
     }
     for (const Label& dir : dirs) {
       const Label T = L + dir;
@@ -185,9 +188,12 @@ LatticeResult grow_lattice(const std::vector<Vec2>& P, Index seed, const Lattice
       const Index b2 = b1 >= 0 ? owner_of(L - 2 * dir) : -1;
       const Vec2 step = dir.x() != 0 ? Vec2(dir.x() * res.axis_i[p]) : Vec2(dir.y() * res.axis_j[p]);
       Vec2 pred;
-      if (b1 >= 0 && b2 >= 0) pred = 3.0 * P[p] - 3.0 * P[b1] + P[b2];
-      else if (b1 >= 0) pred = 2.0 * P[p] - P[b1];
-      else pred = P[p] + step;
+      if (b1 >= 0 && b2 >= 0)
+        pred = 3.0 * P[p] - 3.0 * P[b1] + P[b2];
+      else if (b1 >= 0)
+        pred = 2.0 * P[p] - P[b1];
+      else
+        pred = P[p] + step;
       const double ell = std::max((pred - P[p]).norm(), 1e-9);
       const double radius = o.tolerance * ell;
       const Index taken = owner_of(T);
@@ -215,8 +221,10 @@ LatticeResult grow_lattice(const std::vector<Vec2>& P, Index seed, const Lattice
       owner[key(T)] = c;
       res.axis_i[c] = res.axis_i[p];
       res.axis_j[c] = res.axis_j[p];
-      if (dir.x() != 0) res.axis_i[c] = dir.x() * (P[c] - P[p]);
-      else res.axis_j[c] = dir.y() * (P[c] - P[p]);
+      if (dir.x() != 0)
+        res.axis_i[c] = dir.x() * (P[c] - P[p]);
+      else
+        res.axis_j[c] = dir.y() * (P[c] - P[p]);
       queue.push({(P[c] - pred).norm() / ell, c});
     }
   }

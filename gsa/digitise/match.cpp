@@ -12,10 +12,9 @@ namespace sf::gsa::digitise {
 namespace {
 
 Eigen::Matrix2i symmetry_matrix(int k) {
-  static const Eigen::Matrix2i rot[4] = {(Eigen::Matrix2i() << 1, 0, 0, 1).finished(),
-                                         (Eigen::Matrix2i() << 0, -1, 1, 0).finished(),
-                                         (Eigen::Matrix2i() << -1, 0, 0, -1).finished(),
-                                         (Eigen::Matrix2i() << 0, 1, -1, 0).finished()};
+  static const Eigen::Matrix2i rot[4] = {
+      (Eigen::Matrix2i() << 1, 0, 0, 1).finished(), (Eigen::Matrix2i() << 0, -1, 1, 0).finished(),
+      (Eigen::Matrix2i() << -1, 0, 0, -1).finished(), (Eigen::Matrix2i() << 0, 1, -1, 0).finished()};
   static const Eigen::Matrix2i swap = (Eigen::Matrix2i() << 0, 1, 1, 0).finished();
   return k < 4 ? rot[k] : Eigen::Matrix2i(rot[k - 4] * swap);
 }
@@ -119,23 +118,26 @@ MatchResult match_view(const Camera& cam0, const ViewMarks& v0, const Camera& ca
   res.n_second = second;
   const Index overlap = cands.empty() ? 0 : scores[best].overlap;
   if (res.n_consistent < 6) {
-    res.message = fmt::format("only {} marks agree with the epipolar geometry of camera 0 (need 6): does the "
-                              "calibration belong to these cameras and images?",
-                              res.n_consistent);
+    res.message = fmt::format(
+        "only {} marks agree with the epipolar geometry of camera 0 (need 6): does the "
+        "calibration belong to these cameras and images?",
+        res.n_consistent);
     return res;
   }
   if (res.n_consistent < 0.8 * overlap) {
-    res.message = fmt::format("only {} of {} marks seen in both views agree with the epipolar geometry (within {} "
-                              "px): does the calibration belong to these cameras, and were the images taken "
-                              "at the same time?",
-                              res.n_consistent, overlap, o.tolerance_px);
+    res.message = fmt::format(
+        "only {} of {} marks seen in both views agree with the epipolar geometry (within {} "
+        "px): does the calibration belong to these cameras, and were the images taken "
+        "at the same time?",
+        res.n_consistent, overlap, o.tolerance_px);
     return res;
   }
   if (second >= o.ambiguity * res.n_consistent) {
-    res.message = fmt::format("the labels are ambiguous along the epipolar lines ({} marks agree with the best "
-                              "match, {} with another); print a reference mark, turn the part so the grid does "
-                              "not run along the cameras' baseline, or add a third camera",
-                              res.n_consistent, second);
+    res.message = fmt::format(
+        "the labels are ambiguous along the epipolar lines ({} marks agree with the best "
+        "match, {} with another); print a reference mark, turn the part so the grid does "
+        "not run along the cameras' baseline, or add a third camera",
+        res.n_consistent, second);
     return res;
   }
   res.ok = true;

@@ -27,7 +27,7 @@ namespace sf::gsa::digitise {
 
 // An element of the square lattice's symmetry group with an integer shift.
 struct LabelTransform {
-  int symmetry = 0;           // 0..3: rotation by 90 x k degrees; 4..7: the same after i <-> j
+  int symmetry = 0;  // 0..3: rotation by 90 x k degrees; 4..7: the same after i <-> j
   Label offset = Label(0, 0);
   Vec2 reference = Vec2::Zero();  // r: (0, 0) or (0.5, 0.5)
 
@@ -40,16 +40,16 @@ struct LabelTransform {
 };
 
 struct MatchOptions {
-  double tolerance_px = 2.0;   // epipolar distance that counts as consistent
-  double ambiguity = 0.7;      // second best / best above this: ambiguous
+  double tolerance_px = 2.0;  // epipolar distance that counts as consistent
+  double ambiguity = 0.7;     // second best / best above this: ambiguous
 };
 
 struct MatchResult {
   bool ok = false;
   LabelTransform transform;
-  Index n_consistent = 0;     // marks of the view that agree with camera 0
-  Index n_second = 0;         // the same for the runner-up (S, o)
-  std::string message;        // why not ok
+  Index n_consistent = 0;  // marks of the view that agree with camera 0
+  Index n_second = 0;      // the same for the runner-up (S, o)
+  std::string message;     // why not ok
 };
 
 // How view v's labels map onto view 0's. Both views' marks, and their cameras.

@@ -37,7 +37,8 @@ double corner_radius(const Sheet& s) {
 // Position and normal in the sheet frame.
 Vec3 local_position(const Sheet& s, const Vec2& m) {
   switch (s.shape) {
-    case SheetShape::kFlat: return Vec3(m.x(), m.y(), 0.0);
+    case SheetShape::kFlat:
+      return Vec3(m.x(), m.y(), 0.0);
     case SheetShape::kDome: {
       const double R = s.dome_radius, a = s.dome_stretch / R;
       const double r = m.norm(), phi = a * r;
@@ -57,7 +58,8 @@ Vec3 local_position(const Sheet& s, const Vec2& m) {
 
 Vec3 local_normal(const Sheet& s, const Vec2& m) {
   switch (s.shape) {
-    case SheetShape::kFlat: return Vec3(0, 0, 1);
+    case SheetShape::kFlat:
+      return Vec3(0, 0, 1);
     case SheetShape::kDome: {
       const double R = s.dome_radius, a = s.dome_stretch / R;
       const double r = m.norm(), phi = a * r;
@@ -79,7 +81,8 @@ Vec3 Sheet::normal(const Vec2& m) const { return R * local_normal(*this, m); }
 
 std::pair<double, double> Sheet::stretches(const Vec2& m) const {
   switch (shape) {
-    case SheetShape::kFlat: return {1.0, 1.0};
+    case SheetShape::kFlat:
+      return {1.0, 1.0};
     case SheetShape::kDome: {
       const double R = dome_radius, a = dome_stretch / R;
       const double lm = R * a, lc = R * a * sinc(a * m.norm());
@@ -162,9 +165,7 @@ namespace {
 int clampi(long v, int lo, int hi) { return static_cast<int>(std::clamp<long>(v, lo, hi)); }
 
 // Index of the nearest multiple of `pitch` to x, clamped to [lo, hi].
-int nearest_index(double x, double pitch, int lo, int hi) {
-  return clampi(std::lround(x / pitch), lo, hi);
-}
+int nearest_index(double x, double pitch, int lo, int hi) { return clampi(std::lround(x / pitch), lo, hi); }
 
 }  // namespace
 
@@ -325,8 +326,10 @@ double Pattern::blurred_reflectance(const Vec2& m, const Mat2& blur) const {
       // Square waves S = +-1 along X and Y, each blurred across its nearest edge; black where
       // S_X S_Y = +1, inside the board.
       const long kx = std::lround(m.x() / p), ky = std::lround(m.y() / p);
-      const double Sx = ((kx % 2 == 0) ? 1.0 : -1.0) * std::erf((m.x() - kx * p) / (std::sqrt(2.0) * std::max(sx, 1e-12)));
-      const double Sy = ((ky % 2 == 0) ? 1.0 : -1.0) * std::erf((m.y() - ky * p) / (std::sqrt(2.0) * std::max(sy, 1e-12)));
+      const double Sx =
+          ((kx % 2 == 0) ? 1.0 : -1.0) * std::erf((m.x() - kx * p) / (std::sqrt(2.0) * std::max(sx, 1e-12)));
+      const double Sy =
+          ((ky % 2 == 0) ? 1.0 : -1.0) * std::erf((m.y() - ky * p) / (std::sqrt(2.0) * std::max(sy, 1e-12)));
       const double inside = smooth_band(m.x(), -p, (cols + 1) * p, sx) * smooth_band(m.y(), -p, (rows + 1) * p, sy);
       ink_fraction = 0.5 * (1.0 + Sx * Sy) * inside;
       break;
@@ -423,10 +426,14 @@ struct Caster {
 
   double grey(const Sample& s) const {
     switch (s.id) {
-      case kBackground: return scene.lighting.background;
-      case kFront: return scene.pattern.reflectance(s.m) * s.shade * scene.lighting.exposure;
-      case kBack: return scene.pattern.paper * s.shade * scene.lighting.exposure;
-      default: return scene.occluders[s.id - kOccluder].grey * scene.lighting.exposure;
+      case kBackground:
+        return scene.lighting.background;
+      case kFront:
+        return scene.pattern.reflectance(s.m) * s.shade * scene.lighting.exposure;
+      case kBack:
+        return scene.pattern.paper * s.shade * scene.lighting.exposure;
+      default:
+        return scene.occluders[s.id - kOccluder].grey * scene.lighting.exposure;
     }
   }
 };
@@ -517,8 +524,8 @@ void render_rows(const Caster& caster, const Effects& fx, int r0, int r1, GreyIm
         double sum = 0;
         for (const Vec2& ab : sharp_samples) {
           const double a = ab.x(), b = ab.y();
-          sum += caster.grey(caster.cast((1 - b) * ((1 - a) * k[0]->xn + a * k[1]->xn) +
-                                         b * ((1 - a) * k[2]->xn + a * k[3]->xn)));
+          sum += caster.grey(
+              caster.cast((1 - b) * ((1 - a) * k[0]->xn + a * k[1]->xn) + b * ((1 - a) * k[2]->xn + a * k[3]->xn)));
         }
         value = sum / static_cast<double>(sharp_samples.size());
       }

@@ -36,23 +36,23 @@ enum class SheetShape {
 
 struct Sheet {
   SheetShape shape = SheetShape::kFlat;
-  Vec2 centre = Vec2::Zero();          // centre of the material rectangle (mm)
-  double half_width = 77.5;            // material half extent along X (mm)
-  double half_height = 77.5;           // along Y
+  Vec2 centre = Vec2::Zero();                             // centre of the material rectangle (mm)
+  double half_width = 77.5;                               // material half extent along X (mm)
+  double half_height = 77.5;                              // along Y
   double trim = std::numeric_limits<double>::infinity();  // X + Y > trim is cut away
-  double dome_radius = 150.0;          // R (mm)
-  double dome_stretch = 1.05;          // meridional stretch R a
-  double bend_radius = 100.0;          // R (mm)
-  double bend_stretch1 = 1.04;         // along X (across the bend axis)
-  double bend_stretch2 = 0.98;         // along Y (the bend axis)
-  Mat3 R = Mat3::Identity();           // sheet frame -> world
+  double dome_radius = 150.0;                             // R (mm)
+  double dome_stretch = 1.05;                             // meridional stretch R a
+  double bend_radius = 100.0;                             // R (mm)
+  double bend_stretch1 = 1.04;                            // along X (across the bend axis)
+  double bend_stretch2 = 0.98;                            // along Y (the bend axis)
+  Mat3 R = Mat3::Identity();                              // sheet frame -> world
   Vec3 t = Vec3::Zero();
 
   // The formed shape is placed so that the corners of the material rectangle sit at z = 0
   // and the part bulges toward +z.
-  bool contains(const Vec2& m) const;          // m is on the part (inside the trimmed outline)
-  Vec3 position(const Vec2& m) const;          // world position of material point m
-  Vec3 normal(const Vec2& m) const;            // unit normal (world), the printed side
+  bool contains(const Vec2& m) const;  // m is on the part (inside the trimmed outline)
+  Vec3 position(const Vec2& m) const;  // world position of material point m
+  Vec3 normal(const Vec2& m) const;    // unit normal (world), the printed side
   // Exact principal stretches lambda1 >= lambda2 at material point m.
   std::pair<double, double> stretches(const Vec2& m) const;
 
@@ -67,25 +67,25 @@ struct Sheet {
 };
 
 enum class PatternKind {
-  kDots,                // filled dots at (i, j) * pitch
-  kLines,               // lines X = i pitch and Y = j pitch (junctions are the marks)
-  kChessboard,          // inner corners (k, l) * pitch, k < cols, l < rows
-  kCircles,             // symmetric circle grid, centres (k, l) * pitch
-  kAsymmetricCircles,   // OpenCV's asymmetric grid, centres ((2k + l % 2), l) * pitch
+  kDots,               // filled dots at (i, j) * pitch
+  kLines,              // lines X = i pitch and Y = j pitch (junctions are the marks)
+  kChessboard,         // inner corners (k, l) * pitch, k < cols, l < rows
+  kCircles,            // symmetric circle grid, centres (k, l) * pitch
+  kAsymmetricCircles,  // OpenCV's asymmetric grid, centres ((2k + l % 2), l) * pitch
 };
 
 struct Pattern {
   PatternKind kind = PatternKind::kDots;
-  double pitch = 5.0;            // mm
-  double dot_diameter = 2.0;     // dots, circle grids (mm)
-  double line_width = 0.35;      // lines (mm)
-  int i_min = -15, i_max = 15;   // dots / line junctions: index ranges
+  double pitch = 5.0;           // mm
+  double dot_diameter = 2.0;    // dots, circle grids (mm)
+  double line_width = 0.35;     // lines (mm)
+  int i_min = -15, i_max = 15;  // dots / line junctions: index ranges
   int j_min = -15, j_max = 15;
-  bool reference = true;         // dots: a bigger dot at (0, 0); lines: a dot in cell (0, 0)
+  bool reference = true;             // dots: a bigger dot at (0, 0); lines: a dot in cell (0, 0)
   double reference_diameter = 2.83;  // dots: sqrt(2) x, twice the area; lines: the cell dot
-  int cols = 9, rows = 6;        // chessboard inner corners / circle counts
-  double ink = 0.08;             // reflectance of the printed marks
-  double paper = 0.85;           // reflectance of the sheet
+  int cols = 9, rows = 6;            // chessboard inner corners / circle counts
+  double ink = 0.08;                 // reflectance of the printed marks
+  double paper = 0.85;               // reflectance of the sheet
 
   double reflectance(const Vec2& m) const;
   // The reflectance seen through a Gaussian blur: `blur` maps pixels to material
@@ -115,7 +115,7 @@ struct Occluder {
 
 struct Lighting {
   Vec3 light = Vec3(0.3, -0.4, 1.0).normalized();  // toward the light (world)
-  double ambient = 0.45, diffuse = 0.55;            // Lambertian shading of the sheet
+  double ambient = 0.45, diffuse = 0.55;           // Lambertian shading of the sheet
   double gradient = 0.0;     // illumination falls by this fraction from the left to the right edge
   double vignetting = 0.0;   // fraction lost at the image corners (quadratic in the radius)
   double exposure = 1.0;     // grey level (0..1) of reflectance 1 under full light
@@ -134,8 +134,8 @@ struct Effects {
   double blur_sigma = 0.0;   // optical blur (Gaussian PSF), pixels (0: none); see render()
   double noise_sigma = 0.0;  // additive Gaussian noise, grey levels of 1 (e.g. 2/255)
   unsigned seed = 1;
-  int quantise_bits = 8;     // round to 8 or 16 bits (0: keep floats)
-  int threads = 0;           // 0: the hardware's count
+  int quantise_bits = 8;  // round to 8 or 16 bits (0: keep floats)
+  int threads = 0;        // 0: the hardware's count
 };
 
 // Renders the scene as `camera` sees it (camera.width x camera.height pixels).

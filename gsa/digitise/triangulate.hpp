@@ -33,10 +33,10 @@ struct TriangulationOptions {
 struct TriangulatedPoint {
   bool ok = false;
   Vec3 X = Vec3::Zero();
-  double rms_px = 0;                 // RMS reprojection error over the views used
-  std::vector<Observation> used;     // the views kept
-  std::vector<double> residual_px;   // per view kept
-  std::string why;                   // when not ok
+  double rms_px = 0;                // RMS reprojection error over the views used
+  std::vector<Observation> used;    // the views kept
+  std::vector<double> residual_px;  // per view kept
+  std::string why;                  // when not ok
 };
 
 TriangulatedPoint triangulate(const Rig& rig, const std::vector<Observation>& observations,

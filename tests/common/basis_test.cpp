@@ -56,8 +56,7 @@ TEST(BasisCubicHermite, MatchesClosedFormsOfTheBrief) {
   for (int s = 0; s < 20; ++s) {
     const double t = u(rng);
     const auto h = cubic_hermite(t, 0);
-    const double ref[4] = {1 - 3 * t * t + 2 * t * t * t, t * (t - 1) * (t - 1), t * t * (3 - 2 * t),
-                           t * t * (t - 1)};
+    const double ref[4] = {1 - 3 * t * t + 2 * t * t * t, t * (t - 1) * (t - 1), t * t * (3 - 2 * t), t * t * (t - 1)};
     for (int f = 0; f < 4; ++f) EXPECT_NEAR(h[f], ref[f], kRoundoff) << "H" << f << " at t=" << t;
   }
 }
@@ -137,8 +136,7 @@ TEST(BasisCubicHermite, TableIsCubicHermiteBitForBit) {
 TEST(BasisLinearLagrange, InterpolationAndPartitionOfUnity) {
   for (int end = 0; end < 2; ++end) {
     const auto l = linear_lagrange(end, 0);
-    for (int f = 0; f < 2; ++f)
-      EXPECT_NEAR(l[f], f == end ? 1.0 : 0.0, kRoundoff) << "L" << f << " at t=" << end;
+    for (int f = 0; f < 2; ++f) EXPECT_NEAR(l[f], f == end ? 1.0 : 0.0, kRoundoff) << "L" << f << " at t=" << end;
   }
   for (int q = 0; q <= 8; ++q) {
     const double t = -0.25 + q * 0.1875;
@@ -309,9 +307,8 @@ void check_partition_of_unity(unsigned seed) {
       double sum = 0.0;
       for (int n = 0; n < B::kNumNodes; ++n) sum += basis_derivative<decltype(b), kDim>(b, B::kParamsPerNode * n, o);
       const bool value = o == std::array<int, kDim>{};
-      EXPECT_NEAR(sum, value ? 1.0 : 0.0, kRoundoff)
-          << Traits<B>::name() << ": sum over nodes of the value functions, " << orders_str<kDim>(o)
-          << ", at xi=" << str(xi);
+      EXPECT_NEAR(sum, value ? 1.0 : 0.0, kRoundoff) << Traits<B>::name() << ": sum over nodes of the value functions, "
+                                                     << orders_str<kDim>(o) << ", at xi=" << str(xi);
     }
   }
 }
@@ -421,9 +418,7 @@ TEST(BasisBicubic, InterpolationConditionsAtCorners) { check_interpolation_condi
 
 TEST(BasisBicubic, ReproducesBicubicPolynomials) { check_reproduction<BicubicHermite>(test::kSeed + 11); }
 
-TEST(BasisBicubic, DerivativesMatchFiniteDifferences) {
-  check_finite_differences<BicubicHermite>(test::kSeed + 12);
-}
+TEST(BasisBicubic, DerivativesMatchFiniteDifferences) { check_finite_differences<BicubicHermite>(test::kSeed + 12); }
 
 TEST(BasisBicubic, IsTensorProductInDocumentedOrder) {
   // Function k = 4n + d with n = a + 2b, d = k1 + 2 k2 is H_{2a+k1}(xi1) H_{2b+k2}(xi2).
@@ -448,7 +443,7 @@ TEST(BasisBicubic, DerivativeOfAnyOrderUpToThree) {
     const Vec2 xi = random_point<BicubicHermite>(rng);
     const auto b = BicubicHermite::evaluate(xi, kValues | kFirst | kSecond);
     const std::pair<int, int> orders[] = {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1}, {0, 2}};
-    const Eigen::Matrix<double, 16, 1> expected[] = {b.value,        b.first.col(0),  b.first.col(1),
+    const Eigen::Matrix<double, 16, 1> expected[] = {b.value,         b.first.col(0),  b.first.col(1),
                                                      b.second.col(0), b.second.col(1), b.second.col(2)};
     for (int q = 0; q < 6; ++q) {
       const Eigen::Matrix<double, 16, 1> d = BicubicHermite::derivative(xi, orders[q].first, orders[q].second);
@@ -492,9 +487,7 @@ TEST(BasisBicubic, RecordsRequestedUpdates) {
 // ---------------------------------------------------------------------------
 // Bicubic Hermite x linear (32)
 
-TEST(BasisBicubicHermiteLinear, PartitionOfUnity) {
-  check_partition_of_unity<BicubicHermiteLinear>(test::kSeed + 20);
-}
+TEST(BasisBicubicHermiteLinear, PartitionOfUnity) { check_partition_of_unity<BicubicHermiteLinear>(test::kSeed + 20); }
 
 TEST(BasisBicubicHermiteLinear, InterpolationConditionsAtNodes) {
   check_interpolation_conditions<BicubicHermiteLinear>();
@@ -518,8 +511,8 @@ TEST(BasisBicubicHermiteLinear, FacesAreTheBicubicBasis) {
       for (int k = 0; k < 32; ++k) {
         const bool on_face = (k / 16) == c;
         const int k2 = k % 16;
-        const std::string where = "function " + std::to_string(k) + " on face xi3=" + std::to_string(c) +
-                                  " at xi=" + str(xi);
+        const std::string where =
+            "function " + std::to_string(k) + " on face xi3=" + std::to_string(c) + " at xi=" + str(xi);
         EXPECT_NEAR(b.value[k], on_face ? q.value[k2] : 0.0, kRoundoff) << where;
         EXPECT_NEAR(b.first(k, 0), on_face ? q.first(k2, 0) : 0.0, kRoundoff) << where;
         EXPECT_NEAR(b.first(k, 1), on_face ? q.first(k2, 1) : 0.0, kRoundoff) << where;
@@ -536,13 +529,9 @@ TEST(BasisBicubicHermiteLinear, FacesAreTheBicubicBasis) {
 
 TEST(BasisCubicHermiteLinear, PartitionOfUnity) { check_partition_of_unity<CubicHermiteLinear>(test::kSeed + 30); }
 
-TEST(BasisCubicHermiteLinear, InterpolationConditionsAtNodes) {
-  check_interpolation_conditions<CubicHermiteLinear>();
-}
+TEST(BasisCubicHermiteLinear, InterpolationConditionsAtNodes) { check_interpolation_conditions<CubicHermiteLinear>(); }
 
-TEST(BasisCubicHermiteLinear, ReproducesCubicTimesLinear) {
-  check_reproduction<CubicHermiteLinear>(test::kSeed + 31);
-}
+TEST(BasisCubicHermiteLinear, ReproducesCubicTimesLinear) { check_reproduction<CubicHermiteLinear>(test::kSeed + 31); }
 
 TEST(BasisCubicHermiteLinear, DerivativesMatchFiniteDifferences) {
   check_finite_differences<CubicHermiteLinear>(test::kSeed + 32);

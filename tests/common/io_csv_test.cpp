@@ -55,11 +55,9 @@ TEST(IoCsv, CharColumnCountsUtf8Characters) {
 }
 
 TEST(IoCsv, WrongFieldCountReportsLine) {
-  const std::string msg =
-      message_of<InputError>([] { read_csv_string("id,X,Y\np1,1,2\n\np2,1\n", "grid.csv"); });
+  const std::string msg = message_of<InputError>([] { read_csv_string("id,X,Y\np1,1,2\n\np2,1\n", "grid.csv"); });
   EXPECT_EQ(msg, "grid.csv:4: expected 3 fields (as in the header), found 2");
-  const std::string more =
-      message_of<InputError>([] { read_csv_string("id,X\np1,1,2\n", "g.csv"); });
+  const std::string more = message_of<InputError>([] { read_csv_string("id,X\np1,1,2\n", "g.csv"); });
   EXPECT_EQ(more, "g.csv:2: expected 2 fields (as in the header), found 3");
 }
 
@@ -144,9 +142,8 @@ TEST(IoCsv, NanAndMissingCells) {
 }
 
 TEST(IoCsv, NumberParsingIsStrict) {
-  const CsvTable t = read_csv_string(
-      "v\n1.5e3\n-0.5\n+2\n1e-310\n\"1,5\"\ninf\n-inf\n1e400\n0x10\n1.5abc\n1 2\n-\n.\n+-1\n",
-      "s.csv");
+  const CsvTable t =
+      read_csv_string("v\n1.5e3\n-0.5\n+2\n1e-310\n\"1,5\"\ninf\n-inf\n1e400\n0x10\n1.5abc\n1 2\n-\n.\n+-1\n", "s.csv");
   EXPECT_DOUBLE_EQ(t.number(0, 0), 1500.0);
   EXPECT_DOUBLE_EQ(t.number(1, 0), -0.5);
   EXPECT_DOUBLE_EQ(t.number(2, 0), 2.0);
@@ -187,14 +184,14 @@ TEST(IoCsv, NoHeaderAndTabDelimiter) {
 // after a preamble of other tables; the delimiter found from it.
 TEST(IoCsv, HeaderSearchSkipsAPreambleAndFindsTheDelimiter) {
   const std::string text =
-      "Project: plate 7\n"                     // 1
-      "Stage;Time [s];Force [kN]\n"            // 2: another table first
-      "12;24.0;18.5\n"                         // 3
-      "\n"                                     // 4
-      "id; x [mm]; y [mm]\n"                   // 5: the header
-      "p1; 1.5; 2\n"                           // 6
-      "# a comment\n"                          // 7
-      "p2; 3; 4\n";                            // 8
+      "Project: plate 7\n"           // 1
+      "Stage;Time [s];Force [kN]\n"  // 2: another table first
+      "12;24.0;18.5\n"               // 3
+      "\n"                           // 4
+      "id; x [mm]; y [mm]\n"         // 5: the header
+      "p1; 1.5; 2\n"                 // 6
+      "# a comment\n"                // 7
+      "p2; 3; 4\n";                  // 8
   CsvOptions o;
   o.delimiter = kDetectDelimiter;
   o.header_test = [](const std::vector<std::string>& names) {
@@ -225,7 +222,8 @@ TEST(IoCsv, CommentedHeaderOverTheDataIsTheHeader) {
   CsvOptions o;
   o.delimiter = kDetectDelimiter;
   o.header_test = [](const std::vector<std::string>& names) { return names.size() == 3 && names[0] == "ID"; };
-  const CsvTable t = read_csv_string("# exported 2024\n#   ID;  x_undef [mm];  u [mm]\n  1;  -8.5;  0.25\n", "n.txt", o);
+  const CsvTable t =
+      read_csv_string("# exported 2024\n#   ID;  x_undef [mm];  u [mm]\n  1;  -8.5;  0.25\n", "n.txt", o);
   EXPECT_EQ(t.header_line(), 2);
   EXPECT_EQ(t.names(), (std::vector<std::string>{"ID", "x_undef [mm]", "u [mm]"}));
   ASSERT_EQ(t.n_rows(), 1u);
@@ -314,10 +312,8 @@ TEST(IoCsv, FileReadingAndMissingFile) {
   EXPECT_EQ(t.file_name(), dir.file("g.csv"));
   EXPECT_DOUBLE_EQ(t.number(0, 1), 1.0);
   const std::string missing = dir.file("absent.csv");
-  EXPECT_THAT(message_of<InputError>([&] { read_csv(missing); }),
-              HasSubstr(missing + ": cannot open file"));
-  EXPECT_THAT(message_of<InputError>([&] { read_csv(dir.path().string()); }),
-              HasSubstr("cannot open file"));
+  EXPECT_THAT(message_of<InputError>([&] { read_csv(missing); }), HasSubstr(missing + ": cannot open file"));
+  EXPECT_THAT(message_of<InputError>([&] { read_csv(dir.path().string()); }), HasSubstr("cannot open file"));
 }
 
 TEST(IoCsvWriter, RoundTripsDoublesExactly) {
@@ -326,8 +322,8 @@ TEST(IoCsvWriter, RoundTripsDoublesExactly) {
   std::vector<std::vector<double>> rows;
   for (int r = 0; r < 200; ++r) {
     const double scale = std::pow(10.0, (r % 41) - 20);
-    rows.push_back({uniform(rng) * scale, uniform(rng), 1.0 / 3.0, -0.0,
-                    std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::max()});
+    rows.push_back({uniform(rng) * scale, uniform(rng), 1.0 / 3.0, -0.0, std::numeric_limits<double>::denorm_min(),
+                    std::numeric_limits<double>::max()});
   }
   rows[7][1] = std::numeric_limits<double>::quiet_NaN();
   std::ostringstream out;

@@ -95,7 +95,8 @@ TEST(IoGridFile, PairOfFilesIsJoinedOnIdInAnyRowOrder) {
   ScratchDir dir;
   const std::string u = dir.file("u.csv"), d = dir.file("d.csv");
   write_text(u, "id,x,y,z,i,j\np1,0,0,0,0,0\np2,1,0,0,0,1\np3,0,1,0,1,0\np4,1,1,0,1,1\n");
-  write_text(d, "# deformed, other order, p3 not digitised\nz,id,y,x\n0.4,p4,1.4,1.4\n0.2,p2,0.2,1.2\n0.1,p1,0.1,0.1\n");
+  write_text(d,
+             "# deformed, other order, p3 not digitised\nz,id,y,x\n0.4,p4,1.4,1.4\n0.2,p2,0.2,1.2\n0.1,p1,0.1,0.1\n");
   const GridData g = read_grid_file_pair(u, d);
   ASSERT_EQ(g.n_points(), 4);
   EXPECT_THAT(g.ids, ElementsAre("p1", "p2", "p3", "p4"));
@@ -154,7 +155,8 @@ TEST(IoGridFile, MalformedNumberNamesFileLineAndColumn) {
   EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path); }),
               AllOf(HasSubstr(path + ":4:3:"), HasSubstr("'Y'"), HasSubstr("2x")));
   write_text(path, "id,X,Y,Z,x,y,z,i,j\np1,0,0,0,0,0,0,1.5,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path); }), AllOf(HasSubstr(path + ":2:8:"), HasSubstr("'i'")));
+  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path); }),
+              AllOf(HasSubstr(path + ":2:8:"), HasSubstr("'i'")));
 }
 
 TEST(IoGridFile, DuplicateIdNamesBothLines) {
@@ -175,7 +177,8 @@ TEST(IoGridFile, MissingColumnListsTheColumnsFound) {
   write_text(path, "id,X,Y,Z,u,v\np1,0,0,0,0,0\n");
   GridReadOptions o;
   o.columns = {{"u", "u"}, {"v", "v"}, {"w", "w"}};
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, o); }), AllOf(HasSubstr("'w'"), HasSubstr("id, X, Y, Z, u, v")));
+  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, o); }),
+              AllOf(HasSubstr("'w'"), HasSubstr("id, X, Y, Z, u, v")));
 }
 
 TEST(IoGridFile, MissingFileIsNamed) {
@@ -214,7 +217,8 @@ TEST(IoGridFile, WrittenGridReadsBackExactly) {
   EXPECT_EQ(back.j, g.j);
   for (Index p = 0; p < 5; ++p)
     for (int k = 0; k < 3; ++k) {
-      for (const auto& [written, read] : {std::pair{&g.undeformed, &back.undeformed}, std::pair{&g.deformed, &back.deformed}}) {
+      for (const auto& [written, read] :
+           {std::pair{&g.undeformed, &back.undeformed}, std::pair{&g.deformed, &back.deformed}}) {
         const double w = (*written)(p, k), r = (*read)(p, k);
         if (std::isnan(w)) {
           EXPECT_TRUE(std::isnan(r)) << "mark " << p << " coordinate " << k;
@@ -266,8 +270,7 @@ TEST(IoGridFile, WriterExtraColumns) {
     w.add("b", Vec3(1, 2, 3), Vec3(kNaN, 5, 6), 1, 1, {kNaN, kNaN});
     EXPECT_THROW(w.add("c", Vec3::Zero(), Vec3::Zero(), 2, 1), std::logic_error);  // no extras given
   }
-  EXPECT_EQ(out.str(),
-            "id,X,Y,Z,x,y,z,i,j,views,reproj_px\na,1,2,3,4,5,6,0,1,2,0.125\nb,1,2,3,,,,1,1,,\n");
+  EXPECT_EQ(out.str(), "id,X,Y,Z,x,y,z,i,j,views,reproj_px\na,1,2,3,4,5,6,0,1,2,0.125\nb,1,2,3,,,,1,1,,\n");
   GridWriteOptions clash;
   clash.extra_columns = {"X"};
   std::ostringstream out2;

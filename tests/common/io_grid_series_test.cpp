@@ -69,8 +69,8 @@ TEST(IoGridSeries, OneFilePerStageJoinedOnTheId) {
   EXPECT_EQ(s.stages[0].name, "surface-1_2.000s");
   EXPECT_EQ(s.stages[0].time, 2.0);
   EXPECT_EQ(s.stages[1].time, 10.0);
-  EXPECT_THAT(s.sources, ElementsAre(dir + "surface-1_0.000s.csv", dir + "surface-1_2.000s.csv",
-                                     dir + "surface-1_10.000s.csv"));
+  EXPECT_THAT(s.sources,
+              ElementsAre(dir + "surface-1_0.000s.csv", dir + "surface-1_2.000s.csv", dir + "surface-1_10.000s.csv"));
   for (Index p = 0; p < 49; ++p) {
     const int pid = std::stoi(s.ids[p]);
     const Vec3 X = example_reference((pid - 1) / 7, (pid - 1) % 7);
@@ -142,8 +142,9 @@ TEST(IoGridSeries, StageColumnInOneFile) {
   EXPECT_LT((row(s.undeformed, 8) - X).norm(), kSixDecimals);
   EXPECT_LT((row(s.stages[0].deformed, 8) - example_current(X, 5.0)).norm(), kSixDecimals);
   EXPECT_LT((row(s.stages[1].deformed, 8) - example_current(X, 10.0)).norm(), kSixDecimals);
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_series_column(formats_dir() + "stage_column.csv", "stage", o, "1"); }),
-              HasSubstr("no rows of the reference stage '1' (stages: 0, 5, 10)"));
+  EXPECT_THAT(
+      message_of<InputError>([&] { read_grid_series_column(formats_dir() + "stage_column.csv", "stage", o, "1"); }),
+      HasSubstr("no rows of the reference stage '1' (stages: 0, 5, 10)"));
 }
 
 TEST(IoGridSeries, StageColumnWithReferencePositionsInEveryRow) {
@@ -161,8 +162,9 @@ TEST(IoGridSeries, StageColumnWithReferencePositionsInEveryRow) {
   EXPECT_EQ(s.stages[0].sigma[0], 0.02);
   EXPECT_TRUE(std::isnan(s.stages[0].sigma[1]));
   write_text(path, "id,frame,X,Y,Z,u,v,w\na,1,0,0,0,0.1,0,0\na,1,0,0,0,0.1,0,0\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_series_column(path, "frame"); }),
-              AllOf(HasSubstr(path + ":3:1:"), HasSubstr("duplicate id 'a' in stage '1'"), HasSubstr("first at line 2")));
+  EXPECT_THAT(
+      message_of<InputError>([&] { read_grid_series_column(path, "frame"); }),
+      AllOf(HasSubstr(path + ":3:1:"), HasSubstr("duplicate id 'a' in stage '1'"), HasSubstr("first at line 2")));
 }
 
 TEST(IoGridSeries, StageFileWithAnIdTheReferenceLacksIsAnError) {

@@ -48,7 +48,8 @@ GridReadOptions preset(MeasurementFormat f) {
 }
 
 bool any_note(const GridData& g, const std::string& text) {
-  return std::any_of(g.notes.begin(), g.notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+  return std::any_of(g.notes.begin(), g.notes.end(),
+                     [&](const std::string& n) { return n.find(text) != std::string::npos; });
 }
 
 TEST(IoFormats, PresetNames) {
@@ -151,14 +152,15 @@ TEST(IoFormats, Vic3dFrameExport) {
   const GridData s = read_grid_file(path, scaled);
   ASSERT_EQ(s.sigma_deformed.size(), 49u);
   EXPECT_NEAR(s.sigma_deformed[index_of(s, "300_420")], 0.02 * 0.005, 1e-15);  // point 1
-  EXPECT_TRUE(std::isnan(s.sigma_deformed[index_of(s, "384_420")]));          // point 5: sigma = -1
+  EXPECT_TRUE(std::isnan(s.sigma_deformed[index_of(s, "384_420")]));           // point 5: sigma = -1
   EXPECT_EQ(row(s.undeformed, 1), row(g.undeformed, 1));                       // positions are in mm already
 }
 
 TEST(IoFormats, Vic3dWithoutSigmaTakesARowOfZerosForAFailedPoint) {
   ScratchDir dir;
   const std::string path = dir.file("vic.csv");
-  write_text(path, " \"X\", \"Y\", \"Z\", \"U\", \"V\", \"W\", \"x\", \"y\"\n1,2,3,0.1,0.2,0.3,10,20\n0,0,0,0,0,0,17,20\n");
+  write_text(path,
+             " \"X\", \"Y\", \"Z\", \"U\", \"V\", \"W\", \"x\", \"y\"\n1,2,3,0.1,0.2,0.3,10,20\n0,0,0,0,0,0,17,20\n");
   const GridData g = read_grid_file(path, preset(MeasurementFormat::kVic3d));
   ASSERT_EQ(g.n_points(), 2);
   EXPECT_TRUE(g.has_deformed(0));
@@ -325,9 +327,10 @@ TEST(IoFormats, MissingColumnOfAPresetSaysWhatItReads) {
   ScratchDir dir;
   const std::string path = dir.file("vic.csv");
   write_text(path, "\"X\",\"Y\",\"Z\",\"U\",\"V\",\"x\",\"y\",\"sigma\"\n1,2,3,4,5,6,7,0.01\n");
-  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(MeasurementFormat::kVic3d)); }),
-              AllOf(HasSubstr(path + ":1: missing required column 'W'"), HasSubstr("--format vic3d reads X, Y, Z, U, V, W"),
-                    HasSubstr("found: X, Y, Z, U, V, x, y, sigma")));
+  EXPECT_THAT(
+      message_of<InputError>([&] { read_grid_file(path, preset(MeasurementFormat::kVic3d)); }),
+      AllOf(HasSubstr(path + ":1: missing required column 'W'"), HasSubstr("--format vic3d reads X, Y, Z, U, V, W"),
+            HasSubstr("found: X, Y, Z, U, V, x, y, sigma")));
 }
 
 // The neutral "nodemap" layout of the ARAMIS exporter: a commented header with ID and
@@ -389,9 +392,11 @@ namespace {
 // --format auto: each example export is recognised by its columns and key, and a note
 // says so; the plain grid file stays plain without a note.
 TEST(IoFormats, AutoFindsEachPresetFromItsHeader) {
-  const std::vector<std::pair<std::string, std::string>> files = {
-      {"gom_stage.csv", "gom"}, {"matchid_image.csv", "matchid"}, {"vic3d_frame.csv", "vic3d"},
-      {"dice_solution_10.txt", "dice"}, {"gom_stage_decimal_comma.csv", "gom"}};
+  const std::vector<std::pair<std::string, std::string>> files = {{"gom_stage.csv", "gom"},
+                                                                  {"matchid_image.csv", "matchid"},
+                                                                  {"vic3d_frame.csv", "vic3d"},
+                                                                  {"dice_solution_10.txt", "dice"},
+                                                                  {"gom_stage_decimal_comma.csv", "gom"}};
   GridReadOptions o = preset(MeasurementFormat::kAuto);
   o.decimal = kDetectDecimal;
   for (const auto& [file, name] : files) {
@@ -434,8 +439,9 @@ TEST(IoFormats, AutoNeedsThePresetsKey) {
 TEST(IoFormats, AutoWithAHeaderOfTwoPresetsAsksForOne) {
   ScratchDir dir;
   const std::string path = dir.file("both.csv");
-  write_text(path, "# two systems' columns\nid,x,y,z,displacement_x,displacement_y,displacement_z,X,Y,Z,U,V,W,sigma\n"
-                   "1,1,2,3,0,0,0,1,2,3,0,0,0,0.1\n");
+  write_text(path,
+             "# two systems' columns\nid,x,y,z,displacement_x,displacement_y,displacement_z,X,Y,Z,U,V,W,sigma\n"
+             "1,1,2,3,0,0,0,1,2,3,0,0,0,0.1\n");
   EXPECT_THAT(message_of<InputError>([&] { read_grid_file(path, preset(MeasurementFormat::kAuto)); }),
               AllOf(HasSubstr(path + ":2: the header fits more than one measuring system's format (gom, vic3d)"),
                     HasSubstr("--format")));
@@ -462,7 +468,8 @@ TEST(IoFormats, DecimalSeparatorFoundFromTheData) {
   // A point anywhere in the first rows means a decimal point; a comma-separated file
   // always has one.
   o.decimal = kDetectDecimal;
-  write_text(dir.file("p.csv"), "id;x;y;z;displacement_x;displacement_y;displacement_z\na;1;2;3;0;0;0\nb;1.5;2;3;0;0;0\n");
+  write_text(dir.file("p.csv"),
+             "id;x;y;z;displacement_x;displacement_y;displacement_z\na;1;2;3;0;0;0\nb;1.5;2;3;0;0;0\n");
   EXPECT_FALSE(any_note(read_grid_file(dir.file("p.csv"), o), "decimal comma"));
   write_text(dir.file("c.csv"), "id,x,y,z,displacement_x,displacement_y,displacement_z\na,1,2,3,0,0,0\n");
   EXPECT_FALSE(any_note(read_grid_file(dir.file("c.csv"), o), "decimal comma"));
@@ -479,21 +486,24 @@ TEST(IoFormats, BadCellsOfEachPresetNameFileLineColumn) {
   const std::vector<Case> cases = {
       {MeasurementFormat::kPlain, "id,X,Y,Z,x,y,z\np,0,0,0,1,zwei,0\n",
        ":2:6: expected a number in column 'y', found 'zwei'"},
-      {MeasurementFormat::kGom, "Project;p\n\nid;x [mm];y [mm];z [mm];displacement_x [mm];displacement_y [mm];"
-                                "displacement_z [mm]\n7;1;2;3;0,5;0;0\n",
+      {MeasurementFormat::kGom,
+       "Project;p\n\nid;x [mm];y [mm];z [mm];displacement_x [mm];displacement_y [mm];"
+       "displacement_z [mm]\n7;1;2;3;0,5;0;0\n",
        ":4:5: expected a number in column 'displacement_x [mm]', found '0,5' (a decimal comma?"},
       {MeasurementFormat::kMatchId,
        "Coordinates.Image X [Pixel],Coordinates.Image Y [Pixel],coor.X [mm],coor.Y [mm],coor.Z [mm],"
        "disp.Horizontal Displacement U [mm],disp.Vertical Displacement V [mm],disp.Out-Of-Plane: W [mm]\n"
        "10,,1,2,3,0,0,0\n",
        ":2:4: empty id cell in column 'Coordinates.Image Y [Pixel]'"},
-      {MeasurementFormat::kVic3d, " \"X\",  \"Y\",  \"Z\",  \"U\",  \"V\",  \"W\",  \"sigma\",  \"x\",  \"y\"\n"
-                                  "1,2,3,0.1,0.2,0.3,0.004,100,200\n1,2,3,0.1,0.2,0.3,0.004,100,200\n",
+      {MeasurementFormat::kVic3d,
+       " \"X\",  \"Y\",  \"Z\",  \"U\",  \"V\",  \"W\",  \"sigma\",  \"x\",  \"y\"\n"
+       "1,2,3,0.1,0.2,0.3,0.004,100,200\n1,2,3,0.1,0.2,0.3,0.004,100,200\n",
        ":3:25: duplicate id '100_200' (from columns x, y) (first at line 2)"},
-      {MeasurementFormat::kDice, "*** DICe-style\n***\nSUBSET_ID,MODEL_COORDINATES_X,MODEL_COORDINATES_Y,"
-                                 "MODEL_COORDINATES_Z,MODEL_DISPLACEMENT_X,MODEL_DISPLACEMENT_Y,"
-                                 "MODEL_DISPLACEMENT_Z,SIGMA,MATCH\n0,1,2,3,0.1,0.2,0.3,0.004,0\n"
-                                 "1,1,2,3,0.1,0.2,0.3,0.004,-1x\n",
+      {MeasurementFormat::kDice,
+       "*** DICe-style\n***\nSUBSET_ID,MODEL_COORDINATES_X,MODEL_COORDINATES_Y,"
+       "MODEL_COORDINATES_Z,MODEL_DISPLACEMENT_X,MODEL_DISPLACEMENT_Y,"
+       "MODEL_DISPLACEMENT_Z,SIGMA,MATCH\n0,1,2,3,0.1,0.2,0.3,0.004,0\n"
+       "1,1,2,3,0.1,0.2,0.3,0.004,-1x\n",
        ":5:9: expected a number in column 'MATCH', found '-1x'"},
   };
   ScratchDir dir;
@@ -515,7 +525,8 @@ TEST(IoFormats, MissingColumnsOfEachPreset) {
   const std::vector<Case> cases = {
       {MeasurementFormat::kGom, "# export\nid;x;y;z;displacement_x;displacement_y\n1;1;2;3;0;0\n",
        ":2: missing required column 'displacement_z' (the other out-of-plane columns are there; --format gom reads"},
-      {MeasurementFormat::kMatchId, "coor.X [mm],coor.Y [mm],coor.Z [mm],disp.Horizontal Displacement U [mm]\n1,2,3,4\n",
+      {MeasurementFormat::kMatchId,
+       "coor.X [mm],coor.Y [mm],coor.Z [mm],disp.Horizontal Displacement U [mm]\n1,2,3,4\n",
        ":1: missing required column 'disp.Vertical Displacement V' (--format matchid reads coor.X"},
       {MeasurementFormat::kDice, "***\nSUBSET_ID,COORDINATE_X,COORDINATE_Y,DISPLACEMENT_X\n0,1,2,3\n",
        ":2: missing required column 'DISPLACEMENT_Y' (--format dice reads COORDINATE_X, COORDINATE_Y, DISPLACEMENT_X, "

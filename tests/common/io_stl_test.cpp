@@ -101,8 +101,9 @@ TEST(IoStl, AsciiErrorsNameLineAndColumn) {
   EXPECT_EQ(message_of<InputError>([&] { read_stl_bytes(nan, "die.stl"); }),
             "die.stl:6:16: expected a finite number (vertex coordinate), found 'x'");
   const std::string cut = std::string(kAscii).substr(0, std::string(kAscii).find("    endloop"));
-  EXPECT_NE(message_of<InputError>([&] { read_stl_bytes(cut, "die.stl"); }).find("expected 'endloop', found the end "
-                                                                              "of the file"),
+  EXPECT_NE(message_of<InputError>([&] { read_stl_bytes(cut, "die.stl"); })
+                .find("expected 'endloop', found the end "
+                      "of the file"),
             std::string::npos);
   EXPECT_NE(message_of<InputError>([&] { read_stl_bytes("hello", "x.stl"); }).find("x.stl: byte 0: not an STL file"),
             std::string::npos);

@@ -106,12 +106,10 @@ TEST(IoVtkXml, SizeMistakesAreLogicErrorsNamingTheField) {
   test::ScratchDir dir;
   PolyMesh mesh = make_surface();
   mesh.point_data[1].values.pop_back();
-  EXPECT_THAT(test::message_of<std::logic_error>([&] { write_vtp(dir.file("a.vtp"), mesh); }),
-              HasSubstr("'dir1'"));
+  EXPECT_THAT(test::message_of<std::logic_error>([&] { write_vtp(dir.file("a.vtp"), mesh); }), HasSubstr("'dir1'"));
   mesh = make_surface();
   mesh.cell_data[0].values.pop_back();  // forgot the vertex or the line
-  EXPECT_THAT(test::message_of<std::logic_error>([&] { write_vtp(dir.file("a.vtp"), mesh); }),
-              HasSubstr("'element'"));
+  EXPECT_THAT(test::message_of<std::logic_error>([&] { write_vtp(dir.file("a.vtp"), mesh); }), HasSubstr("'element'"));
   mesh = make_surface();
   mesh.polygons[1][2] = 6;
   EXPECT_THAT(test::message_of<std::logic_error>([&] { write_vtp(dir.file("a.vtp"), mesh); }),
@@ -135,7 +133,8 @@ TEST(IoVtkXml, WriterAndReaderFailuresNameThePath) {
 
 TEST(IoVtkXml, PvdListsStepsInOrder) {
   test::ScratchDir dir;
-  write_pvd(dir.file("run.pvd"), std::vector<std::pair<double, std::string>>{{0.0, "steps/step_0000.vtu"}, {0.125, "steps/a&b.vtu"}});
+  write_pvd(dir.file("run.pvd"),
+            std::vector<std::pair<double, std::string>>{{0.0, "steps/step_0000.vtu"}, {0.125, "steps/a&b.vtu"}});
   EXPECT_EQ(test::read_text(dir.path() / "run.pvd"),
             "<?xml version=\"1.0\"?>\n"
             "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
@@ -144,7 +143,8 @@ TEST(IoVtkXml, PvdListsStepsInOrder) {
             "    <DataSet timestep=\"0.125\" group=\"\" part=\"0\" file=\"steps/a&amp;b.vtu\"/>\n"
             "  </Collection>\n"
             "</VTKFile>\n");
-  EXPECT_THROW(write_pvd(dir.file("x.pvd"), std::vector<std::pair<double, std::string>>{{std::nan(""), "a.vtu"}}), std::logic_error);
+  EXPECT_THROW(write_pvd(dir.file("x.pvd"), std::vector<std::pair<double, std::string>>{{std::nan(""), "a.vtu"}}),
+               std::logic_error);
 }
 
 }  // namespace

@@ -26,11 +26,9 @@ constexpr int kGridSize = 30;                 // 30 x 30 grid -> n = 900
 constexpr int kNumRhs = 4;
 constexpr unsigned kSeed = 20240611;
 
-const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto,      SolverKind::kCholmod,
-                                           SolverKind::kCholmodSimplicial, SolverKind::kUmfpack,
-                                           SolverKind::kEigenLDLT, SolverKind::kEigenLU};
-const std::vector<SolverKind> kLuKinds = {SolverKind::kAuto, SolverKind::kUmfpack,
-                                          SolverKind::kEigenLU};
+const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto,    SolverKind::kCholmod,   SolverKind::kCholmodSimplicial,
+                                           SolverKind::kUmfpack, SolverKind::kEigenLDLT, SolverKind::kEigenLU};
+const std::vector<SolverKind> kLuKinds = {SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLU};
 
 // Grid node (ix, iy) -> row; -1 outside the grid (Dirichlet boundary) or for
 // the node `skip` (a DOF no element touches).
@@ -82,8 +80,7 @@ Eigen::MatrixXd random_rhs(Index n, int n_rhs, unsigned seed) {
 }
 
 // Largest ||A x_j - b_j|| / ||b_j|| over the columns.
-double max_relative_residual(const SparseMatrix& a, const Eigen::MatrixXd& x,
-                             const Eigen::MatrixXd& b) {
+double max_relative_residual(const SparseMatrix& a, const Eigen::MatrixXd& x, const Eigen::MatrixXd& b) {
   const Eigen::MatrixXd r = a * x - b;
   double worst = 0.0;
   for (Eigen::Index j = 0; j < b.cols(); ++j) {
@@ -235,12 +232,9 @@ TEST(LinalgSolverKind, SymmetricBackendsRejectUnsymmetricProperty) {
 }
 
 TEST(LinalgSolverKind, AutoResolvesFromMatrixProperty) {
-  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricPositiveDefinite).kind(),
-            SolverKind::kCholmod);
-  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricIndefinite).kind(),
-            SolverKind::kUmfpack);
-  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kUnsymmetric).kind(),
-            SolverKind::kUmfpack);
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricPositiveDefinite).kind(), SolverKind::kCholmod);
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kSymmetricIndefinite).kind(), SolverKind::kUmfpack);
+  EXPECT_EQ(LinearSolver(SolverKind::kAuto, MatrixProperty::kUnsymmetric).kind(), SolverKind::kUmfpack);
   EXPECT_EQ(LinearSolver(SolverKind::kEigenLU).kind(), SolverKind::kEigenLU);
 }
 
@@ -427,7 +421,6 @@ TEST(LinalgSolver, SolveAcceptsBlocksAndVectorsAndRecordsTiming) {
   EXPECT_EQ(brief.rfind("cholmod n=900 ", 0), 0u) << brief;
   EXPECT_NE(brief.find(": ok"), std::string::npos) << brief;
 }
-
 
 // gsa's fit solves two penalties at once, one simplicial CHOLMOD solver per
 // thread: concurrent runs must give exactly what one thread gives.

@@ -20,16 +20,14 @@ namespace sf::mesh {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kXiTol = 1e-10;       // xi recovered for points on the surface
-constexpr double kDistTol = 1e-9;      // mm, distances of exactly known feet
-constexpr double kOrthoTol = 1e-8;     // relative |r . x,i| / (|r| |x,i|) at a converged result
+constexpr double kXiTol = 1e-10;    // xi recovered for points on the surface
+constexpr double kDistTol = 1e-9;   // mm, distances of exactly known feet
+constexpr double kOrthoTol = 1e-8;  // relative |r . x,i| / (|r| |x,i|) at a converged result
 
 using Status = Projection::Status;
 
 // Flat 40 x 30 mm rectangle in z = 0, 4 x 3 elements of 10 x 10 mm.
-SurfaceMesh flat_mesh() {
-  return make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 40.0, 30.0, 4, 3);
-}
+SurfaceMesh flat_mesh() { return make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 40.0, 30.0, 4, 3); }
 
 // z = f(x, y), degree <= 3 in x and in y, so the bicubic Hermite mesh reproduces it exactly.
 struct Height {
@@ -57,15 +55,12 @@ SurfaceMesh curved_mesh() {
 
 // Half cylinder of radius r about the z axis (theta in [0, pi]), 20 mm tall, 6 x 2 elements.
 SurfaceMesh half_cylinder_mesh(double r) {
-  SurfaceMesh mesh =
-      make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), kPi * r, 20.0, 6, 2);
+  SurfaceMesh mesh = make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), kPi * r, 20.0, 6, 2);
   for (Index node = 0; node < mesh.n_nodes(); ++node) {
     const Vec3 q = mesh.node_position(node);
     const double th = q.x() / r;
-    mesh.geometry().row(SurfaceMesh::dof(node, kValue)) =
-        Vec3(r * std::cos(th), r * std::sin(th), q.y()).transpose();
-    mesh.geometry().row(SurfaceMesh::dof(node, kD1)) =
-        Vec3(-std::sin(th), std::cos(th), 0).transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, kValue)) = Vec3(r * std::cos(th), r * std::sin(th), q.y()).transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, kD1)) = Vec3(-std::sin(th), std::cos(th), 0).transpose();
     mesh.geometry().row(SurfaceMesh::dof(node, kD2)) = Vec3(0, 0, 1).transpose();
     mesh.geometry().row(SurfaceMesh::dof(node, kD12)) = Vec3::Zero().transpose();
   }
@@ -75,21 +70,18 @@ SurfaceMesh half_cylinder_mesh(double r) {
 // Spherical cap (a hemisphere of radius r about the origin, pole at (0, 0, r)) made
 // from a disk mesh: disk radius rho -> polar angle pi/2 rho; collapsed elements at the pole.
 SurfaceMesh dome_mesh(double r, int n_rings, int n_sectors) {
-  SurfaceMesh mesh =
-      make_disk_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0, n_rings, n_sectors);
+  SurfaceMesh mesh = make_disk_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0, n_rings, n_sectors);
   for (Index node = 0; node < mesh.n_nodes(); ++node) {
     const Vec3 q = mesh.node_position(node);
     const double phi = 0.5 * kPi * q.norm(), th = std::atan2(q.y(), q.x());
-    const Vec3 x = r * Vec3(std::sin(phi) * std::cos(th), std::sin(phi) * std::sin(th),
-                            std::cos(phi));
+    const Vec3 x = r * Vec3(std::sin(phi) * std::cos(th), std::sin(phi) * std::sin(th), std::cos(phi));
     mesh.geometry().row(SurfaceMesh::dof(node, kValue)) = x.transpose();
     if (node == 0) continue;  // apex: value only changes; D1, D2 stay x, y (tangent plane)
     const Vec3 t1(-std::sin(th), std::cos(th), 0.0);
     const Vec3 t2(std::cos(phi) * std::cos(th), std::cos(phi) * std::sin(th), -std::sin(phi));
     mesh.geometry().row(SurfaceMesh::dof(node, kD1)) = t1.transpose();
     mesh.geometry().row(SurfaceMesh::dof(node, kD2)) = t2.transpose();
-    mesh.geometry().row(SurfaceMesh::dof(node, kD12)) =
-        (t1 * std::cos(phi) / (r * std::sin(phi))).transpose();
+    mesh.geometry().row(SurfaceMesh::dof(node, kD12)) = (t1 * std::cos(phi) / (r * std::sin(phi))).transpose();
   }
   mesh.compute_arc_length_scale_factors();
   return mesh;
@@ -154,8 +146,8 @@ TEST(ProjectionTest, NormalOffsetRecoversFootAndDistance) {
   // A tilted, graded rectangle: the frame is not axis aligned, elements differ in size.
   const Vec3 a1 = Vec3(1, 1, 0).normalized();
   const Vec3 a2 = Vec3(-1, 1, 2).normalized();
-  const SurfaceMesh mesh = make_rectangle_mesh(Vec3(5, -3, 2), a1, a2, 30.0, 20.0, 3, 2,
-                                               {0.0, 6.0, 18.0, 30.0}, {0.0, 12.0, 20.0});
+  const SurfaceMesh mesh =
+      make_rectangle_mesh(Vec3(5, -3, 2), a1, a2, 30.0, 20.0, 3, 2, {0.0, 6.0, 18.0, 30.0}, {0.0, 12.0, 20.0});
   const fe::SurfaceField field(mesh, mesh.geometry());
   const SurfaceProjector projector(mesh, mesh.geometry());
   std::mt19937 rng(12);
@@ -268,9 +260,8 @@ TEST(ProjectionTest, NearElementBoundariesLandInTheRightElement) {
   // Feet 1e-7 (in xi) inside each element next to every edge and corner, offset 0.3
   // along the normal.
   const double in = 1e-7;
-  const std::vector<Vec2> feet = {{in, 0.5},      {1 - in, 0.5},      {0.5, in},
-                                  {0.5, 1 - in},  {in, in},           {1 - in, 1 - in},
-                                  {in, 1 - in},   {1 - in, in}};
+  const std::vector<Vec2> feet = {{in, 0.5}, {1 - in, 0.5},    {0.5, in},    {0.5, 1 - in},
+                                  {in, in},  {1 - in, 1 - in}, {in, 1 - in}, {1 - in, in}};
   for (Index e = 0; e < mesh.n_elements(); ++e)
     for (const Vec2& xi : feet)
       for (double h : {-0.3, 0.3}) {
@@ -344,8 +335,7 @@ TEST(ProjectionTest, BeyondFreeEdgeReportsOnFreeEdge) {
 TEST(ProjectionTest, DiskApexPointAboveCentre) {
   const Vec3 centre(1.0, 2.0, 3.0);
   const int n_sectors = 8;
-  const SurfaceMesh mesh =
-      make_disk_mesh(centre, Vec3::UnitX(), Vec3::UnitY(), 10.0, 3, n_sectors);
+  const SurfaceMesh mesh = make_disk_mesh(centre, Vec3::UnitX(), Vec3::UnitY(), 10.0, 3, n_sectors);
   const SurfaceProjector projector(mesh, mesh.geometry());
   for (double h : {4.0, -2.5, 1e-3}) {
     const Projection r = projector.project(centre + Vec3(0, 0, h));
@@ -392,8 +382,7 @@ TEST(ProjectionTest, DomeWithCollapsedPoleFindsTheGlobalMinimum) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> uxy(-13.0, 13.0), uz(-3.0, 14.0), upole(-0.5, 0.5);
   for (int k = 0; k < 80; ++k) {
-    const Vec3 p = k < 20 ? Vec3(upole(rng), upole(rng), radius + 4.0 * upole(rng))
-                          : Vec3(uxy(rng), uxy(rng), uz(rng));
+    const Vec3 p = k < 20 ? Vec3(upole(rng), upole(rng), radius + 4.0 * upole(rng)) : Vec3(uxy(rng), uxy(rng), uz(rng));
     const Projection r = projector.project(p);
     ASSERT_TRUE(r.ok()) << r.brief() << " p=" << p.transpose();
     EXPECT_TRUE(r.xi.allFinite() && std::isfinite(r.distance));
@@ -502,8 +491,7 @@ TEST(ProjectionTest, BadInputFailsCleanly) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(projector.project(Vec3(nan, 0, 0)).status, Status::kFailed);
   EXPECT_EQ(projector.refine(Vec3(1, 1, 1), -1, Vec2(0.5, 0.5)).status, Status::kFailed);
-  EXPECT_EQ(projector.refine(Vec3(1, 1, 1), mesh.n_elements(), Vec2(0.5, 0.5)).status,
-            Status::kFailed);
+  EXPECT_EQ(projector.refine(Vec3(1, 1, 1), mesh.n_elements(), Vec2(0.5, 0.5)).status, Status::kFailed);
   EXPECT_FALSE(Projection{}.ok());
   EXPECT_THROW(SurfaceProjector(mesh, MatX::Zero(mesh.n_dofs(), 2)), InputError);
   EXPECT_THROW(SurfaceProjector(mesh, MatX::Zero(mesh.n_dofs() - 1, 3)), InputError);

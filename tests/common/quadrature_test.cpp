@@ -49,8 +49,7 @@ TEST(QuadratureGaussLegendre, MissesDegree2nByTheGaussErrorConstant) {
     const double expected = gauss_error_constant(n);
     // Nonzero, with the right sign and size: not exact, and not roundoff.
     EXPECT_GT(error, 0.5 * expected) << n << "-point rule must NOT integrate t^" << k << " exactly";
-    EXPECT_NEAR(error, expected, kQuadratureErrorConstantRel * expected)
-        << n << "-point rule, error for t^" << k;
+    EXPECT_NEAR(error, expected, kQuadratureErrorConstantRel * expected) << n << "-point rule, error for t^" << k;
   }
 }
 

@@ -38,8 +38,8 @@ double distance(const Colour& a, const Colour& b) {
 }
 
 std::string colour_text(const Colour& c) {
-  return "(" + std::to_string(std::lround(c.r * 255)) + ", " + std::to_string(std::lround(c.g * 255)) +
-         ", " + std::to_string(std::lround(c.b * 255)) + ")";
+  return "(" + std::to_string(std::lround(c.r * 255)) + ", " + std::to_string(std::lround(c.g * 255)) + ", " +
+         std::to_string(std::lround(c.b * 255)) + ")";
 }
 
 std::string read_bytes(const fs::path& p) {
@@ -90,7 +90,7 @@ TEST(RenderColour, MapEndsAndMiddle) {
   EXPECT_LT(distance(colour_at(ColourMap::kViridis, 1), Colour::from_rgb8(253, 231, 37)), 1e-12);
   EXPECT_LT(distance(colour_at(ColourMap::kViridis, -3), colour_at(ColourMap::kViridis, 0)), 1e-12);
   const Colour mid = colour_at(ColourMap::kDiverging, 0.5);
-  EXPECT_GT(mid.r, 0.95);  // near white at zero
+  EXPECT_GT(mid.r, 0.95);                                                                   // near white at zero
   EXPECT_GT(colour_at(ColourMap::kDiverging, 0).b, colour_at(ColourMap::kDiverging, 0).r);  // blue low
   EXPECT_GT(colour_at(ColourMap::kDiverging, 1).r, colour_at(ColourMap::kDiverging, 1).b);  // red high
 }
@@ -215,10 +215,9 @@ TEST(RenderImage, LinearFieldShowsMapEndsAtTheRightSides) {
       const Colour got_low = img.at(int(std::floor(a.x())), int(std::floor(a.y())));
       const Colour got_high = img.at(int(std::floor(c.x())), int(std::floor(c.y())));
       SCOPED_TRACE(path);
-      EXPECT_LT(distance(got_low, low), 0.04) << "low end " << colour_text(got_low) << " expected "
-                                              << colour_text(low);
-      EXPECT_LT(distance(got_high, high), 0.04) << "high end " << colour_text(got_high) << " expected "
-                                                << colour_text(high);
+      EXPECT_LT(distance(got_low, low), 0.04) << "low end " << colour_text(got_low) << " expected " << colour_text(low);
+      EXPECT_LT(distance(got_high, high), 0.04)
+          << "high end " << colour_text(got_high) << " expected " << colour_text(high);
       if (map == ColourMap::kDiverging) {
         EXPECT_GT(got_low.b, got_low.r + 0.3);
         EXPECT_GT(got_high.r, got_high.b + 0.3);

@@ -40,8 +40,7 @@ MatX random_parameters(Index rows, Index cols, std::mt19937& rng) {
 
 // A graded rectangle (quads only) and a disk (collapsed + quads).
 mesh::SurfaceMesh rectangle() {
-  return mesh::make_rectangle_mesh(Vec3(1, 2, 3), Vec3::UnitX(), Vec3::UnitZ(), 4.0, 2.5, 2, 2, {0, 1, 4},
-                                   {0, 2, 2.5});
+  return mesh::make_rectangle_mesh(Vec3(1, 2, 3), Vec3::UnitX(), Vec3::UnitZ(), 4.0, 2.5, 2, 2, {0, 1, 4}, {0, 2, 2.5});
 }
 mesh::SurfaceMesh disk() { return mesh::make_disk_mesh(Vec3(0, 0, 1), Vec3::UnitX(), Vec3::UnitY(), 2.0, 2, 6); }
 
@@ -105,8 +104,7 @@ TEST(SurfaceFieldEvaluate, OnlyRequestedPartsAreFilled) {
     EXPECT_EQ(s.updated, flags) << tag;
     EXPECT_NEAR((s.x - (want0 ? full.x : Vec3::Zero())).cwiseAbs().maxCoeff(), 0.0, kRoundoff) << tag << ": x";
     EXPECT_NEAR((s.dx - (want1 ? full.dx : Mat32::Zero())).cwiseAbs().maxCoeff(), 0.0, kRoundoff) << tag << ": dx";
-    EXPECT_NEAR((s.d2x - (want2 ? full.d2x : Mat3::Zero())).cwiseAbs().maxCoeff(), 0.0, kRoundoff)
-        << tag << ": d2x";
+    EXPECT_NEAR((s.d2x - (want2 ? full.d2x : Mat3::Zero())).cwiseAbs().maxCoeff(), 0.0, kRoundoff) << tag << ": d2x";
   }
 }
 
@@ -155,10 +153,14 @@ TEST(SurfaceFieldEvaluate, DerivativesMatchFiniteDifferences) {
 
 double pick(const FieldPoint& p, int which) {
   switch (which) {
-    case 0: return p.value[0];
-    case 1: return p.first(0, 0);
-    case 2: return p.first(0, 1);
-    default: return p.second(0, which - 3);
+    case 0:
+      return p.value[0];
+    case 1:
+      return p.first(0, 0);
+    case 2:
+      return p.first(0, 1);
+    default:
+      return p.second(0, which - 3);
   }
 }
 
@@ -225,8 +227,8 @@ TEST(SurfaceFieldElementDofMap, ReproducesElementParameters) {
       const MatX expected = m.element_parameters(e, params);
       for (int k = 0; k < 16; ++k)
         for (int c = 0; c < 3; ++c)
-          EXPECT_NEAR(ue(k, c), expected(k, c), kRoundoff) << "element " << e << " parameter " << k << " component "
-                                                           << c;
+          EXPECT_NEAR(ue(k, c), expected(k, c), kRoundoff)
+              << "element " << e << " parameter " << k << " component " << c;
       if (collapsed) {
         const Index apex_cross = mesh::SurfaceMesh::dof(m.element(e).nodes[0], mesh::kD12);
         EXPECT_EQ(std::count(map.dofs.begin(), map.dofs.end(), apex_cross), 0)
@@ -248,16 +250,19 @@ TEST(SurfaceFieldElementDofMap, AgreesWithGlobalBasisRows) {
       const auto b = basis::BicubicHermite::evaluate(xi, kAll);
       for (int which = 0; which < 6; ++which) {
         Eigen::Matrix<double, 16, 1> n;
-        if (which == 0) n = b.value;
-        else if (which <= 2) n = b.first.col(which - 1);
-        else n = b.second.col(which - 3);
+        if (which == 0)
+          n = b.value;
+        else if (which <= 2)
+          n = b.first.col(which - 1);
+        else
+          n = b.second.col(which - 3);
         const Eigen::RowVectorXd expected = n.transpose() * dmap.t;
         const GlobalBasisRow row = global_basis_row(emap, b, which);
         for (std::size_t j = 0; j < dmap.dofs.size(); ++j) {
           const auto it = std::find(row.dofs.begin(), row.dofs.end(), dmap.dofs[j]);
           const double coef = it == row.dofs.end() ? 0.0 : row.coefs[it - row.dofs.begin()];
-          EXPECT_NEAR(coef, expected[j], kRoundoff) << "dof " << dmap.dofs[j] << ", which=" << which << ", "
-                                                    << where(e, xi);
+          EXPECT_NEAR(coef, expected[j], kRoundoff)
+              << "dof " << dmap.dofs[j] << ", which=" << which << ", " << where(e, xi);
         }
         for (Index d : row.dofs)
           EXPECT_NE(std::find(dmap.dofs.begin(), dmap.dofs.end(), d), dmap.dofs.end())

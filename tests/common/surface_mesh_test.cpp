@@ -156,8 +156,8 @@ TEST(SurfaceMeshRectangle, CountsAndBoundaryEdges) {
     EXPECT_EQ(static_cast<int>(boundary.size()), 2 * (n1 + n2)) << tag;
     for (const auto& [e, edge] : boundary) {
       const int i = static_cast<int>(e % n1), j = static_cast<int>(e / n1);
-      const bool outer = (edge == 0 && j == 0) || (edge == 2 && j == n2 - 1) || (edge == 3 && i == 0) ||
-                         (edge == 1 && i == n1 - 1);
+      const bool outer =
+          (edge == 0 && j == 0) || (edge == 2 && j == n2 - 1) || (edge == 3 && i == 0) || (edge == 1 && i == n1 - 1);
       EXPECT_TRUE(outer) << tag << ": boundary edge " << edge << " of element (" << i << ", " << j
                          << ") is not on the outline";
     }
@@ -215,8 +215,8 @@ TEST(SurfaceMeshRectangle, UniformMeshReproducesTheFlatPlaneExactly) {
         EXPECT_NEAR(p.dx(c, 0), h1 * f.a1[c], kGeometry) << "x,1 component " << c << ", " << where(e, xi);
         EXPECT_NEAR(p.dx(c, 1), h2 * f.a2[c], kGeometry) << "x,2 component " << c << ", " << where(e, xi);
         for (int s = 0; s < 3; ++s)
-          EXPECT_NEAR(p.d2x(c, s), 0.0, kGeometry) << "second derivative " << s << " component " << c << ", "
-                                                   << where(e, xi);
+          EXPECT_NEAR(p.d2x(c, s), 0.0, kGeometry)
+              << "second derivative " << s << " component " << c << ", " << where(e, xi);
       }
       EXPECT_NEAR(unit_normal(p.dx).dot(f.n), 1.0, kNormal) << "normal a1 x a2, " << where(e, xi);
     }
@@ -248,8 +248,7 @@ TEST(SurfaceMeshRectangle, RejectsBadInput) {
 
 TEST(SurfaceMeshElementMap, QuadParametersAreScaledNodalParameters) {
   std::mt19937 rng(test::kSeed + 101);
-  SurfaceMesh m = make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 4.0, 3.0, 2, 2, {0, 1, 4},
-                                      {0, 2, 3});
+  SurfaceMesh m = make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 4.0, 3.0, 2, 2, {0, 1, 4}, {0, 2, 3});
   const MatX field = random_parameters(m.n_dofs(), 2, rng);
   for (Index e = 0; e < m.n_elements(); ++e) {
     const Element& el = m.element(e);
@@ -357,7 +356,8 @@ TEST(SurfaceMeshGraded, LinearFunctionOfPositionHasTheExactSurfaceGradient) {
       const auto px = x.evaluate3(e, xi, basis::kValues | basis::kFirst);
       EXPECT_NEAR(pu.value[0], c.dot(px.x), kGeometry) << "value, " << where(e, xi);
       const MatX grad = surface_gradient(px.dx, pu.first);
-      for (int k = 0; k < 3; ++k) EXPECT_NEAR(grad(k, 0), expected[k], kGeometry) << "gradient " << k << ", " << where(e, xi);
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(grad(k, 0), expected[k], kGeometry) << "gradient " << k << ", " << where(e, xi);
     }
 }
 
@@ -650,8 +650,8 @@ TEST(SurfaceMeshDisk, CurvedApexKeepsTangentPlaneContinuity) {
     for (double xi2 : {1e-3, 0.3, 0.8}) {
       const Vec3 na = unit_normal(x.evaluate3(e, Vec2(1.0, xi2), basis::kFirst).dx);
       const Vec3 nb3 = unit_normal(x.evaluate3(nb.element, Vec2(0.0, xi2), basis::kFirst).dx);
-      EXPECT_LT((na - nb3).norm(), kNormal) << "normal across the radial edge of elements " << e << " and "
-                                            << nb.element << " at xi2=" << xi2;
+      EXPECT_LT((na - nb3).norm(), kNormal)
+          << "normal across the radial edge of elements " << e << " and " << nb.element << " at xi2=" << xi2;
     }
   }
 }
@@ -676,8 +676,8 @@ TEST(SurfaceMeshDisk, ScaleFactorsAreNodallyConsistent) {
         if (el.shape == ElementShape::kCollapsed && n < 2 && dir == 0) continue;
         double& s = seen[el.nodes[n]][dir];
         if (s < 0) s = el.scale[n][dir];
-        EXPECT_NEAR(el.scale[n][dir], s, kGeometry) << "S" << dir + 1 << " at node " << el.nodes[n] << ", element "
-                                                    << e << " local node " << n;
+        EXPECT_NEAR(el.scale[n][dir], s, kGeometry)
+            << "S" << dir + 1 << " at node " << el.nodes[n] << ", element " << e << " local node " << n;
         EXPECT_GT(el.scale[n][dir], 0.0);
       }
 }
@@ -689,8 +689,7 @@ TEST(SurfaceMeshDisk, AreaApproachesPiRSquaredAtFourthOrderInSectors) {
   const double err32 = std::abs(disk_area(make_disk(test::kSeed + 212, 4, 32, radius).mesh) / exact - 1.0);
   EXPECT_LT(err8, test::kDiskAreaRel) << "relative area error, 8 sectors x 4 rings";
   const double factor = std::pow(2.0, test::kDiskAreaOrder);
-  EXPECT_LT(err16, err8 / factor) << "16 sectors must beat 8 at fourth order (errors " << err8 << ", " << err16
-                                  << ")";
+  EXPECT_LT(err16, err8 / factor) << "16 sectors must beat 8 at fourth order (errors " << err8 << ", " << err16 << ")";
   EXPECT_LT(err32, err16 / factor) << "32 sectors must beat 16 at fourth order (errors " << err16 << ", " << err32
                                    << ")";
 }

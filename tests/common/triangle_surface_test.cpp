@@ -20,9 +20,9 @@ namespace sf::mesh {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kFdStep = 1e-6;        // mm, for O(1) geometry
-constexpr double kFdRel = 1e-6;         // derivative vs central difference (measured ~1e-9)
-constexpr double kBruteForce = 1e-12;   // mm, closest distance vs brute force
+constexpr double kFdStep = 1e-6;       // mm, for O(1) geometry
+constexpr double kFdRel = 1e-6;        // derivative vs central difference (measured ~1e-9)
+constexpr double kBruteForce = 1e-12;  // mm, closest distance vs brute force
 
 // A UV sphere of radius r (n_lat x n_lon), closed, outward-oriented.
 TriangleSurface uv_sphere(double r, int n_lat, int n_lon) {
@@ -150,9 +150,9 @@ TEST(TriangleSurface, PointsBeyondAFreeEdgeAreNotInFront) {
   const TriangleSurface s(v, {{0, 1, 2}, {0, 2, 3}});
   EXPECT_TRUE(s.closest(Vec3(0.5, 0.5, 0.2)).in_front);
   EXPECT_TRUE(s.closest(Vec3(0.5, 0.5, -0.2)).in_front);
-  EXPECT_TRUE(s.closest(Vec3(1.05, 0.5, 0.2)).in_front);   // just past the edge, mostly above it
-  EXPECT_FALSE(s.closest(Vec3(1.5, 0.5, 0.1)).in_front);   // well beside the edge
-  EXPECT_FALSE(s.closest(Vec3(1.5, 1.5, 0.0)).in_front);   // beside a corner
+  EXPECT_TRUE(s.closest(Vec3(1.05, 0.5, 0.2)).in_front);  // just past the edge, mostly above it
+  EXPECT_FALSE(s.closest(Vec3(1.5, 0.5, 0.1)).in_front);  // well beside the edge
+  EXPECT_FALSE(s.closest(Vec3(1.5, 1.5, 0.0)).in_front);  // beside a corner
   const SurfaceClosestPoint c = s.closest(Vec3(0.25, 0.5, -0.2));
   EXPECT_NEAR(c.gap, -0.2, test::kRoundoff);
   EXPECT_LT((c.normal - Vec3::UnitZ()).norm(), test::kRoundoff);

@@ -15,10 +15,10 @@ namespace sf::gsa::digitise {
 namespace {
 
 // The targets.
-constexpr double kFocalRel = 1e-3;          // focal length within 0.1 %
-constexpr double kReprojectionPx = 0.1;     // calibration reprojection error
-constexpr double kMarkRmsMm = 0.02;         // 3-D marks from two views
-constexpr double kStrainRatio = 2.0;        // images-to-strains error / exact grid + 0.01 mm noise
+constexpr double kFocalRel = 1e-3;       // focal length within 0.1 %
+constexpr double kReprojectionPx = 0.1;  // calibration reprojection error
+constexpr double kMarkRmsMm = 0.02;      // 3-D marks from two views
+constexpr double kStrainRatio = 2.0;     // images-to-strains error / exact grid + 0.01 mm noise
 
 std::vector<ExactStrain> exact_strains(const std::vector<GridRow>& rows, const synth::Scene& formed) {
   std::vector<ExactStrain> out;
@@ -88,7 +88,8 @@ TEST(DigitiseStudy, CalibrationMarksAndStrainsAtTwoMegapixels) {
   std::normal_distribution<double> noise(0.0, 0.01);
   for (Index p = 0; p < ref.n_points(); ++p) {
     const auto [I, J] = synth::material_index(rows[p].ij, o.marks);
-    const Vec3 X = flat.sheet.position(Vec2(I * o.pitch, J * o.pitch)), x = dome.sheet.position(Vec2(I * o.pitch, J * o.pitch));
+    const Vec3 X = flat.sheet.position(Vec2(I * o.pitch, J * o.pitch)),
+               x = dome.sheet.position(Vec2(I * o.pitch, J * o.pitch));
     for (int k = 0; k < 3; ++k) {
       ref.undeformed(p, k) = X(k) + noise(rng);
       ref.deformed(p, k) = x(k) + noise(rng);

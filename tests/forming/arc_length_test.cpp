@@ -107,7 +107,9 @@ Tube make_tube(int n1, double a, double b, double span, bool arch) {
   const Index ns = ply.n_surface_nodes();
   t.model.add_ply(std::move(ply), std::make_shared<NeoHookean>(NeoHookeanParams{kMu, kLambda}));
   const VecX X = t.model.reference_positions();
-  auto fix = [&](Index node, int d, int c) { t.fixed.push_back({t.model.dof(0, node, d, c), X(t.model.dof(0, node, d, c))}); };
+  auto fix = [&](Index node, int d, int c) {
+    t.fixed.push_back({t.model.dof(0, node, d, c), X(t.model.dof(0, node, d, c))});
+  };
   for (Index node = 0; node < 2 * ns; ++node) {
     for (int d = 0; d < 4; ++d) fix(node, d, 2);
     for (int c = 0; c < 2; ++c) {
@@ -232,9 +234,10 @@ TEST(ArcLength, ShallowArchSnapsThroughItsLimitPoint) {
   const StaticResult s = solve_static(t.model, X, t.fixed, beyond, true, so);
   EXPECT_FALSE(s.report.ok());
   EXPECT_NEAR(s.report.load_factor * 1.05 * p_max, p_max, 0.02 * p_max) << "load control stalls at the limit point";
-  std::printf("shallow arch: limit pressure %.6g MPa at crown deflection %.4f mm, falls to %.3g of it; %zu points, "
-              "%d cut-backs; load control to 1.05 p_limit stalls at %.4f p_limit\n",
-              p_max, crown_at_max, p_min_after / p_max, r.path.size(), r.n_cutbacks, s.report.load_factor * 1.05);
+  std::printf(
+      "shallow arch: limit pressure %.6g MPa at crown deflection %.4f mm, falls to %.3g of it; %zu points, "
+      "%d cut-backs; load control to 1.05 p_limit stalls at %.4f p_limit\n",
+      p_max, crown_at_max, p_min_after / p_max, r.path.size(), r.n_cutbacks, s.report.load_factor * 1.05);
 }
 
 // The diaphragm-inflation sample (control: arc_length in the case file): the load

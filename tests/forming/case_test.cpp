@@ -48,14 +48,16 @@ std::string uniaxial_case(double angle, double u, const std::string& extra_solve
         "    transversely_isotropic: {E_f: 25000, E_T: 1, G_L: 0.5, G_T: 0.4}\n"
         "plies:\n"
         "  - {name: ply, size: [100, 20], thickness: 1, elements: [4, 2], angle: "
-     << angle << ", material: gfpp}\n"
-                 "boundary_conditions:\n"
-                 "  - symmetry: {ply: ply, plane: x0}\n"
-                 "  - symmetry: {ply: ply, plane: y0}\n"
-                 "  - symmetry: {ply: ply, plane: bottom}\n"
-                 "  - displacement: {ply: ply, edge: x1, value: ["
-     << u << ", ~, ~]}\n"
-             "solver: {steps: 2, tolerance: 1.0e-10"
+     << angle
+     << ", material: gfpp}\n"
+        "boundary_conditions:\n"
+        "  - symmetry: {ply: ply, plane: x0}\n"
+        "  - symmetry: {ply: ply, plane: y0}\n"
+        "  - symmetry: {ply: ply, plane: bottom}\n"
+        "  - displacement: {ply: ply, edge: x1, value: ["
+     << u
+     << ", ~, ~]}\n"
+        "solver: {steps: 2, tolerance: 1.0e-10"
      << extra_solver << "}\n";
   return os.str();
 }
@@ -104,28 +106,28 @@ double last(const io::CsvTable& t, const std::string& column) {
 
 TEST(FormingCase, CheckListsEveryProblemWithItsPlace) {
   const std::string text =
-      "materials:\n"                                                        // 1
-      "  gfpp:\n"                                                           // 2
+      "materials:\n"                                                             // 1
+      "  gfpp:\n"                                                                // 2
       "    transversely_isotropic: {E_f: 25000, E_T: -1, G_L: 0.5, G_T: 0.4}\n"  // 3
-      "  rubber:\n"                                                         // 4
-      "    neo_hookean: {E: 1, nu: 0.3, colour: red}\n"                     // 5
-      "plies:\n"                                                            // 6
-      "  - name: a\n"                                                       // 7
-      "    size: [100, 20]\n"                                               // 8
-      "    thickness: thick\n"                                              // 9
-      "    elements: [4, 2]\n"                                              // 10
-      "    material: steel\n"                                               // 11
-      "boundary_conditions:\n"                                              // 12
-      "  - clamp: {ply: b, edge: x0}\n"                                     // 13
-      "  - displacement: {ply: a, edge: x2, value: [1, 0]}\n"               // 14
-      "solvr: {steps: 3}\n";                                                // 15
+      "  rubber:\n"                                                              // 4
+      "    neo_hookean: {E: 1, nu: 0.3, colour: red}\n"                          // 5
+      "plies:\n"                                                                 // 6
+      "  - name: a\n"                                                            // 7
+      "    size: [100, 20]\n"                                                    // 8
+      "    thickness: thick\n"                                                   // 9
+      "    elements: [4, 2]\n"                                                   // 10
+      "    material: steel\n"                                                    // 11
+      "boundary_conditions:\n"                                                   // 12
+      "  - clamp: {ply: b, edge: x0}\n"                                          // 13
+      "  - displacement: {ply: a, edge: x2, value: [1, 0]}\n"                    // 14
+      "solvr: {steps: 3}\n";                                                     // 15
   const CaseCheck c = check_case_text(text, "broken.yaml");
   ASSERT_FALSE(c.ok());
   std::vector<std::string> all;
   for (std::size_t i = 0; i < c.problems.size(); ++i) all.push_back(c.located(i));
   const std::string joined = ::testing::PrintToString(all);
   // One problem per mistake, in file order, each at its line.
-  EXPECT_THAT(all, ::testing::Contains(::testing::HasSubstr("broken.yaml:3:")));   // E_T < 0
+  EXPECT_THAT(all, ::testing::Contains(::testing::HasSubstr("broken.yaml:3:")));  // E_T < 0
   EXPECT_THAT(all, ::testing::Contains(::testing::MatchesRegex("broken.yaml:5:[0-9]+: .*unknown key 'colour'.*")));
   EXPECT_THAT(all, ::testing::Contains(::testing::MatchesRegex("broken.yaml:9:16: .*thickness.*'thick'.*")));
   EXPECT_THAT(all, ::testing::Contains(::testing::MatchesRegex("broken.yaml:11:15: .*unknown material 'steel'.*")));
@@ -169,15 +171,15 @@ TEST(FormingCase, ConflictingConditionsAreReported) {
 // and name, not by message text); a reference to something undefined is.
 TEST(FormingCase, ProblemsCarryKindPlaceAndName) {
   const std::string text =
-      "materials:\n"                                                                        // 1
-      "  bad: {neo_hookean: {E: -1, nu: 0.3}}\n"                                            // 2
-      "plies:\n"                                                                            // 3
-      "  - {name: a, size: [1, 1], thickness: 1, elements: [1, 1], material: bad}\n"        // 4
-      "  - {name: b, size: [1, 1], thickness: oops, elements: [1, 1], material: bad}\n"     // 5
-      "  - {name: c, size: [1, 1], thickness: 1, elements: [1, 1], material: nothing}\n"    // 6
-      "boundary_conditions:\n"                                                              // 7
-      "  - clamp: {ply: b, edge: x0}\n"                                                     // 8
-      "  - clamp: {ply: z, edge: x0}\n";                                                    // 9
+      "materials:\n"                                                                      // 1
+      "  bad: {neo_hookean: {E: -1, nu: 0.3}}\n"                                          // 2
+      "plies:\n"                                                                          // 3
+      "  - {name: a, size: [1, 1], thickness: 1, elements: [1, 1], material: bad}\n"      // 4
+      "  - {name: b, size: [1, 1], thickness: oops, elements: [1, 1], material: bad}\n"   // 5
+      "  - {name: c, size: [1, 1], thickness: 1, elements: [1, 1], material: nothing}\n"  // 6
+      "boundary_conditions:\n"                                                            // 7
+      "  - clamp: {ply: b, edge: x0}\n"                                                   // 8
+      "  - clamp: {ply: z, edge: x0}\n";                                                  // 9
   const CaseCheck c = check_case_text(text, "kinds.yaml");
   std::vector<std::string> all;
   for (std::size_t i = 0; i < c.problems.size(); ++i) all.push_back(c.located(i));

@@ -53,7 +53,8 @@ TEST(ConstrainedCase, TensionAcrossInextensibleFibresIsExact) {
   for (int k = 1; k <= 4; ++k) {
     const LoadFunction none = [&](double, const VecX& xs, bool t) { return loads.at(model, 0.0, xs, t); };
     UzawaReport ur;
-    const StaticResult r = solve_static_constrained(model, x, problem.prescriptions.at(k / 4.0), none, false, so, uo, &ur);
+    const StaticResult r =
+        solve_static_constrained(model, x, problem.prescriptions.at(k / 4.0), none, false, so, uo, &ur);
     ASSERT_TRUE(r.report.ok()) << r.report.brief();
     updates += ur.updates;
     x = r.positions;
@@ -72,9 +73,10 @@ TEST(ConstrainedCase, TensionAcrossInextensibleFibresIsExact) {
   EXPECT_LT(f_err, 1e-8);
   EXPECT_LT(p_err, 1e-7);
   EXPECT_LT(t_err, 1e-7);
-  std::printf("case B at lambda 1.3: max |g| %.1e, |F - F_exact| %.1e, |p - p_exact| %.1e, |T - T_exact| %.1e "
-              "(T = %.6f), %d multiplier updates\n",
-              max_g, f_err, p_err, t_err, mu_t * (1.0 / (lam * lam) - 1.0), updates);
+  std::printf(
+      "case B at lambda 1.3: max |g| %.1e, |F - F_exact| %.1e, |p - p_exact| %.1e, |T - T_exact| %.1e "
+      "(T = %.6f), %d multiplier updates\n",
+      max_g, f_err, p_err, t_err, mu_t * (1.0 / (lam * lam) - 1.0), updates);
 }
 
 TEST(ConstrainedCase, InextensibleNeedsFibres) {

@@ -383,8 +383,8 @@ TEST(ConstraintClosedForm, CaseBExactStateIsInEquilibrium) {
   EXPECT_LT(worst_reaction, kZeroForceRel * fmax);
   // Resultant = sigma22 times the current face area l1 x h / lambda.
   EXPECT_NEAR(face_resultant_y(r.force), cb.sigma22() * cb.l1 * cb.h / cb.lambda, kZeroForceRel * fmax);
-  std::printf("case B exact state: |f_free| / |f| = %.1e, consistent reactions error / |f| = %.1e\n",
-              worst_free / fmax, worst_reaction / fmax);
+  std::printf("case B exact state: |f_free| / |f| = %.1e, consistent reactions error / |f| = %.1e\n", worst_free / fmax,
+              worst_reaction / fmax);
 }
 
 TEST(ConstraintClosedForm, CaseBNewtonUzawaConvergesToClosedForm) {
@@ -451,9 +451,10 @@ TEST(ConstraintClosedForm, CaseBNewtonUzawaConvergesToClosedForm) {
     c.T = r.T_eff;  //        T <- T + k_fibre g_T
   }
   r = brick_element(X, x, *material, rule, false, c);
-  std::printf("case B Newton + Uzawa (kappa = k_fibre = 1000 mu_T): %d Uzawa updates, %d Newton steps; "
-              "|g_J| = %.1e, |g_T| = %.1e, p = %.12f (closed form %.12f), T = %.12f (closed form %.12f)\n",
-              uzawa, newton_total, std::abs(r.g_J), std::abs(r.g_T), r.p_eff, cb.p(), r.T_eff, cb.T());
+  std::printf(
+      "case B Newton + Uzawa (kappa = k_fibre = 1000 mu_T): %d Uzawa updates, %d Newton steps; "
+      "|g_J| = %.1e, |g_T| = %.1e, p = %.12f (closed form %.12f), T = %.12f (closed form %.12f)\n",
+      uzawa, newton_total, std::abs(r.g_J), std::abs(r.g_T), r.p_eff, cb.p(), r.T_eff, cb.T());
   EXPECT_LT(std::abs(r.g_J), kUzawaResidual);
   EXPECT_LT(std::abs(r.g_T), kUzawaResidual);
   EXPECT_NEAR(r.p_eff, cb.p(), kUzawaMultiplierRel * cb.mu_T);
@@ -601,16 +602,17 @@ TEST(ConstraintLocking, MeanConstraintDoesNotLockInBendingPointwisePenaltyDoes) 
   const double k_beam_layer = beam * (lambda + 2.0 * mu);  // one linear layer, eps33 constant in z
   const double k_beam_comp = beam * 2.0 * mu / (1.0 - 0.3);
   const double k_beam_inc = beam * 4.0 * mu;
-  std::printf("cantilever 10 x 1 bricks, L/h = 20, kappa/mu = 1e4, tip stiffness (N/mm), plane strain:\n"
-              "  neo-Hookean nu = 0.3            %.4e  (beam E_b = lambda + 2mu: ratio %.3f; 2mu/(1-nu): %.3f)\n"
-              "  + mean constraint               %.4e  (ratio to compressible %.4f, to incompressible beam %.3f)\n"
-              "  + pointwise penalty instead     %.4e  (ratio to mean %.0f: locked)\n"
-              "  incompressible law + mean only  %.4e  (ratio to incompressible beam %.3f)\n"
-              " free width: neo-Hookean + mean %.4e (beam E = 2.6 mu: ratio %.3f); incompressible law + mean "
-              "%.4e (beam E = 3 mu: ratio %.1e)\n",
-              k_comp, k_comp / k_beam_layer, k_comp / k_beam_comp, k_mean, k_mean / k_comp, k_mean / k_beam_inc,
-              k_point, k_point / k_mean, k_inc, k_inc / k_beam_inc, k_mean_free, k_mean_free / (beam * 2.6 * mu),
-              k_inc_free, k_inc_free / (beam * 3.0 * mu));
+  std::printf(
+      "cantilever 10 x 1 bricks, L/h = 20, kappa/mu = 1e4, tip stiffness (N/mm), plane strain:\n"
+      "  neo-Hookean nu = 0.3            %.4e  (beam E_b = lambda + 2mu: ratio %.3f; 2mu/(1-nu): %.3f)\n"
+      "  + mean constraint               %.4e  (ratio to compressible %.4f, to incompressible beam %.3f)\n"
+      "  + pointwise penalty instead     %.4e  (ratio to mean %.0f: locked)\n"
+      "  incompressible law + mean only  %.4e  (ratio to incompressible beam %.3f)\n"
+      " free width: neo-Hookean + mean %.4e (beam E = 2.6 mu: ratio %.3f); incompressible law + mean "
+      "%.4e (beam E = 3 mu: ratio %.1e)\n",
+      k_comp, k_comp / k_beam_layer, k_comp / k_beam_comp, k_mean, k_mean / k_comp, k_mean / k_beam_inc, k_point,
+      k_point / k_mean, k_inc, k_inc / k_beam_inc, k_mean_free, k_mean_free / (beam * 2.6 * mu), k_inc_free,
+      k_inc_free / (beam * 3.0 * mu));
   EXPECT_NEAR(k_comp / k_beam_layer, 1.0, 0.1);
   EXPECT_NEAR(k_mean / k_comp, 1.0, 0.1);  // the mean dilatation of bending is zero: no locking
   EXPECT_GT(k_point / k_mean, 10.0);       // locked

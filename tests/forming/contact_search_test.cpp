@@ -78,8 +78,8 @@ TEST(ContactSurface, BezierBoxesHoldTheirFacesTopBottomAndSides) {
   const Curved c = curved_ply();
   std::vector<std::pair<Index, BrickFace>> faces;
   for (Index e = 0; e < 6; ++e)
-    for (BrickFace f : {BrickFace::kTop, BrickFace::kBottom, BrickFace::kXi1Min, BrickFace::kXi1Max,
-                        BrickFace::kXi2Min, BrickFace::kXi2Max})
+    for (BrickFace f : {BrickFace::kTop, BrickFace::kBottom, BrickFace::kXi1Min, BrickFace::kXi1Max, BrickFace::kXi2Min,
+                        BrickFace::kXi2Max})
       faces.emplace_back(e, f);
   const ContactSurface s(c.model, 0, faces);
   for (Index f = 0; f < s.n_faces(); ++f) {

@@ -28,8 +28,9 @@ TEST(DynamicCase, SlowlyLoadedStripEndsNearTheStaticSag) {
   const double tip_s = -s.max_displacement.z(), tip_d = -d.max_displacement.z();
   EXPECT_NEAR(tip_d, tip_s, 0.05 * tip_s);
   EXPECT_NEAR(d.tool_force.z(), s.tool_force.z(), 0.1 * s.tool_force.z());
-  std::printf("free bending: static tip %.4f mm, dynamic (end of smooth ramp) %.4f mm (%.2f %%); clamp %.5f vs %.5f N\n",
-              tip_s, tip_d, 100.0 * (tip_d - tip_s) / tip_s, d.tool_force.z(), s.tool_force.z());
+  std::printf(
+      "free bending: static tip %.4f mm, dynamic (end of smooth ramp) %.4f mm (%.2f %%); clamp %.5f vs %.5f N\n", tip_s,
+      tip_d, 100.0 * (tip_d - tip_s) / tip_s, d.tool_force.z(), s.tool_force.z());
   std::filesystem::remove_all(o.out_dir);
 }
 

@@ -46,9 +46,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kE = 1000.0;      // MPa
+constexpr double kE = 1000.0;  // MPa
 constexpr double kNu = 0.3;
-constexpr double kRho = 1.5e-9;    // t/mm^3
+constexpr double kRho = 1.5e-9;                   // t/mm^3
 constexpr double kL1 = 2.0, kL2 = 1.0, kH = 0.2;  // mm
 
 // ---- Named tolerances (measured values in the comments) -------------------------
@@ -290,8 +290,8 @@ TEST(DynamicsEnergy, TrapezoidalConservesAndRhoHalfDissipates) {
   double drift = 0.0;
   for (double e : cons.energy) drift = std::max(drift, std::abs(e - e0) / e0);
   std::printf("[energy] rho_inf 1: %s\n", cons.report.brief().c_str());
-  std::printf("[energy] rho_inf 1: E0 = %.6e N mm, max |E - E0|/E0 = %.2e, end %.2e, momentum change %.1e\n", e0,
-              drift, (cons.energy.back() - e0) / e0, cons.max_momentum_change / cons.momentum_scale);
+  std::printf("[energy] rho_inf 1: E0 = %.6e N mm, max |E - E0|/E0 = %.2e, end %.2e, momentum change %.1e\n", e0, drift,
+              (cons.energy.back() - e0) / e0, cons.max_momentum_change / cons.momentum_scale);
   EXPECT_LE(drift, kEnergyDrift);
   EXPECT_LE(cons.max_momentum_change, kMomentum * cons.momentum_scale);
 
@@ -374,10 +374,10 @@ TEST(DynamicsPeriod, TrapezoidalSecondOrderPeriodError) {
     const double model_err = 0.5 * wdt / std::atan(0.5 * wdt) - 1.0;
     errors[r] = err;
     if (r == 0) w_ref = run.omega_discrete;
-    std::printf("[period] rho_inf 1, dt = T/%d: omega dt %.4f, period error %.5e, closed form %.5e, "
-                "(omega dt)^2/12 %.5e, modal energy ratio %.8f, %d Newton iterations\n",
-                per_period, wdt, err, model_err, wdt * wdt / 12.0, run.modal_energy_ratio,
-                run.report.total_iterations);
+    std::printf(
+        "[period] rho_inf 1, dt = T/%d: omega dt %.4f, period error %.5e, closed form %.5e, "
+        "(omega dt)^2/12 %.5e, modal energy ratio %.8f, %d Newton iterations\n",
+        per_period, wdt, err, model_err, wdt * wdt / 12.0, run.modal_energy_ratio, run.report.total_iterations);
     EXPECT_NEAR(err, model_err, kPeriodModel * model_err);
     EXPECT_NEAR(run.modal_energy_ratio, 1.0, kModalEnergy) << "no amplitude decay";
   }
@@ -405,8 +405,7 @@ TEST(DynamicsPeriod, TrapezoidalSecondOrderPeriodError) {
     const PeriodRun run = run_mode(s, clamp, mode, dt, 64, *o);
     ASSERT_TRUE(run.report.ok()) << run.report.brief();
     std::printf("[period] %s (%s): period error %.4e, modal energy after 4 periods %.4f\n",
-                to_string(o->integrator).c_str(),
-                o->integrator == Integrator::kHHTAlpha ? "alpha -0.1" : "rho_inf 0.5",
+                to_string(o->integrator).c_str(), o->integrator == Integrator::kHHTAlpha ? "alpha -0.1" : "rho_inf 0.5",
                 mode.omega / run.omega_discrete - 1.0, run.modal_energy_ratio);
     EXPECT_LT(run.modal_energy_ratio, 1.0);
     EXPECT_GT(mode.omega / run.omega_discrete - 1.0, 0.0);
@@ -489,9 +488,9 @@ TEST(DynamicsPrescribed, ConstantVelocityRigidTranslationIsExact) {
   const VecX expected = s.X + opt.end_time * v0;
   const double err = (r.positions - expected).lpNorm<Eigen::Infinity>() / s.X.lpNorm<Eigen::Infinity>();
   const double verr = (r.velocities - v0).lpNorm<Eigen::Infinity>() / vel.norm();
-  std::printf("[prescribed] rigid translation: position err %.1e, velocity err %.1e, |a| %.1e, |reactions| %.1e N; %s\n",
-              err, verr, r.accelerations.lpNorm<Eigen::Infinity>(), r.reactions.lpNorm<Eigen::Infinity>(),
-              r.report.brief().c_str());
+  std::printf(
+      "[prescribed] rigid translation: position err %.1e, velocity err %.1e, |a| %.1e, |reactions| %.1e N; %s\n", err,
+      verr, r.accelerations.lpNorm<Eigen::Infinity>(), r.reactions.lpNorm<Eigen::Infinity>(), r.report.brief().c_str());
   EXPECT_LE(err, kRigidExact);
   EXPECT_LE(verr, kRigidVelocity);
   EXPECT_EQ(r.report.n_converged_steps, 100);
@@ -513,8 +512,10 @@ TEST(DynamicsStepping, HitTimesRegrowthAndCallback) {
   std::vector<double> times;
   const DynamicResult r = solve_dynamic(
       *s.model, s.mass, s.X, VecX::Zero(s.X.size()), fixed(clamp, s.X),
-      [&](double, const VecX&, bool) { return ExternalForce{f, {}}; }, opt,
-      [&](double t, const VecX&, const VecX&) { times.push_back(t); });
+      [&](double, const VecX&, bool) {
+        return ExternalForce{f, {}};
+      },
+      opt, [&](double t, const VecX&, const VecX&) { times.push_back(t); });
   ASSERT_TRUE(r.report.ok()) << r.report.brief();
   std::printf("[stepping] %s\n", r.report.brief().c_str());
   ASSERT_EQ(times.size(), static_cast<std::size_t>(r.report.n_converged_steps + 1));
@@ -560,10 +561,10 @@ TEST(DynamicsExternalTangent, GroundSpringTangentSpeedsNewtonSameAnswer) {
   opt.end_time = 30 * opt.initial_dt;
   opt.residual_tol_rel = kNewtonTolRel;
   opt.max_iterations = 60;
-  const DynamicResult with = solve_dynamic(model, s.mass, s.X, VecX::Zero(s.X.size()), fixed(clamp, s.X),
-                                           make_load(true), opt);
-  const DynamicResult without = solve_dynamic(model, s.mass, s.X, VecX::Zero(s.X.size()), fixed(clamp, s.X),
-                                              make_load(false), opt);
+  const DynamicResult with =
+      solve_dynamic(model, s.mass, s.X, VecX::Zero(s.X.size()), fixed(clamp, s.X), make_load(true), opt);
+  const DynamicResult without =
+      solve_dynamic(model, s.mass, s.X, VecX::Zero(s.X.size()), fixed(clamp, s.X), make_load(false), opt);
   ASSERT_TRUE(with.report.ok()) << with.report.brief();
   ASSERT_TRUE(without.report.ok()) << without.report.brief();
   const double amp = (with.positions - s.X).lpNorm<Eigen::Infinity>();
@@ -645,8 +646,9 @@ TEST(DynamicsOptions, ParametersMatchTable) {
   struct Row {
     double rho, am, af, gamma, beta;
   };
-  for (const Row& r : {Row{1.0, 0.5, 0.5, 0.5, 0.25}, Row{0.8, 1.0 / 3.0, 4.0 / 9.0, 0.6111111111111111, 0.30864197530864196},
-                       Row{0.5, 0.0, 1.0 / 3.0, 5.0 / 6.0, 4.0 / 9.0}, Row{0.0, -1.0, 0.0, 1.5, 1.0}}) {
+  for (const Row& r :
+       {Row{1.0, 0.5, 0.5, 0.5, 0.25}, Row{0.8, 1.0 / 3.0, 4.0 / 9.0, 0.6111111111111111, 0.30864197530864196},
+        Row{0.5, 0.0, 1.0 / 3.0, 5.0 / 6.0, 4.0 / 9.0}, Row{0.0, -1.0, 0.0, 1.5, 1.0}}) {
     DynamicOptions o;
     o.rho_inf = r.rho;
     const IntegratorParameters p = o.parameters();

@@ -280,8 +280,8 @@ TEST(FormingElementPlane, TangentForceRigidRotationAndExactF) {
 
 TEST(FormingElementPlyMesh, LayersNumberingMapAndFibre) {
   const double h = 0.4;
-  const mesh::SurfaceMesh s = mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 3.0, 2.0, 3, 2,
-                                                        {0.0, 0.5, 2.0, 3.0}, {});
+  const mesh::SurfaceMesh s =
+      mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 3.0, 2.0, 3, 2, {0.0, 0.5, 2.0, 3.0}, {});
   const PlyMesh bottom(s, h, 30.0, PlyPlacement::kBottom);
   const PlyMesh mid(s, h, 30.0, PlyPlacement::kMiddle);
   const Index ns = s.n_nodes();
@@ -324,8 +324,8 @@ TEST(FormingElementPlyMesh, LayersNumberingMapAndFibre) {
 TEST(FormingElementAssembly, AssembledTangentMatchesFiniteDifferencesOnGradedMesh) {
   std::mt19937 rng(test::kSeed + 5);
   Model model;
-  PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 3.0, 2.0, 2, 2,
-                                        {0.0, 1.2, 3.0}, {0.0, 0.7, 2.0}),
+  PlyMesh ply(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 3.0, 2.0, 2, 2, {0.0, 1.2, 3.0},
+                                        {0.0, 0.7, 2.0}),
               0.3, 30.0);
   const Vec3 a0 = ply.fibre_direction();
   EXPECT_LT((a0 - fibre_from_layup_angle(30.0)).norm(), 1e-15);

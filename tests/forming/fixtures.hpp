@@ -44,9 +44,9 @@ double max_abs(const Eigen::MatrixBase<Derived>& m) {
 inline PlyMesh rectangle_ply(double lx, double ly, double h, int n1, int n2, double angle_deg = 0.0,
                              PlyPlacement placement = PlyPlacement::kBottom, const std::vector<double>& breaks1 = {},
                              const std::vector<double>& breaks2 = {}) {
-  return PlyMesh(mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), lx, ly, n1, n2, breaks1,
-                                           breaks2),
-                 h, angle_deg, placement);
+  return PlyMesh(
+      mesh::make_rectangle_mesh(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), lx, ly, n1, n2, breaks1, breaks2), h,
+      angle_deg, placement);
 }
 
 // A model of one ply with one material.

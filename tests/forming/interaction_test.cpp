@@ -60,11 +60,11 @@ constexpr double kOrderRatioLow = 3.8, kOrderRatioHigh = 4.2;
 
 // ---- The series system ------------------------------------------------------------
 
-constexpr double kMu = 1.0;                             // MPa, lambda = 0
-constexpr double kL = 2.0, kW = 1.0, kH = 0.5;          // block size, mm
-constexpr double kGap = 0.5;                            // between the blocks, mm (spring rest length)
-constexpr double kSpring = 0.25;                        // N/mm per spring
-constexpr int kAlong = 2;                               // elements along x per block
+constexpr double kMu = 1.0;                     // MPa, lambda = 0
+constexpr double kL = 2.0, kW = 1.0, kH = 0.5;  // block size, mm
+constexpr double kGap = 0.5;                    // between the blocks, mm (spring rest length)
+constexpr double kSpring = 0.25;                // N/mm per spring
+constexpr int kAlong = 2;                       // elements along x per block
 
 double nominal_stress(double l) { return kMu * (l - 1.0 / l); }
 
@@ -80,10 +80,10 @@ Series series(bool with_springs) {
   Series s;
   const auto law = fixtures::neo_hookean(kMu, 0.0);
   s.model.add_ply(fixtures::rectangle_ply(kL, kW, kH, kAlong, 1), law);
-  s.model.add_ply(PlyMesh(mesh::make_rectangle_mesh(Vec3(kL + kGap, 0.0, 0.0), Vec3::UnitX(), Vec3::UnitY(), kL, kW,
-                                                    kAlong, 1),
-                          kH, 0.0),
-                  law);
+  s.model.add_ply(
+      PlyMesh(mesh::make_rectangle_mesh(Vec3(kL + kGap, 0.0, 0.0), Vec3::UnitX(), Vec3::UnitY(), kL, kW, kAlong, 1), kH,
+              0.0),
+      law);
   const PlyGrid grid{kAlong, 1};
   for (int j = 0; j <= 1; ++j)
     for (int layer = 0; layer < 2; ++layer) {
@@ -170,9 +170,9 @@ TEST(Interaction, SpringForceAndStiffnessMatchFiniteDifferences) {
 
 TEST(Interaction, SpringsInSeriesWithTwoBlocksGiveTheClosedForm) {
   const double l = 1.2;
-  const double force = nominal_stress(l) * kW * kH;             // N through every section
-  const double extension = force / (4.0 * kSpring);             // mm per spring
-  const double u = 2.0 * kL * (l - 1.0) + extension;            // mm at the far end
+  const double force = nominal_stress(l) * kW * kH;   // N through every section
+  const double extension = force / (4.0 * kSpring);   // mm per spring
+  const double u = 2.0 * kL * (l - 1.0) + extension;  // mm at the far end
   Series s = series(true);
   const Prescriptions prescribed = series_prescriptions(s.model, u);
   StaticOptions options;
@@ -198,9 +198,10 @@ TEST(Interaction, SpringsInSeriesWithTwoBlocksGiveTheClosedForm) {
   EXPECT_LT(e_t, kClosedFormRel);
   EXPECT_NEAR(reaction / force, 1.0, kClosedFormRel) << "reaction " << reaction << " N, force " << force << " N";
   EXPECT_LT(e_energy, kClosedFormRel);
-  std::printf("springs in series at stretch %.2f: u = %.6f mm, |F - diag(l, 1, 1)| = %.1e, spring tension %.1e, "
-              "reaction %.10f N (P W H = %.10f N), spring energy %.1e (relative errors); %s\n",
-              l, u, e_F, e_t, reaction, force, e_energy, r.report.brief().c_str());
+  std::printf(
+      "springs in series at stretch %.2f: u = %.6f mm, |F - diag(l, 1, 1)| = %.1e, spring tension %.1e, "
+      "reaction %.10f N (P W H = %.10f N), spring energy %.1e (relative errors); %s\n",
+      l, u, e_F, e_t, reaction, force, e_energy, r.report.brief().c_str());
 }
 
 TEST(Interaction, ZeroLengthSpringIsAnInadmissibleState) {
@@ -284,9 +285,10 @@ TEST(Interaction, VelocityDependentInteractionInDynamicsDecaysExponentially) {
   // A linear system with the exact effective tangent converges in one Newton solve.
   EXPECT_EQ(coarse.iterations, coarse.steps);
   EXPECT_EQ(fine.iterations, fine.steps);
-  std::printf("damped translation c t = 1: error %.2e (dt = 0.01 s), %.2e (dt / 2), ratio %.3f; %d Newton "
-              "iterations in %d steps\n",
-              coarse.error, fine.error, ratio, coarse.iterations, coarse.steps);
+  std::printf(
+      "damped translation c t = 1: error %.2e (dt = 0.01 s), %.2e (dt / 2), ratio %.3f; %d Newton "
+      "iterations in %d steps\n",
+      coarse.error, fine.error, ratio, coarse.iterations, coarse.steps);
 }
 
 }  // namespace

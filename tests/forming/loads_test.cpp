@@ -57,7 +57,8 @@ TEST(Loads, FollowerPressureTangentMatchesFiniteDifferences) {
     VecX xp = x, xm = x;
     xp(j) += h;
     xm(j) -= h;
-    const VecX fd = (loads.assemble(model, xp, 1.0, false).force - loads.assemble(model, xm, 1.0, false).force) / (2 * h);
+    const VecX fd =
+        (loads.assemble(model, xp, 1.0, false).force - loads.assemble(model, xm, 1.0, false).force) / (2 * h);
     max_err = std::max(max_err, (fd - k.col(j)).lpNorm<Eigen::Infinity>());
     max_k = std::max(max_k, k.col(j).lpNorm<Eigen::Infinity>());
   }
@@ -131,7 +132,8 @@ BlockSolution compress_block(double p, bool follower) {
   const VecX X = model.reference_positions();
   std::vector<PrescribedDof> fixed;
   for (Index s = 0; s < ply.n_surface_nodes(); ++s)
-    for (int d = 0; d < 4; ++d) fixed.push_back({model.dof(0, ply.node(s, 0), d, 2), X(model.dof(0, ply.node(s, 0), d, 2))});
+    for (int d = 0; d < 4; ++d)
+      fixed.push_back({model.dof(0, ply.node(s, 0), d, 2), X(model.dof(0, ply.node(s, 0), d, 2))});
   // Node 0 (origin) fixed in x, y on both layers; node 2 (x = 2, y = 0) in y.
   for (int layer = 0; layer < 2; ++layer) {
     fixed.push_back({model.dof(0, ply.node(0, layer), 0, 0), 0.0});
@@ -168,8 +170,8 @@ TEST(Loads, FollowerPressureIsACauchyTractionOnTheCurrentFace) {
   // Dead pressure: force p * reference area on the current area F11 F22.
   EXPECT_NEAR(d.sigma(2, 2) * d.F(0, 0) * d.F(1, 1), -p, 1e-9);
   EXPECT_GT(std::abs(d.F(2, 2) - s.F(2, 2)), 1e-3) << "follower and dead pressure should differ at finite strain";
-  std::printf("block under p = %.2f: follower F33 = %.6f sigma33 = %.12f (%d Newton); dead F33 = %.6f\n", p,
-              s.F(2, 2), s.sigma(2, 2), s.iterations, d.F(2, 2));
+  std::printf("block under p = %.2f: follower F33 = %.6f sigma33 = %.12f (%d Newton); dead F33 = %.6f\n", p, s.F(2, 2),
+              s.sigma(2, 2), s.iterations, d.F(2, 2));
 }
 
 // The free-bending sample (data/forming/free_bending.yaml): a clamped strip under its

@@ -52,9 +52,7 @@ constexpr double kModuliRel = 1e-6;
 // of the modulus times the stiffness ratio of the law.
 constexpr double kSecantRel = 1e-4;
 
-Mat3 rotation(const Vec3& axis, double angle) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
+Mat3 rotation(const Vec3& axis, double angle) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
 
 Mat3 random_rotation(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -99,8 +97,8 @@ Mat3 perturbed(const Mat3& C, int J, double t) {
 Mat3 fd_stress(const Material& m, const Mat3& C, double h) {
   Mat3 S;
   for (int J = 0; J < 6; ++J) {
-    const double dw = (m.evaluate(perturbed(C, J, h), false).energy -
-                       m.evaluate(perturbed(C, J, -h), false).energy) / (2.0 * h);
+    const double dw =
+        (m.evaluate(perturbed(C, J, h), false).energy - m.evaluate(perturbed(C, J, -h), false).energy) / (2.0 * h);
     const int k = kPair[J][0], l = kPair[J][1];
     S(k, l) = S(l, k) = (k == l ? 2.0 : 1.0) * dw;
   }
@@ -113,7 +111,8 @@ Mat6 fd_tangent(const Material& m, const Mat3& C, double h) {
   Mat6 CC;
   for (int J = 0; J < 6; ++J) {
     const Vec6 ds = (voigt_stress(m.evaluate(perturbed(C, J, h), false).stress) -
-                     voigt_stress(m.evaluate(perturbed(C, J, -h), false).stress)) / (2.0 * h);
+                     voigt_stress(m.evaluate(perturbed(C, J, -h), false).stress)) /
+                    (2.0 * h);
     CC.col(J) = (kPair[J][0] == kPair[J][1] ? 2.0 : 1.0) * ds;
   }
   return CC;
@@ -142,10 +141,8 @@ TransverselyIsotropicEngineering gfpp(bool incompressible) {
 }
 
 std::vector<NamedMaterial> neo_hookeans() {
-  return {{"neo-Hookean E=10 nu=0.3", std::make_shared<NeoHookean>(
-                                           NeoHookeanParams::from_young_poisson(10.0, 0.3))},
-          {"neo-Hookean mu=1 kappa=200", std::make_shared<NeoHookean>(
-                                             NeoHookeanParams::from_shear_bulk(1.0, 200.0))}};
+  return {{"neo-Hookean E=10 nu=0.3", std::make_shared<NeoHookean>(NeoHookeanParams::from_young_poisson(10.0, 0.3))},
+          {"neo-Hookean mu=1 kappa=200", std::make_shared<NeoHookean>(NeoHookeanParams::from_shear_bulk(1.0, 200.0))}};
 }
 
 // Both TI variants at several layup angles, an out-of-plane fibre, mu_L < mu_T, and
@@ -155,30 +152,24 @@ std::vector<NamedMaterial> transversely_isotropics() {
   for (const double angle : {0.0, 30.0, 45.0, 90.0, -60.0}) {
     const Vec3 a0 = fibre_from_layup_angle(angle);
     const std::string at = " at " + std::to_string(angle) + " deg";
-    out.push_back({"TI incompressible (1,3,50)" + at,
-                   std::make_shared<TransverselyIsotropic>(ti(1.0, 3.0, 50.0), a0)});
+    out.push_back({"TI incompressible (1,3,50)" + at, std::make_shared<TransverselyIsotropic>(ti(1.0, 3.0, 50.0), a0)});
     out.push_back({"TI compressible (1,3,50,lambda 5)" + at,
-                   std::make_shared<TransverselyIsotropic>(ti_compressible(1.0, 3.0, 50.0, 5.0),
-                                                           a0)});
+                   std::make_shared<TransverselyIsotropic>(ti_compressible(1.0, 3.0, 50.0, 5.0), a0)});
   }
   out.push_back({"TI incompressible, fibre (1,2,3)",
                  std::make_shared<TransverselyIsotropic>(ti(1.0, 3.0, 50.0), Vec3(1.0, 2.0, 3.0))});
   out.push_back({"TI compressible mu_L < mu_T, fibre (-1,0.5,2)",
-                 std::make_shared<TransverselyIsotropic>(ti_compressible(2.0, 1.0, 20.0, -0.5),
-                                                         Vec3(-1.0, 0.5, 2.0))});
+                 std::make_shared<TransverselyIsotropic>(ti_compressible(2.0, 1.0, 20.0, -0.5), Vec3(-1.0, 0.5, 2.0))});
   out.push_back({"TI incompressible GF/PP at 20 deg",
-                 std::make_shared<TransverselyIsotropic>(gfpp(true).to_params(),
-                                                         fibre_from_layup_angle(20.0))});
+                 std::make_shared<TransverselyIsotropic>(gfpp(true).to_params(), fibre_from_layup_angle(20.0))});
   out.push_back({"TI compressible GF/PP at 70 deg",
-                 std::make_shared<TransverselyIsotropic>(gfpp(false).to_params(),
-                                                         fibre_from_layup_angle(70.0))});
+                 std::make_shared<TransverselyIsotropic>(gfpp(false).to_params(), fibre_from_layup_angle(70.0))});
   return out;
 }
 
 // Worst relative FD errors (stress, tangent) over `n` random C for one material;
 // also checks the tangent's major symmetry and that want_tangent does not change W, S.
-void check_against_finite_differences(const NamedMaterial& nm, unsigned seed, double& worst_s,
-                                      double& worst_cc) {
+void check_against_finite_differences(const NamedMaterial& nm, unsigned seed, double& worst_s, double& worst_cc) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 8; ++trial) {
     const Mat3 F = random_deformation(rng, 0.3);
@@ -201,17 +192,14 @@ void check_against_finite_differences(const NamedMaterial& nm, unsigned seed, do
   }
 }
 
-void print_measured(const char* what, double value) {
-  std::printf("[ measured ] %s: %.3e\n", what, value);
-}
+void print_measured(const char* what, double value) { std::printf("[ measured ] %s: %.3e\n", what, value); }
 
 // ---------------------------------------------------------------------------------
 // Neo-Hookean
 
 TEST(FormingMaterialNeoHookean, StressAndTangentMatchFiniteDifferences) {
   double ws = 0.0, wc = 0.0;
-  for (const NamedMaterial& nm : neo_hookeans())
-    check_against_finite_differences(nm, sf::test::kSeed, ws, wc);
+  for (const NamedMaterial& nm : neo_hookeans()) check_against_finite_differences(nm, sf::test::kSeed, ws, wc);
   print_measured("neo-Hookean FD stress rel. error", ws);
   print_measured("neo-Hookean FD tangent rel. error", wc);
 }
@@ -241,8 +229,7 @@ TEST(FormingMaterialNeoHookean, HomogeneousDeformationsInClosedForm) {
     const Mat3 sigma = cauchy_stress(F, m.evaluate(F.transpose() * F, false).stress);
     const double j = s * s * s;
     const double expected = (p.mu * (s * s - 1.0) + p.lambda * std::log(j)) / j;
-    EXPECT_LT(max_abs(sigma - expected * Mat3::Identity()), kExactRel * (1.0 + std::abs(expected)))
-        << "s = " << s;
+    EXPECT_LT(max_abs(sigma - expected * Mat3::Identity()), kExactRel * (1.0 + std::abs(expected))) << "s = " << s;
   }
   for (const double g : {0.1, 1.0, 3.0}) {
     Mat3 F = Mat3::Identity();
@@ -290,8 +277,7 @@ TEST(FormingMaterialNeoHookean, BadParametersAreNamed) {
 TEST(FormingMaterialTransverselyIsotropic, StressAndTangentMatchFiniteDifferences) {
   double ws = 0.0, wc = 0.0;
   unsigned seed = sf::test::kSeed;
-  for (const NamedMaterial& nm : transversely_isotropics())
-    check_against_finite_differences(nm, seed++, ws, wc);
+  for (const NamedMaterial& nm : transversely_isotropics()) check_against_finite_differences(nm, seed++, ws, wc);
   print_measured("TI FD stress rel. error", ws);
   print_measured("TI FD tangent rel. error", wc);
 }
@@ -307,8 +293,7 @@ TEST(FormingMaterialTransverselyIsotropic, TangentMatchesFiniteDifferencesAtLarg
       const Mat3 C = F.transpose() * F;
       const MaterialResponse r = nm.material->evaluate(C, true);
       const double h = kFdStepC * std::max(1.0, max_abs(C));
-      const double e = max_abs(fd_tangent(*nm.material, C, h) - r.tangent) /
-                       std::max(1.0, max_abs(r.tangent));
+      const double e = max_abs(fd_tangent(*nm.material, C, h) - r.tangent) / std::max(1.0, max_abs(r.tangent));
       EXPECT_LT(e, kFdRel) << nm.label << ", trial " << trial;
       worst = std::max(worst, e);
     }
@@ -405,9 +390,7 @@ TEST(FormingMaterialTransverselyIsotropic, MaterialSymmetryAndObjectivity) {
   const TransverselyIsotropic m(ti(1.0, 3.0, 50.0), Vec3::UnitX());
   const Mat3 C = Vec3(1.21, 1.0 / 1.1, 1.0 / 1.1).asDiagonal();
   const Mat3 Rz = rotation(Vec3::UnitZ(), kPi / 2);
-  EXPECT_GT(std::abs(m.evaluate(Rz * C * Rz.transpose(), false).energy -
-                     m.evaluate(C, false).energy),
-            0.4);
+  EXPECT_GT(std::abs(m.evaluate(Rz * C * Rz.transpose(), false).energy - m.evaluate(C, false).energy), 0.4);
 }
 
 TEST(FormingMaterialTransverselyIsotropic, FibreDirectionFromLayupAngle) {
@@ -432,9 +415,7 @@ TEST(FormingMaterialTransverselyIsotropic, FibreDirectionFromLayupAngle) {
 // Run in the fibre's own frame for several layup angles.
 TEST(FormingMaterialTransverselyIsotropic, UniaxialTensionAlongFibresClosedForm) {
   const TransverselyIsotropicParams p = ti(1.0, 3.0, 50.0);
-  const struct {
-    double stretch, sigma11;
-  } cases[] = {{1.05, 6.252457}, {1.2, 34.821067}};
+  const struct { double stretch, sigma11; } cases[] = {{1.05, 6.252457}, {1.2, 34.821067}};
   for (const double angle : {0.0, 30.0, 90.0, -75.0}) {
     const Mat3 R = rotation(Vec3::UnitZ(), angle * kPi / 180.0);  // fibre frame -> global
     const TransverselyIsotropic m(p, fibre_from_layup_angle(angle));
@@ -445,16 +426,14 @@ TEST(FormingMaterialTransverselyIsotropic, UniaxialTensionAlongFibresClosedForm)
       const Mat3 sigma_global =
           cauchy_stress(F, m.evaluate(F.transpose() * F, false).stress) - pressure * Mat3::Identity();
       const Mat3 sigma = R.transpose() * sigma_global * R;
-      const double formula = p.mu_T * (l * l - 1.0 / l) +
-                             (p.kappa_f + 2.0 * (p.mu_L - p.mu_T)) * l * l * (l * l - 1.0);
+      const double formula = p.mu_T * (l * l - 1.0 / l) + (p.kappa_f + 2.0 * (p.mu_L - p.mu_T)) * l * l * (l * l - 1.0);
       EXPECT_NEAR(sigma(0, 0), c.sigma11, kQuoted6) << "stretch " << l << ", angle " << angle;
       EXPECT_NEAR(sigma(0, 0), formula, kExactRel * formula);
       EXPECT_NEAR(sigma(1, 1), 0.0, kExactRel * formula);
       EXPECT_NEAR(sigma(2, 2), 0.0, kExactRel * formula);
       EXPECT_NEAR(sigma(0, 1), 0.0, kExactRel * formula);
       if (angle == 0.0)
-        std::printf("[ measured ] case A l=%.2f: sigma11 = %.9f (notes %.6f)\n", l, sigma(0, 0),
-                    c.sigma11);
+        std::printf("[ measured ] case A l=%.2f: sigma11 = %.9f (notes %.6f)\n", l, sigma(0, 0), c.sigma11);
     }
   }
 }
@@ -465,9 +444,7 @@ TEST(FormingMaterialTransverselyIsotropic, UniaxialTensionAlongFibresClosedForm)
 TEST(FormingMaterialTransverselyIsotropic, TensionAcrossInextensibleFibresClosedForm) {
   const struct {
     double mu_t, stretch, sigma22, tension;
-  } cases[] = {{1.0, 2.0, 3.75, -0.75},
-               {1.0, 1.3, 1.098284, -0.408284},
-               {0.7, 2.0, 3.75 * 0.7, -0.75 * 0.7}};
+  } cases[] = {{1.0, 2.0, 3.75, -0.75}, {1.0, 1.3, 1.098284, -0.408284}, {0.7, 2.0, 3.75 * 0.7, -0.75 * 0.7}};
   for (const auto& c : cases) {
     for (const TransverselyIsotropicParams& p : {ti(c.mu_t, 3.0, 50.0), ti(c.mu_t, 0.5, 12500.0)}) {
       const TransverselyIsotropic m(p, Vec3::UnitX());
@@ -477,15 +454,15 @@ TEST(FormingMaterialTransverselyIsotropic, TensionAcrossInextensibleFibresClosed
       const double tension = p.mu_T * (1.0 / (l * l) - 1.0);
       const Vec3 a = F * m.fibre_direction();
       // S_total = S - p J C^-1 + T a0 (x) a0, pushed forward with J = 1.
-      const Mat3 sigma = cauchy_stress(F, m.evaluate(F.transpose() * F, false).stress) -
-                         pressure * Mat3::Identity() + tension * a * a.transpose();
+      const Mat3 sigma = cauchy_stress(F, m.evaluate(F.transpose() * F, false).stress) - pressure * Mat3::Identity() +
+                         tension * a * a.transpose();
       EXPECT_NEAR(tension, c.tension, kQuoted6);
       EXPECT_NEAR(sigma(1, 1), c.sigma22, kQuoted6) << "stretch " << l;
       EXPECT_NEAR(sigma(0, 0), 0.0, kExactRel * c.sigma22) << "stretch " << l;
       EXPECT_NEAR(sigma(2, 2), 0.0, kExactRel * c.sigma22) << "stretch " << l;
       if (p.mu_L == 3.0)
-        std::printf("[ measured ] case B mu_T=%.1f l=%.1f: sigma22 = %.9f, T = %.9f\n", c.mu_t, l,
-                    sigma(1, 1), tension);
+        std::printf("[ measured ] case B mu_T=%.1f l=%.1f: sigma22 = %.9f, T = %.9f\n", c.mu_t, l, sigma(1, 1),
+                    tension);
     }
   }
 }
@@ -588,15 +565,14 @@ TEST(FormingMaterialTransverselyIsotropic, EngineeringConstantsRecoveredIncompre
     const TransverselyIsotropicModuli f = small_strain_moduli(p);
     expect_rel(got.E_T, f.E_T, "E_T formula, " + at);
     expect_rel(got.nu_TT, f.nu_TT, "nu_TT formula, " + at);
-    worst = std::max({worst, std::abs(got.E_L / e.E_f - 1.0), std::abs(got.E_T / e.E_T - 1.0),
-                      std::abs(got.G_L / e.G_L - 1.0)});
+    worst = std::max(
+        {worst, std::abs(got.E_L / e.E_f - 1.0), std::abs(got.E_T / e.E_T - 1.0), std::abs(got.G_L / e.G_L - 1.0)});
   }
   // The identity E_L = 3 mu_T + 2 kappa_f + 4 (mu_L - mu_T) against the finite-strain
   // closed form (A) as a secant at stretch 1 + 1e-6.
   const TransverselyIsotropicParams p = ti(1.0, 3.0, 50.0);
   const double l = 1.0 + 1e-6;
-  const double sigma11 = p.mu_T * (l * l - 1.0 / l) +
-                         (p.kappa_f + 2.0 * (p.mu_L - p.mu_T)) * l * l * (l * l - 1.0);
+  const double sigma11 = p.mu_T * (l * l - 1.0 / l) + (p.kappa_f + 2.0 * (p.mu_L - p.mu_T)) * l * l * (l * l - 1.0);
   const double e_l = 3.0 * p.mu_T + 2.0 * p.kappa_f + 4.0 * (p.mu_L - p.mu_T);
   EXPECT_NEAR(sigma11 / (l - 1.0), e_l, kSecantRel * e_l);
   EXPECT_NEAR(small_strain_moduli(p).E_L, e_l, kExactRel * e_l);
@@ -605,9 +581,9 @@ TEST(FormingMaterialTransverselyIsotropic, EngineeringConstantsRecoveredIncompre
 
 TEST(FormingMaterialTransverselyIsotropic, EngineeringConstantsRecoveredCompressible) {
   const TransverselyIsotropicEngineering cases[] = {gfpp(false),
-                                                   {50.0, 4.0, 3.0, 1.5, false},
-                                                   {10.0, 2.0, 1.0, 1.2, false},   // nu_TT < 0
-                                                   {25000.0, 1.0, 0.5, 0.2502, false}};  // nu_TT ~ 1
+                                                    {50.0, 4.0, 3.0, 1.5, false},
+                                                    {10.0, 2.0, 1.0, 1.2, false},         // nu_TT < 0
+                                                    {25000.0, 1.0, 0.5, 0.2502, false}};  // nu_TT ~ 1
   double worst = 0.0;
   for (const TransverselyIsotropicEngineering& e : cases) {
     const TransverselyIsotropicParams p = e.to_params();

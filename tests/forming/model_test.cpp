@@ -39,14 +39,15 @@ std::shared_ptr<const Material> ti_model_material(const Vec3& a0) {
 // yet.)
 Model test_model() {
   Model model;
-  model.add_ply(fixtures::rectangle_ply(40.0, 30.0, 1.0, 4, 3, 0.0, PlyPlacement::kBottom, {0.0, 5.0, 20.0, 30.0, 40.0}),
-                ti_model_material(fibre_from_layup_angle(0.0)));
+  model.add_ply(
+      fixtures::rectangle_ply(40.0, 30.0, 1.0, 4, 3, 0.0, PlyPlacement::kBottom, {0.0, 5.0, 20.0, 30.0, 40.0}),
+      ti_model_material(fibre_from_layup_angle(0.0)));
   PlyMesh upper(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, 1.5), Vec3::UnitX(), Vec3::UnitY(), 40.0, 30.0, 3, 3), 1.0,
                 30.0);
   model.add_ply(std::move(upper), ti_model_material(fibre_from_layup_angle(30.0)));
-  model.add_ply(PlyMesh(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, 4.0), Vec3::UnitX(), Vec3::UnitY(), 20.0, 10.0, 2, 2),
-                        0.5, 0.0),
-                fixtures::neo_hookean(1.0, 4.0));
+  model.add_ply(
+      PlyMesh(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, 4.0), Vec3::UnitX(), Vec3::UnitY(), 20.0, 10.0, 2, 2), 0.5, 0.0),
+      fixtures::neo_hookean(1.0, 4.0));
   for (Index s : {0, 5, 11})
     model.add_interaction(std::make_shared<NodeSpring>(model, BodyNode{0, model.ply(0).node(s, 1)},
                                                        BodyNode{1, model.ply(1).node(s, 0)}, 3.0, 0.5));
@@ -154,8 +155,7 @@ TEST(FormingModel, InvertedElementIsReportedByTheFastAssembly) {
 // as its lower triangle. Cholesky breaks down, the LDL^T takes over and solves it.
 TEST(FormingTangentSolver, IndefiniteTangentIsSolvedByLdlt) {
   Model model;
-  model.add_ply(fixtures::rectangle_ply(20.0, 20.0, 1.0, 4, 4, 30.0),
-                ti_model_material(fibre_from_layup_angle(30.0)));
+  model.add_ply(fixtures::rectangle_ply(20.0, 20.0, 1.0, 4, 4, 30.0), ti_model_material(fibre_from_layup_angle(30.0)));
   std::vector<bool> is_free(static_cast<std::size_t>(model.n_dofs()), true);
   for (Index d = 0; d < 48; ++d) is_free[static_cast<std::size_t>(d)] = false;  // a clamped corner node pair
   TangentSolver solver(linalg::SolverKind::kAuto, false);

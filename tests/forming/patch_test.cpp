@@ -154,7 +154,8 @@ void run_patch(const std::shared_ptr<const Material>& material, const PlyMesh& p
   EXPECT_LT(pos_err, kPatchExact);
   // F = F0 at every Gauss point.
   double f_err = 0.0;
-  for (const Mat3& F : model.deformation_gradients(0, res.positions)) f_err = std::max(f_err, (F - F0).cwiseAbs().maxCoeff());
+  for (const Mat3& F : model.deformation_gradients(0, res.positions))
+    f_err = std::max(f_err, (F - F0).cwiseAbs().maxCoeff());
   EXPECT_LT(f_err, kPatchExact);
   std::printf("  max |x - (F0 X + t)| = %.2e mm, max |F - F0| = %.2e over %zu Gauss points\n", pos_err, f_err,
               model.deformation_gradients(0, res.positions).size());

@@ -48,7 +48,8 @@ TEST(Restart, SplitRunMatchesUninterruptedRun) {
   EXPECT_LT(diff, 1e-9) << "final positions of the split run differ by " << diff << " mm";
   // History: same number of rows; the collection lists every frame once.
   auto rows = [](const std::string& t) { return std::count(t.begin(), t.end(), '\n'); };
-  EXPECT_EQ(rows(fixtures::read_text(tmp / "whole" / "history.csv")), rows(fixtures::read_text(tmp / "split" / "history.csv")));
+  EXPECT_EQ(rows(fixtures::read_text(tmp / "whole" / "history.csv")),
+            rows(fixtures::read_text(tmp / "split" / "history.csv")));
   // Every frame of the whole run is in the split run's collection (which also has the
   // frame written where it stopped).
   const std::string pvd_split = fixtures::read_text(tmp / "split" / "result.pvd");

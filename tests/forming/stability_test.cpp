@@ -56,7 +56,6 @@ inline constexpr double kLongWaveRest = 1e-6;
 inline constexpr double kInextensible = 1e-13;
 }  // namespace tol
 
-
 TrellisSpec spec(double angle_a, double angle_b, double shear_rate, double ta, double tb) {
   TrellisSpec s;
   s.fibre_angles_deg = {angle_a, angle_b};
@@ -165,8 +164,8 @@ TEST(StabilityClosedForm, FibreSheetGrowthIsDThreeMinusResolvedTension) {
     if (std::abs(f.shear_rate) > 1e-3 && std::abs(f.sheet.rate33()) > 1e-9) {
       const double tau = tn / (f.sheet.viscosity * std::abs(f.shear_rate));
       const FlowKind k = f.thickening() ? FlowKind::kThickening : FlowKind::kThinning;
-      EXPECT_NEAR(growth_factor(tau, f.fibre_angle, k), fibre_sheet_growth_rate(f.sheet, theta) / std::abs(f.shear_rate),
-                  1e-10 * (1 + std::abs(tau)));
+      EXPECT_NEAR(growth_factor(tau, f.fibre_angle, k),
+                  fibre_sheet_growth_rate(f.sheet, theta) / std::abs(f.shear_rate), 1e-10 * (1 + std::abs(tau)));
     }
   }
 }
@@ -181,8 +180,8 @@ TEST(StabilityClosedForm, NewtonianExactSolutionSatisfiesItsEquations) {
   for (double q : {0.2, 1.0, 3.0, 7.0}) {
     const double h = 2.0, k = q / h, hh = h / 2;
     const std::complex<double> i(0.0, 1.0);
-    const std::complex<double> b = i * s * eta * std::sinh(k * hh) /
-                                   (2.0 * mu * (std::sinh(k * hh) * std::cosh(k * hh) - k * hh));
+    const std::complex<double> b =
+        i * s * eta * std::sinh(k * hh) / (2.0 * mu * (std::sinh(k * hh) * std::cosh(k * hh) - k * hh));
     const std::complex<double> a = -b * hh * std::cosh(k * hh) / std::sinh(k * hh);
     const double z = hh, c = std::cosh(k * z), sh = std::sinh(k * z);
     const std::complex<double> f = a * c + b * z * sh;
@@ -247,7 +246,8 @@ TEST(StabilitySpectral, NewtonianSheetMatchesTheExactStokesSolution) {
     const double kh = std::pow(10.0, -1.3 + 2.3 * (1 + u(rng)) / 2);  // 0.05 .. 10
     const SpectralReport r = solve_spectral(s, theta, kh / s.thickness);
     ASSERT_TRUE(r.ok()) << r.brief();
-    const NewtonianGrowthRates g = newtonian_sheet_growth_rates(s.rate, s.viscosity, s.thickness, theta, kh / s.thickness);
+    const NewtonianGrowthRates g =
+        newtonian_sheet_growth_rates(s.rate, s.viscosity, s.thickness, theta, kh / s.thickness);
     const double scale = std::abs(g.sinuous) + std::abs(g.varicose) + s.rate.norm();
     worst = std::max({worst, std::abs(r.sinuous - g.sinuous) / scale, std::abs(r.varicose - g.varicose) / scale});
     EXPECT_LT(std::abs(r.sinuous - g.sinuous) / scale, tol::kNewtonianSpectralRel) << "Kh " << kh << " " << r.brief();
@@ -400,8 +400,10 @@ TEST(StabilityInput, ReadsTheSampleAndReportsPlaces) {
                "in\\.yaml:4:8: .*stretches the fibres");
   expect_error(ok + "rates: {D11: 1, D22: -3, D12: 0, D33: 5}\ntensions: {T_a: 0, T_b: 0}\n",
                "in\\.yaml:4:39: D33 = 5 1/s violates incompressibility");
-  expect_error(ok + "shear_rate: 1\ntensions: {T_a: 0, T_c: 0}\n", "in\\.yaml:5:20: tensions \\(MPa\\): unknown key 'T_c'");
-  expect_error(ok + "shear_rate: fast\n", "in\\.yaml:4:13: shear_rate \\(1/s\\): expected a finite number, found 'fast'");
+  expect_error(ok + "shear_rate: 1\ntensions: {T_a: 0, T_c: 0}\n",
+               "in\\.yaml:5:20: tensions \\(MPa\\): unknown key 'T_c'");
+  expect_error(ok + "shear_rate: fast\n",
+               "in\\.yaml:4:13: shear_rate \\(1/s\\): expected a finite number, found 'fast'");
   expect_error(ok + "shear_rat: 1\n", "in\\.yaml:4:1: stability input: unknown key 'shear_rat'");
   expect_error("fibres: [30, -30, 5]\n", "in\\.yaml:1:9: fibres .*expected a list of 2 numbers, found a list of 3");
 }

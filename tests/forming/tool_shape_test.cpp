@@ -24,9 +24,9 @@
 namespace sf::forming {
 namespace {
 
-constexpr double kFdStep = 1e-6;     // mm
-constexpr double kFdRel = 1e-6;      // derivatives vs central differences (measured ~1e-9)
-constexpr double kExact = 1e-12;     // mm, gaps known in closed form
+constexpr double kFdStep = 1e-6;  // mm
+constexpr double kFdRel = 1e-6;   // derivatives vs central differences (measured ~1e-9)
+constexpr double kExact = 1e-12;  // mm, gaps known in closed form
 
 struct Named {
   std::string name;
@@ -71,8 +71,8 @@ TEST(ToolShape, AnalyticShapesAreSignedDistancesWithExactDerivatives) {
         dn.col(j) = (p.normal - m.normal) / (2 * kFdStep);
       }
       EXPECT_LT((dg - t.normal).norm(), kFdRel) << s.name << " at " << x.transpose();
-      EXPECT_LT((dn - t.normal_gradient).norm(), kFdRel * std::max(1.0, dn.norm())) << s.name << " at "
-                                                                                     << x.transpose();
+      EXPECT_LT((dn - t.normal_gradient).norm(), kFdRel * std::max(1.0, dn.norm()))
+          << s.name << " at " << x.transpose();
       EXPECT_LT((t.normal_gradient - t.normal_gradient.transpose()).norm(), 1e-12) << s.name;
       // The foot point x - g n lies on the surface.
       EXPECT_NEAR(s.shape->evaluate(x - t.gap * t.normal).gap, 0.0, 1e-10) << s.name;
@@ -89,20 +89,20 @@ TEST(ToolShape, KnownGaps) {
   EXPECT_NEAR(cylinder->evaluate(Vec3(123, 0, 0)).gap, 2.0, kExact);
   // Punch pressing along -z, tip face at z = 5, radius 20, fillet 5.
   const auto punch = make_punch(Vec3(0, 0, 5), Vec3(0, 0, -1), 20.0, 5.0);
-  EXPECT_NEAR(punch->evaluate(Vec3(3, 4, 2)).gap, 3.0, kExact);                // below the end face
+  EXPECT_NEAR(punch->evaluate(Vec3(3, 4, 2)).gap, 3.0, kExact);  // below the end face
   EXPECT_LT((punch->evaluate(Vec3(3, 4, 2)).normal - Vec3(0, 0, -1)).norm(), kExact);
-  EXPECT_NEAR(punch->evaluate(Vec3(0, 23, 30)).gap, 3.0, kExact);              // beside the side
-  const Vec3 fillet_centre(0, 15, 10);                                         // (R - r, tip + r)
+  EXPECT_NEAR(punch->evaluate(Vec3(0, 23, 30)).gap, 3.0, kExact);  // beside the side
+  const Vec3 fillet_centre(0, 15, 10);                             // (R - r, tip + r)
   const Vec3 dir = Vec3(0, 1, -1).normalized();
-  EXPECT_NEAR(punch->evaluate(fillet_centre + 7.0 * dir).gap, 2.0, kExact);    // off the fillet
-  EXPECT_NEAR(punch->evaluate(Vec3(0, 0, 6)).gap, -1.0, kExact);               // inside
+  EXPECT_NEAR(punch->evaluate(fillet_centre + 7.0 * dir).gap, 2.0, kExact);  // off the fillet
+  EXPECT_NEAR(punch->evaluate(Vec3(0, 0, 6)).gap, -1.0, kExact);             // inside
   // Die: top face z = 0, circular opening radius 20, edge radius 4.
   DieOpening circle;
   circle.radius = 20.0;
   const auto die = make_die(Vec3(0, 0, 0), Vec3(0, 0, 1), circle, 4.0);
-  EXPECT_NEAR(die->evaluate(Vec3(30, 0, 2)).gap, 2.0, kExact);                 // above the top face
-  EXPECT_NEAR(die->evaluate(Vec3(0, 17, -10)).gap, 3.0, kExact);               // in the opening, off the wall
-  EXPECT_NEAR(die->evaluate(Vec3(0, 0, -10)).gap, 20.0, kExact);               // on the axis
+  EXPECT_NEAR(die->evaluate(Vec3(30, 0, 2)).gap, 2.0, kExact);    // above the top face
+  EXPECT_NEAR(die->evaluate(Vec3(0, 17, -10)).gap, 3.0, kExact);  // in the opening, off the wall
+  EXPECT_NEAR(die->evaluate(Vec3(0, 0, -10)).gap, 20.0, kExact);  // on the axis
   const Vec3 edge_centre(24, 0, -4);
   EXPECT_NEAR(die->evaluate(edge_centre + 5.0 * Vec3(-1, 0, 1).normalized()).gap, 1.0, kExact);
   DieOpening slot;

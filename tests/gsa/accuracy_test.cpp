@@ -170,7 +170,8 @@ TEST(GsaAccuracy, RigidMotionGivesZeroStrainAtEveryMark) {
   EXPECT_LT(r.result.rms_deformed, tol::kExactResidual);
   // The deformed normal is the rotated flat normal (+-Z rotated).
   const Vec3 n = synthetic_rotation() * Vec3::UnitZ();
-  const auto [dn, idn] = worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.normal_deformed.dot(n)); });
+  const auto [dn, idn] =
+      worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.normal_deformed.dot(n)); });
   EXPECT_LT(dn, tol::kExactDirection) << "deformed normal at " << idn;
 }
 
@@ -182,13 +183,14 @@ TEST(GsaAccuracy, HomogeneousStretchIsExactWithDirections) {
   EXPECT_LT(e.max_abs, tol::kExactStrain) << describe(e);
   // Major stretch 1.2 along X, then rotated: dir1 (deformed) = R e_x, dir1 (undeformed) = e_x.
   const Vec3 d1 = synthetic_rotation() * Vec3::UnitX();
-  const auto [dd, idd] = worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
-  const auto [du, idu] = worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_undeformed.dot(Vec3::UnitX())); });
+  const auto [dd, idd] =
+      worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
+  const auto [du, idu] =
+      worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_undeformed.dot(Vec3::UnitX())); });
   EXPECT_LT(dd, tol::kExactDirection) << "deformed major direction at " << idd;
   EXPECT_LT(du, tol::kExactDirection) << "undeformed major direction at " << idu;
-  const auto [th, idt] = worst(r, [](Index, const SurfaceStrain& s) {
-    return s.thickness_change_pct() - 100.0 * (1.0 / (1.2 * 0.9) - 1.0);
-  });
+  const auto [th, idt] = worst(
+      r, [](Index, const SurfaceStrain& s) { return s.thickness_change_pct() - 100.0 * (1.0 / (1.2 * 0.9) - 1.0); });
   EXPECT_LT(th, 100 * tol::kExactStrain) << "thickness change at " << idt;
 }
 
@@ -203,7 +205,8 @@ TEST(GsaAccuracy, SimpleShearIsExactWithDirections) {
   F << 1.0, 0.3, 0.0, 1.0;
   Eigen::SelfAdjointEigenSolver<Mat2> es(F * F.transpose());
   const Vec3 d1(es.eigenvectors()(0, 1), es.eigenvectors()(1, 1), 0.0);
-  const auto [dd, idd] = worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
+  const auto [dd, idd] =
+      worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
   EXPECT_LT(dd, tol::kExactDirection) << "deformed major direction at " << idd;
   // The sheet stays in its plane: the surface strain conserves the area ratio
   // lambda1 lambda2 = det F = 1.
@@ -393,14 +396,12 @@ TEST_P(Noisy, SurfaceBeatsTriangles) {
   const auto [s, t] = noisy_errors(GetParam().name);
   EXPECT_LT(s, GetParam().ratio * t) << "surface rms " << s << ", triangles rms " << t << ", ratio " << s / t;
 }
-INSTANTIATE_TEST_SUITE_P(GsaAccuracy, Noisy,
-                         ::testing::Values(NoisyCase{"rigid", tol::kNoisyFlatRatio},
-                                           NoisyCase{"stretch", tol::kNoisyFlatRatio},
-                                           NoisyCase{"dome", tol::kNoisyCurvedRatio},
-                                           NoisyCase{"cylinder", tol::kNoisyCurvedRatio},
-                                           NoisyCase{"trellis", tol::kNoisyCurvedRatio},
-                                           NoisyCase{"wavy", tol::kNoisyCurvedRatio}),
-                         [](const ::testing::TestParamInfo<NoisyCase>& p) { return p.param.name; });
+INSTANTIATE_TEST_SUITE_P(
+    GsaAccuracy, Noisy,
+    ::testing::Values(NoisyCase{"rigid", tol::kNoisyFlatRatio}, NoisyCase{"stretch", tol::kNoisyFlatRatio},
+                      NoisyCase{"dome", tol::kNoisyCurvedRatio}, NoisyCase{"cylinder", tol::kNoisyCurvedRatio},
+                      NoisyCase{"trellis", tol::kNoisyCurvedRatio}, NoisyCase{"wavy", tol::kNoisyCurvedRatio}),
+    [](const ::testing::TestParamInfo<NoisyCase>& p) { return p.param.name; });
 
 // ---------------------------------------------------------------- triangles method
 
@@ -414,7 +415,8 @@ TEST(GsaTriangles, HomogeneousStretchIsExactOnGridTriangles) {
   EXPECT_EQ(e.n, r.grid.n_points());
   EXPECT_LT(e.max_abs, tol::kExactStrain) << describe(e);
   const Vec3 d1 = synthetic_rotation() * Vec3::UnitX();
-  const auto [dd, idd] = worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
+  const auto [dd, idd] =
+      worst(r, [&](Index, const SurfaceStrain& s) { return 1.0 - std::abs(s.dir1_deformed.dot(d1)); });
   EXPECT_LT(dd, tol::kExactDirection) << "deformed major direction at " << idd;
 }
 
@@ -562,8 +564,8 @@ TEST_P(NoisyOutliers, AreFlaggedAndTheRestStayAsAccurate) {
   expect_only_moved_marks_flagged(g, res);
   const StrainError e = strain_error(g, res, exact), e0 = strain_error(clean, analyse(clean, {}), exact);
   EXPECT_EQ(e.n_missing, 0);
-  EXPECT_LT(e.rms(), tol::kOutlierRemovedRel * e0.rms()) << "with outliers: " << describe(e)
-                                                         << "; without: " << describe(e0);
+  EXPECT_LT(e.rms(), tol::kOutlierRemovedRel * e0.rms())
+      << "with outliers: " << describe(e) << "; without: " << describe(e0);
 }
 INSTANTIATE_TEST_SUITE_P(GsaMissing, NoisyOutliers, ::testing::Values("dome", "cylinder"));
 

@@ -101,9 +101,8 @@ class GsaCli : public ::testing::Test {
   // `gsa synth CASE --out DIR/NAME.csv --exact DIR/NAME_exact.csv EXTRA`; returns the grid path.
   std::string synth(const std::string& name, const std::string& extra = "") {
     const std::string grid = dir_.file(name + ".csv");
-    const CommandResult r =
-        run_gsa(dir_, "synth " + name + " --out " + quoted(grid) + " --exact " + quoted(dir_.file(name + "_exact.csv")) +
-                          " " + extra);
+    const CommandResult r = run_gsa(dir_, "synth " + name + " --out " + quoted(grid) + " --exact " +
+                                              quoted(dir_.file(name + "_exact.csv")) + " " + extra);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return grid;
   }
@@ -203,10 +202,12 @@ TEST_F(GsaCli, SummaryJsonHasUnitsCountsResidualsAndTimings) {
   }
   EXPECT_EQ(j.at("parameters").at("method"), "surface");
   EXPECT_TRUE(j.at("parameters").at("mesh").at("elements").is_number());
-  for (const char* w : {"alpha", "beta", "gamma"}) EXPECT_TRUE(j.at("parameters").at("deformed").at(w).is_number()) << w;
+  for (const char* w : {"alpha", "beta", "gamma"})
+    EXPECT_TRUE(j.at("parameters").at("deformed").at(w).is_number()) << w;
   ASSERT_TRUE(j.at("inputs").is_array());
   EXPECT_EQ(j.at("inputs").at(0), grid);
-  EXPECT_LE(j.at("strain_ranges").at("E2").at("max").get<double>(), j.at("strain_ranges").at("E1").at("max").get<double>());
+  EXPECT_LE(j.at("strain_ranges").at("E2").at("max").get<double>(),
+            j.at("strain_ranges").at("E1").at("max").get<double>());
 }
 
 // Flagged marks: why, in strains.csv and summary.json, with the full command line and
@@ -312,8 +313,8 @@ TEST_F(GsaCli, FilePairAndDisplacementColumnsGiveTheSameStrains) {
   write_text(dir_.file("d.csv"), d.str());
   write_text(dir_.file("disp.csv"), disp.str());
   const Strains one = read_strains(analyse_ok(quoted(grid), "one"));
-  const Strains pair = read_strains(analyse_ok(
-      "--undeformed " + quoted(dir_.file("u.csv")) + " --deformed " + quoted(dir_.file("d.csv")), "pair"));
+  const Strains pair = read_strains(
+      analyse_ok("--undeformed " + quoted(dir_.file("u.csv")) + " --deformed " + quoted(dir_.file("d.csv")), "pair"));
   const Strains dsp = read_strains(
       analyse_ok(quoted(dir_.file("disp.csv")) + " --columns id=name,X=X0,Y=Y0,Z=Z0,u=ux,v=uy,w=uz", "disp"));
   ASSERT_EQ(pair.t.n_rows(), one.t.n_rows());
@@ -351,7 +352,8 @@ TEST_F(GsaCli, FibreModeAddsFibreColumnsAndShearAngle) {
   double worst = 0;
   for (std::size_t r = 0; r < exact.n_rows(); ++r) {
     const std::string id(exact.cell(r, 0));
-    worst = std::max(worst, std::abs(s.num(id, "shear_angle_deg") - exact.number(r, exact.column_index("shear_angle_deg"))));
+    worst = std::max(worst,
+                     std::abs(s.num(id, "shear_angle_deg") - exact.number(r, exact.column_index("shear_angle_deg"))));
   }
   EXPECT_LT(worst, kTrellisShearDegAllMarks) << "max shear angle error (degrees), all marks";
   const io::PolyMesh m = io::read_vtp(out + "/deformed.vtp");
@@ -408,8 +410,8 @@ TEST_F(GsaCli, MeasurementExportsGiveTheExactStrains) {
 // how the columns were read.
 TEST_F(GsaCli, FormatFoundFromTheHeaderIsStated) {
   const std::string d = std::string(SF_SOURCE_DIR) + "/data/formats/";
-  const CommandResult r = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --no-plots --out " +
-                                            quoted(dir_.file("out")));
+  const CommandResult r =
+      run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --no-plots --out " + quoted(dir_.file("out")));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.err, AllOf(HasSubstr("format found from the header: vic3d (Correlated Solutions VIC-3D"),
                            HasSubstr("X, Y, Z = reference positions; U, V, W = displacements; key x, y"),
@@ -428,7 +430,8 @@ TEST_F(GsaCli, ReadingErrorsNameTheFileOrTheOption) {
   // it first and the 2024 names after it.
   EXPECT_THAT(column.err, AllOf(HasSubstr("gom_stage.csv:6: missing required column 'u'"),
                                 HasSubstr("--format matchid reads x, y, z, u, v, w (or coor.X, coor.Y")));
-  const CommandResult pixels = run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic3d --units px" + out);
+  const CommandResult pixels =
+      run_gsa(dir_, "analyse " + quoted(d + "vic3d_frame.csv") + " --format vic3d --units px" + out);
   EXPECT_EQ(pixels.exit_code, 1);
   EXPECT_THAT(pixels.err, HasSubstr("vic3d_frame.csv:1:1: column 'X' holds lengths"));
   // A unit gsa does not convert, named by file, header line and field.
@@ -497,12 +500,12 @@ TEST_F(GsaCli, WrongUsageExitsTwo) {
   const std::string out = " --out " + quoted(dir_.file("out"));
   for (const std::string& args : std::vector<std::string>{
            "analyse " + quoted(grid) + out + " --bogus", "analyse " + quoted(grid),  // --out missing
-        "", "frobnicate", "analyse" + out,                                      // no grid
-        "analyse " + quoted(grid) + out + " --method magic", "analyse " + quoted(grid) + out + " --elements 8",
-        "analyse " + quoted(grid) + out + " --fibres 0", "analyse " + quoted(grid) + out + " --penalty none",
+           "", "frobnicate", "analyse" + out,                                        // no grid
+           "analyse " + quoted(grid) + out + " --method magic", "analyse " + quoted(grid) + out + " --elements 8",
+           "analyse " + quoted(grid) + out + " --fibres 0", "analyse " + quoted(grid) + out + " --penalty none",
            "analyse " + quoted(grid) + out + " --smoothing-scale 0", "analyse " + quoted(grid) + out + " --sample 51",
-        "analyse " + quoted(grid) + " --undeformed " + quoted(grid) + " --deformed " + quoted(grid) + out,
-        "synth nosuchcase --out " + quoted(dir_.file("x.csv"))}) {
+           "analyse " + quoted(grid) + " --undeformed " + quoted(grid) + " --deformed " + quoted(grid) + out,
+           "synth nosuchcase --out " + quoted(dir_.file("x.csv"))}) {
     const CommandResult r = run_gsa(dir_, args);
     EXPECT_EQ(r.exit_code, 2) << "gsa " << args << "\n" << r.err;
     EXPECT_FALSE(r.err.empty()) << "gsa " << args;
@@ -570,8 +573,8 @@ TEST_F(GsaCli, FormingLimitMarginIsWrittenWithoutPictures) {
 TEST_F(GsaCli, BadOptionValuesExitTwo) {
   const std::string grid = synth("rigid");
   const std::string out = " --out " + quoted(dir_.file("out"));
-  for (const std::string& opt : std::vector<std::string>{"--delimiter xx", "--columns foo", "--columns Q=x0", "--alpha -2", "--beta -1",
-                                "--gamma -0.5"}) {
+  for (const std::string& opt : std::vector<std::string>{"--delimiter xx", "--columns foo", "--columns Q=x0",
+                                                         "--alpha -2", "--beta -1", "--gamma -0.5"}) {
     const CommandResult r = run_gsa(dir_, "analyse " + quoted(grid) + out + " " + opt);
     EXPECT_EQ(r.exit_code, 2) << opt << "\n" << r.err;
   }

@@ -15,10 +15,10 @@
 namespace sf::gsa::digitise {
 namespace {
 
-using ::testing::HasSubstr;
 using test::tol::kBaselineRel;
 using test::tol::kCalibrationRmsPx;
 using test::tol::kFocalRel;
+using ::testing::HasSubstr;
 
 CalibrateOptions board_options(const synth::ExampleOptions& o) {
   const synth::BoardSpec b = synth::example_board(o);

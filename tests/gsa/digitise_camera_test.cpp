@@ -140,7 +140,8 @@ TEST(DigitiseCamera, RigFilesRoundTripAndNameBadKeys) {
     EXPECT_THAT(bad(R"({"cameras": [{"image_size": [10, 10], "fx": 1, "fy": 1, "cx": 0, "cy": 0,
                        "distortion": {"k9": 1}}]})"),
                 HasSubstr("distortion.k9"));
-    EXPECT_THAT(io::test::message_of<InputError>([&] { read_rig(dir.file("missing.json")); }), HasSubstr("missing.json"));
+    EXPECT_THAT(io::test::message_of<InputError>([&] { read_rig(dir.file("missing.json")); }),
+                HasSubstr("missing.json"));
   }
 }
 

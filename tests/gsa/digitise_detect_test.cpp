@@ -14,10 +14,10 @@
 namespace sf::gsa::digitise {
 namespace {
 
-using ::testing::HasSubstr;
 using test::tol::kDotCentreRmsPx;
 using test::tol::kJunctionRmsPx;
 using test::tol::kMarkMaxPx;
+using ::testing::HasSubstr;
 
 struct Check {
   Index n = 0, wrong = 0;
@@ -168,9 +168,8 @@ TEST(DigitiseDetect, LightMarksAndSeedsWithoutAReference) {
     EXPECT_EQ(wrong, 0);
     DetectOptions far = d;
     far.seed = Vec2(3, 3);  // a corner of the image, no mark near
-    EXPECT_THAT(io::test::message_of<InputError>([&] {
-                  find_marks(synth::render(rig.cameras[0], sc, o.effects), "view.png", far);
-                }),
+    EXPECT_THAT(io::test::message_of<InputError>(
+                    [&] { find_marks(synth::render(rig.cameras[0], sc, o.effects), "view.png", far); }),
                 HasSubstr("--seed"));
   }
 }

@@ -91,7 +91,7 @@ TEST(DigitiseLattice, AmbiguousAndStrayPointsAreNotLabelled) {
   }
   {  // stray points stay unlabelled
     Lattice l = make(0.0, 3);
-    l.points.push_back(Vec2(5000, 5000));  // far away
+    l.points.push_back(Vec2(5000, 5000));           // far away
     l.points.push_back(warp(2, 3) + Vec2(14, 15));  // in the middle of a cell
     const LatticeResult r = grow_lattice(l.points, index_of(l, Label(0, 0)));
     EXPECT_FALSE(r.labels[l.points.size() - 1].has_value());

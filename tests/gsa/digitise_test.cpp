@@ -17,10 +17,10 @@
 namespace sf::gsa::digitise {
 namespace {
 
-using ::testing::AllOf;
-using ::testing::HasSubstr;
 using test::tol::kMarkMax3dMm;
 using test::tol::kMarkRms3dMm;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
 
 TEST(Digitise, BlankAndDomeFromTwoViewsToAGridFile) {
   const auto o = test::small_example();
@@ -150,18 +150,23 @@ TEST(Digitise, CalibrationsAndImageSetsThatDoNotBelongAreRefused) {
   write_png(dir.file("a.png"), GreyImage(1024, 768, 0.5f));
   write_png(dir.file("small.png"), GreyImage(800, 600, 0.5f));
   io::test::write_text(dir.file("text.png"), "not an image");
-  EXPECT_THAT(io::test::message_of<InputError>([&] { read_image_set(rig, {dir.file("a.png")}, "--deformed", "r.json"); }),
-              HasSubstr("1 image given, but the rig r.json has 2 cameras"));
-  EXPECT_THAT(io::test::message_of<InputError>(
-                  [&] { read_image_set(rig, {dir.file("a.png"), dir.file("small.png")}, "--deformed", "r.json"); }),
+  EXPECT_THAT(
+      io::test::message_of<InputError>([&] { read_image_set(rig, {dir.file("a.png")}, "--deformed", "r.json"); }),
+      HasSubstr("1 image given, but the rig r.json has 2 cameras"));
+  EXPECT_THAT(io::test::message_of<InputError>([&] {
+                read_image_set(rig, {dir.file("a.png"), dir.file("small.png")}, "--deformed", "r.json");
+              }),
               AllOf(HasSubstr("small.png"), HasSubstr("800 x 600"), HasSubstr("1024 x 768")));
-  EXPECT_THAT(io::test::message_of<InputError>(
-                  [&] { read_image_set(rig, {dir.file("a.png"), dir.file("none.png")}, "--deformed", "r.json"); }),
+  EXPECT_THAT(io::test::message_of<InputError>([&] {
+                read_image_set(rig, {dir.file("a.png"), dir.file("none.png")}, "--deformed", "r.json");
+              }),
               AllOf(HasSubstr("none.png"), HasSubstr("no such file")));
-  EXPECT_THAT(io::test::message_of<InputError>(
-                  [&] { read_image_set(rig, {dir.file("a.png"), dir.file("text.png")}, "--deformed", "r.json"); }),
+  EXPECT_THAT(io::test::message_of<InputError>([&] {
+                read_image_set(rig, {dir.file("a.png"), dir.file("text.png")}, "--deformed", "r.json");
+              }),
               HasSubstr("text.png"));
-  const std::vector<NamedImage> blank = {{"b0.png", GreyImage(1024, 768, 0.5f)}, {"b1.png", GreyImage(1024, 768, 0.5f)}};
+  const std::vector<NamedImage> blank = {{"b0.png", GreyImage(1024, 768, 0.5f)},
+                                         {"b1.png", GreyImage(1024, 768, 0.5f)}};
   EXPECT_THAT(io::test::message_of<InputError>([&] { digitise_set(rig, blank, DigitiseOptions{}); }),
               HasSubstr("b0.png"));
 }

@@ -61,7 +61,7 @@ TEST(DigitiseTriangulate, RecoversPointsAndDropsABadView) {
     const TriangulatedPoint p = triangulate(rig, obs);
     ASSERT_TRUE(p.ok);
     EXPECT_LT((p.X - X).norm(), 0.05);  // 0.05 px noise at 0.18 mm/px
-    obs[1].pixel += Vec2(6, -4);       // a mislocated mark in camera 1
+    obs[1].pixel += Vec2(6, -4);        // a mislocated mark in camera 1
     const TriangulatedPoint q = triangulate(rig, obs);
     ASSERT_TRUE(q.ok) << q.why;
     EXPECT_EQ(q.used.size(), 2u);

@@ -127,7 +127,8 @@ TEST(GsaFit, EachPenaltyOrderLeavesItsNullSpaceAlone) {
   beta.beta = kHuge;
   gamma.gamma = kHuge;
   delta.delta = kHuge;
-  for (const Case& c : {Case{"alpha", alpha, 0}, Case{"beta", beta, 1}, Case{"gamma", gamma, 2}, Case{"delta", delta, 3}}) {
+  for (const Case& c :
+       {Case{"alpha", alpha, 0}, Case{"beta", beta, 1}, Case{"gamma", gamma, 2}, Case{"delta", delta, 3}}) {
     SCOPED_TRACE(c.name);
     const Field f = random_bicubic(test::kSeed + 1, c.degree);
     const FitResult r = fit(p, p.values(f), c.penalty, p.zero_reference());

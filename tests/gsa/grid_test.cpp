@@ -48,8 +48,10 @@ std::string seven_rows() {
 }
 
 TEST(GsaGrid, BadColumnMapTextIsRejectedNamingTheOption) {
-  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X=x0,Y"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Y'")));
-  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("Q=x0"); }), AllOf(HasSubstr("--columns"), HasSubstr("'Q'")));
+  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X=x0,Y"); }),
+              AllOf(HasSubstr("--columns"), HasSubstr("'Y'")));
+  EXPECT_THAT(message_of<UsageError>([] { parse_column_map("Q=x0"); }),
+              AllOf(HasSubstr("--columns"), HasSubstr("'Q'")));
   EXPECT_THAT(message_of<UsageError>([] { parse_column_map("X="); }), HasSubstr("--columns"));
   const auto map = parse_column_map("id=label,X=x0,u=du");
   EXPECT_EQ(map.size(), 3u);
@@ -131,14 +133,30 @@ TEST(GsaGrid, ReadingFlagsAndTheirErrors) {
                 f.positions = "later";
               }),
               HasSubstr("--positions: expected 'reference' or 'current'"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "comma"; f.delimiter = ","; }), HasSubstr("--decimal comma"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.decimal = "comma";
+                f.delimiter = ",";
+              }),
+              HasSubstr("--decimal comma"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.decimal = "dot"; }), HasSubstr("--decimal: expected 'auto'"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.pitch = 0; }), HasSubstr("--pitch: must be > 0"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.pixel_size = -1; }), HasSubstr("--pixel-size"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.skip_lines = 2; f.header_line = 4; }), HasSubstr("--skip-lines or --header-line"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.id = "a"; f.columns = "id=b"; }), HasSubstr("--id"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.skip_lines = 2;
+                f.header_line = 4;
+              }),
+              HasSubstr("--skip-lines or --header-line"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.id = "a";
+                f.columns = "id=b";
+              }),
+              HasSubstr("--id"));
   EXPECT_THAT(error([](AnalyseFlags& f) { f.columns = "X=a,x=b,u=c"; }), HasSubstr("--columns: reference positions"));
-  EXPECT_THAT(error([](AnalyseFlags& f) { f.pitch = 5; f.columns = "X=a"; }), HasSubstr("--pitch"));
+  EXPECT_THAT(error([](AnalyseFlags& f) {
+                f.pitch = 5;
+                f.columns = "X=a";
+              }),
+              HasSubstr("--pitch"));
 }
 
 // ---------------------------------------------------------------- grids analyse refuses

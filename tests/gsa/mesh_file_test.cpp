@@ -64,9 +64,8 @@ TEST(GsaMeshFile, UserQuadMeshAnalysesTheDomeAccurately) {
 
 TEST(GsaMeshFile, ReadsCollapsedElements) {
   // A square split into a centre-fan of 4 collapsed elements around node 0.
-  const std::string path = write_temp(
-      "fan.json",
-      R"({"nodes": [[0,0,0], [10,0,0], [0,10,0], [-10,0,0], [0,-10,0]],
+  const std::string path = write_temp("fan.json",
+                                      R"({"nodes": [[0,0,0], [10,0,0], [0,10,0], [-10,0,0], [0,-10,0]],
           "elements": [[0,0,1,2], [0,0,2,3], [0,0,3,4], [0,0,4,1]]})");
   const mesh::SurfaceMesh m = read_mesh_file(path);
   EXPECT_EQ(m.n_elements(), 4);
@@ -81,12 +80,12 @@ TEST(GsaMeshFile, BadFilesAreNamed) {
   const std::string b =
       write_temp("b.json", R"({"nodes": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]], "elements": [[0,1,2,9]]})");
   EXPECT_THAT(message_of([&] { read_mesh_file(b); }), HasSubstr("node 9"));
-  const std::string c = write_temp("c.json", R"({"nodes": [[0,0,0],[1,0,"x"],[0,1,0],[1,1,0]], "elements": [[0,1,2,3]]})");
+  const std::string c =
+      write_temp("c.json", R"({"nodes": [[0,0,0],[1,0,"x"],[0,1,0],[1,1,0]], "elements": [[0,1,2,3]]})");
   EXPECT_THAT(message_of([&] { read_mesh_file(c); }), HasSubstr("nodes[1][2]"));
   // Two elements with opposite xi1 directions.
   const std::string d = write_temp(
-      "d.json",
-      R"({"nodes": [[0,0,0],[1,0,0],[2,0,0],[0,1,0],[1,1,0],[2,1,0]], "elements": [[0,1,3,4],[2,1,5,4]]})");
+      "d.json", R"({"nodes": [[0,0,0],[1,0,0],[2,0,0],[0,1,0],[1,1,0],[2,1,0]], "elements": [[0,1,3,4],[2,1,5,4]]})");
   EXPECT_THAT(message_of([&] { read_mesh_file(d); }), HasSubstr("disagreeing xi directions"));
   const std::string f = write_temp("f.json", "{ not json");
   EXPECT_THAT(message_of([&] { read_mesh_file(f); }), HasSubstr("not valid JSON"));

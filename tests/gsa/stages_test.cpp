@@ -52,17 +52,17 @@ TEST(GsaStages, ProgressHearsEachStageInOrderWithTheMesh) {
     }
   };
   const AnalysisResult r = analyse(grid, {}, progress);
-  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers,
-                                 AnalysisStage::kUndeformedFit, AnalysisStage::kDeformedFit,
-                                 AnalysisStage::kSmoothingChoice, AnalysisStage::kStrains));
+  EXPECT_THAT(heard,
+              ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers, AnalysisStage::kUndeformedFit,
+                          AnalysisStage::kDeformedFit, AnalysisStage::kSmoothingChoice, AnalysisStage::kStrains));
   EXPECT_EQ(layout, r.mesh_layout);
   // Explicit weights: no smoothing is chosen.
   heard.clear();
   AnalyseOptions o;
   o.smoothing.gamma = 1.0;
   analyse(grid, o, progress);
-  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers,
-                                 AnalysisStage::kUndeformedFit, AnalysisStage::kDeformedFit, AnalysisStage::kStrains));
+  EXPECT_THAT(heard, ElementsAre(AnalysisStage::kFrameAndMesh, AnalysisStage::kOutliers, AnalysisStage::kUndeformedFit,
+                                 AnalysisStage::kDeformedFit, AnalysisStage::kStrains));
 }
 
 // Stage series: the undeformed fit of the marks once, then two deformed states of the
@@ -111,7 +111,8 @@ TEST(GsaStages, OutlierFlagsCarryReasonDeviationThresholdAndNoise) {
   const FitMarks marks = fit_marks(grid);
   const FrameAndMesh setup = build_frame_and_mesh(grid, marks, o.mesh);
   Points3 deformed(marks.size(), 3);
-  for (Index k = 0; k < marks.size(); ++k) deformed.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  for (Index k = 0; k < marks.size(); ++k)
+    deformed.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
   MarkOutliers found = find_outliers(marks, deformed, setup.mark_spacing, o.outliers);
   EXPECT_TRUE(found.undeformed.empty());
   ASSERT_EQ(found.deformed.size(), 2u);
@@ -176,7 +177,10 @@ TEST(GsaStages, OptionErrorsNameTheFieldAndOnTheCommandLineTheFlag) {
       {"smoothing.scale", "--smoothing-scale", [](AnalyseOptions& o) { o.smoothing.scale = 0; }},
       {"outliers.sigma", "--outlier-sigma", [](AnalyseOptions& o) { o.outliers.sigma = -3; }},
       {"fibre_angles", "--fibres", [](AnalyseOptions& o) { o.fibre_angles = {0}; }},
-      {"fibre_angles", "--fibres", [](AnalyseOptions& o) { o.fibre_angles = {0, 90, 45}; }},
+      {"fibre_angles", "--fibres",
+       [](AnalyseOptions& o) {
+         o.fibre_angles = {0, 90, 45};
+       }},
   };
   const GridData grid = grid_of("stretch", 5);
   for (const Bad& b : bad) {

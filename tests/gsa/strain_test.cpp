@@ -34,7 +34,8 @@ struct Homogeneous {
   Vec3 d1() const { return Vec3(std::cos(t), std::sin(t), 0); }
   Vec3 d2() const { return Vec3(-std::sin(t), std::cos(t), 0); }
   Mat3 f() const {
-    return r * (l1 * d1() * d1().transpose() + l2 * d2() * d2().transpose() + Vec3::UnitZ() * Vec3::UnitZ().transpose());
+    return r *
+           (l1 * d1() * d1().transpose() + l2 * d2() * d2().transpose() + Vec3::UnitZ() * Vec3::UnitZ().transpose());
   }
 };
 
@@ -107,7 +108,7 @@ TEST(GsaStrain, MajorFirstAndCompressionNegative) {
 
 TEST(GsaStrain, DegenerateTangentsGiveNoStrain) {
   const Mat32 G = tangents(Vec3::UnitX(), Vec3::UnitY());
-  EXPECT_FALSE(surface_strain(tangents(Vec3::UnitX(), Vec3::UnitX()), G));  // undeformed collapsed
+  EXPECT_FALSE(surface_strain(tangents(Vec3::UnitX(), Vec3::UnitX()), G));      // undeformed collapsed
   EXPECT_FALSE(surface_strain(G, tangents(Vec3::UnitX(), 2 * Vec3::UnitX())));  // deformed collapsed
   EXPECT_FALSE(surface_strain(G, tangents(Vec3::Zero(), Vec3::UnitY())));
   Mat32 nan = G;

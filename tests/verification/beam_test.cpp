@@ -139,9 +139,10 @@ double solve_elastica(const Model& model, const std::vector<PrescribedDof>& bcs,
   const Vec3 m = mean_position(model, res.positions, tip);
   const double v = m.z() / kL, u = (kL - m.x()) / kL;
   const double ev = (v - row.v) / row.v, eu = (u - row.u) / row.u;
-  std::printf("elastica %s, alpha = %4.1f: v/L = %.5f (table %.5f, rel. error %+.2e), u/L = %.5f (table %.5f, rel. "
-              "error %+.2e); %s; %.2f s\n",
-              label, row.alpha, v, row.v, ev, u, row.u, eu, res.report.brief().c_str(), seconds_since(t0));
+  std::printf(
+      "elastica %s, alpha = %4.1f: v/L = %.5f (table %.5f, rel. error %+.2e), u/L = %.5f (table %.5f, rel. "
+      "error %+.2e); %s; %.2f s\n",
+      label, row.alpha, v, row.v, ev, u, row.u, eu, res.report.brief().c_str(), seconds_since(t0));
   EXPECT_LT(std::abs(ev), tol_v) << label << " alpha " << row.alpha;
   EXPECT_LT(std::abs(eu), tol_u) << label << " alpha " << row.alpha;
   return ev;
@@ -261,11 +262,12 @@ TEST(VerificationRollUp, EndRotationBendsStripIntoCircularArc) {
         for (int i = 0; i < 3; ++i) force(i) += res.reactions(model.dof(0, ply.node(s, layer), mesh::kValue, i));
     const double couple_force = kEI * theta / kL / kH;  // M / h
     const double e_force = force.norm() / couple_force;
-    std::printf("roll-up (tip section on the circle) theta = %g pi: max mid-surface deviation from the circle / L = "
-                "%.2e; energy %.6g vs EI theta^2/2L = %.6g N mm (rel. error %+.2e); |tip resultant| / (M/h) = %.2e; "
-                "%s; %.2f s so far\n",
-                theta / kPi, c.e_arc, c.energy, c.exact, (c.energy - c.exact) / c.exact, e_force,
-                res.report.brief().c_str(), seconds_since(t0));
+    std::printf(
+        "roll-up (tip section on the circle) theta = %g pi: max mid-surface deviation from the circle / L = "
+        "%.2e; energy %.6g vs EI theta^2/2L = %.6g N mm (rel. error %+.2e); |tip resultant| / (M/h) = %.2e; "
+        "%s; %.2f s so far\n",
+        theta / kPi, c.e_arc, c.energy, c.exact, (c.energy - c.exact) / c.exact, e_force, res.report.brief().c_str(),
+        seconds_since(t0));
     EXPECT_LT(c.e_arc, kTolArc) << "theta " << theta;
     EXPECT_LT(c.e_energy, kTolEnergy) << "theta " << theta;
     EXPECT_LT(e_force, kTolForce) << "theta " << theta;
@@ -295,10 +297,10 @@ TEST(VerificationRollUp, TangentOnlyEndRotationIsNotAPureMoment) {
     x = res.positions;
   }
   const RollUpCheck c = check_roll_up(model, x, 0.5 * kPi);
-  std::printf("roll-up (tangent-only tip condition) theta = pi/2: tip (%.4f, %.4f) vs (%.4f, %.4f) mm, |error|/L = "
-              "%.2e; max deviation from the circle / L = %.2e; energy rel. error %+.2e\n",
-              c.tip.x(), c.tip.z(), kL / (0.5 * kPi), kL / (0.5 * kPi), c.e_tip, c.e_arc,
-              (c.energy - c.exact) / c.exact);
+  std::printf(
+      "roll-up (tangent-only tip condition) theta = pi/2: tip (%.4f, %.4f) vs (%.4f, %.4f) mm, |error|/L = "
+      "%.2e; max deviation from the circle / L = %.2e; energy rel. error %+.2e\n",
+      c.tip.x(), c.tip.z(), kL / (0.5 * kPi), kL / (0.5 * kPi), c.e_tip, c.e_arc, (c.energy - c.exact) / c.exact);
   // The bent shape is a sanity bound only: the tip moved up and inwards by the right order.
   EXPECT_LT(c.e_tip, 0.1);
 }

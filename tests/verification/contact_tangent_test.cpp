@@ -66,8 +66,7 @@ struct Errors {
 
 // FD of the force in x (stiffness), in v (damping, when ctx has velocities) and of the
 // energy (force, when `potential`).
-Errors finite_differences(const Interaction& c, Index n, const VecX& x, const InteractionContext& ctx,
-                          bool potential) {
+Errors finite_differences(const Interaction& c, Index n, const VecX& x, const InteractionContext& ctx, bool potential) {
   const Share s = evaluate(c, n, x, ctx, true);
   MatX k_fd = MatX::Zero(n, n), d_fd;
   VecX f_fd = VecX::Zero(n);
@@ -115,10 +114,10 @@ TwoPlies two_plies(unsigned seed) {
   TwoPlies t;
   const auto law = fixtures::neo_hookean(1.0, 1.0);
   t.model.add_ply(fixtures::rectangle_ply(10.0, 8.0, 1.0, 2, 2), law);
-  t.model.add_ply(PlyMesh(mesh::make_rectangle_mesh(Vec3(-0.5, -0.5, 0.95), Vec3::UnitX(), Vec3::UnitY(), 11.0,
-                                                    9.0, 3, 3),
-                          1.0, 30.0),
-                  law);
+  t.model.add_ply(
+      PlyMesh(mesh::make_rectangle_mesh(Vec3(-0.5, -0.5, 0.95), Vec3::UnitX(), Vec3::UnitY(), 11.0, 9.0, 3, 3), 1.0,
+              30.0),
+      law);
   t.x = t.model.reference_positions();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -270,8 +269,8 @@ TEST(ContactTangent, PlyToolNormalAndFriction) {
       EXPECT_LT(en.energy, kFdRel);
     }
     std::printf("ply-tool %s normal: FD stiffness %.1e, FD force %.1e\n", tool.name.c_str(), en.stiffness, en.energy);
-    for (const ContactOptions& o : {options(0.02, 0, 0), options(0, 0.3, 1e-3), options(0, 0.3, 100.0),
-                                    options(0.02, 0.3, 0.2)}) {
+    for (const ContactOptions& o :
+         {options(0.02, 0, 0), options(0, 0.3, 1e-3), options(0, 0.3, 100.0), options(0.02, 0.3, 0.2)}) {
       const auto c = std::make_shared<ToolContact>("f", t.model, ContactSurface::whole_face(t.model, 0, true), tool, o);
       const Errors eq = finite_differences(*c, t.model.n_dofs(), t.x, qs, false);
       const Errors ed = finite_differences(*c, t.model.n_dofs(), t.x, dyn, false);

@@ -130,7 +130,8 @@ contact:
           law + R"(}
 boundary_conditions:
   - clamp: {ply: b, edge: x0}
-)" + loads + R"(
+)" + loads +
+          R"(
 solver: {steps: 3, process_time: 0.3, tolerance: 1.0e-10}
 )",
       r);
@@ -141,8 +142,7 @@ solver: {steps: 3, process_time: 0.3, tolerance: 1.0e-10}
 
 TEST(SlidingBlock, ViscousForceIsCfVA) {
   CaseRun r;
-  const double F =
-      sliding_block_force("viscous: 0.02", "loads:\n  - pressure: {ply: b, face: top, value: 0.2}", r).x();
+  const double F = sliding_block_force("viscous: 0.02", "loads:\n  - pressure: {ply: b, face: top, value: 0.2}", r).x();
   const double expected = 0.02 * 2.0 * 100.0;  // c_f v A, N
   // The tool moves +x, the block's drag on it points -x.
   EXPECT_NEAR(-F, expected, 1e-4 * expected);
@@ -159,8 +159,8 @@ TEST(SlidingBlock, CoulombForceIsMuN) {
   const double N = -F.z();
   EXPECT_GT(N, 0.5 * 0.2 * 100.0);
   EXPECT_NEAR(-F.x(), 0.3 * N, 1e-5 * 0.3 * N);
-  std::printf("sliding block, Coulomb: F = %.8g N, mu N = %.8g N (N = %.6g N), relative error %.2e\n", -F.x(),
-              0.3 * N, N, std::abs(-F.x() - 0.3 * N) / (0.3 * N));
+  std::printf("sliding block, Coulomb: F = %.8g N, mu N = %.8g N (N = %.6g N), relative error %.2e\n", -F.x(), 0.3 * N,
+              N, std::abs(-F.x() - 0.3 * N) / (0.3 * N));
 }
 
 TEST(AugmentedLagrangian, DrivesThePenetrationUnderItsTolerance) {

@@ -63,7 +63,7 @@ namespace {
 
 constexpr double kMu = 0.4225;  // MPa (422.5 kPa)
 constexpr double kNu = 0.3;
-constexpr double kReference = 14.33;  // mm, deal.II Q2 at 32-64 elements per edge
+constexpr double kReference = 14.33;      // mm, deal.II Q2 at 32-64 elements per edge
 constexpr double kTraction = 1.0 / 16.0;  // MPa (1 N over 16 mm x 1 mm)
 
 constexpr int kVoigt[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
@@ -95,8 +95,8 @@ class DealiiNeoHookean final : public Material {
           const double cc = Ci(i, j) * Ci(k, l);
           const double codot = 0.5 * (Ci(i, k) * Ci(j, l) + Ci(i, l) * Ci(j, k));
           const double mixed = I(i, j) * Ci(k, l) + Ci(i, j) * I(k, l);
-          r.tangent(p, q) = kappa_ * J2 * cc - kappa_ * (J2 - 1.0) * codot +
-                            (2.0 * a / 3.0) * (-mixed + I1 / 3.0 * cc + I1 * codot);
+          r.tangent(p, q) =
+              kappa_ * J2 * cc - kappa_ * (J2 - 1.0) * codot + (2.0 * a / 3.0) * (-mixed + I1 / 3.0 * cc + I1 * codot);
         }
     }
     return r;
@@ -253,10 +253,11 @@ TEST(VerificationCook, FiniteStrainTipDisplacementConvergesToReference) {
   for (int n : {2, 4, 8, 16}) {
     const CookResult r = solve_cook(n, dealii, Clamp::kValueAndTangent, Faces::kFreeFaces);
     ASSERT_TRUE(r.ok) << n << ": " << r.brief;
-    std::printf("cook %2d x %-2d (%5ld dofs), faces free, value + d/ds2 clamp: u_y(C) = %.4f mm, rel. error vs %.2f = "
-                "%+.2e; %s; %.2f s\n",
-                n, n, static_cast<long>(r.n_dofs), r.uy, kReference, (r.uy - kReference) / kReference, r.brief.c_str(),
-                r.seconds);
+    std::printf(
+        "cook %2d x %-2d (%5ld dofs), faces free, value + d/ds2 clamp: u_y(C) = %.4f mm, rel. error vs %.2f = "
+        "%+.2e; %s; %.2f s\n",
+        n, n, static_cast<long>(r.n_dofs), r.uy, kReference, (r.uy - kReference) / kReference, r.brief.c_str(),
+        r.seconds);
     finest = r.uy;
   }
   EXPECT_LT(std::abs(finest - kReference) / kReference, kTol);
@@ -274,9 +275,10 @@ TEST(VerificationCook, FiniteStrainTipDisplacementConvergesToReference) {
   for (int n : {8, 16}) {
     const CookResult r = solve_cook(n, dealii, Clamp::kValueAndTangent, Faces::kPlaneStrain);
     ASSERT_TRUE(r.ok) << n << ": " << r.brief;
-    std::printf("cook %2d x %-2d, plane strain (u_z = 0), value + d/ds2 clamp: u_y(C) = %.4f mm (%+.2e vs 14.33); "
-                "%.2f s\n",
-                n, n, r.uy, (r.uy - kReference) / kReference, r.seconds);
+    std::printf(
+        "cook %2d x %-2d, plane strain (u_z = 0), value + d/ds2 clamp: u_y(C) = %.4f mm (%+.2e vs 14.33); "
+        "%.2f s\n",
+        n, n, r.uy, (r.uy - kReference) / kReference, r.seconds);
     (n == 8 ? ps8 : ps16) = r.uy;
   }
   // Plane strain: converged to 0.1 % between 8 and 16 elements per edge (measured 4e-4).
@@ -284,9 +286,10 @@ TEST(VerificationCook, FiniteStrainTipDisplacementConvergesToReference) {
   {
     const CookResult r = solve_cook(8, library, Clamp::kAllParameters, Faces::kFreeFaces);
     ASSERT_TRUE(r.ok) << r.brief;
-    std::printf("cook 8 x 8, faces free, library NeoHookean (ln J form, same mu, nu): u_y(C) = %.4f mm (%+.2e vs "
-                "14.33); %.2f s\n",
-                r.uy, (r.uy - kReference) / kReference, r.seconds);
+    std::printf(
+        "cook 8 x 8, faces free, library NeoHookean (ln J form, same mu, nu): u_y(C) = %.4f mm (%+.2e vs "
+        "14.33); %.2f s\n",
+        r.uy, (r.uy - kReference) / kReference, r.seconds);
   }
 }
 

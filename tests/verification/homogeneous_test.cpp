@@ -109,9 +109,10 @@ TEST(VerificationObjectivity, TransverselyIsotropicEnergyAndReactionsAreFrameInd
   const double e_energy_a = std::abs(a.energy - w_exact) / w_exact;
   const double e_energy_rot_a = std::abs(a_rot.energy - a.energy) / a.energy;
   const double e_force_a = max_abs(a_rot.force - rotate(a.force, R)) / max_abs(a.force);
-  std::printf("objectivity (a) homogeneous F0: energy %.12g N mm, |E - W V|/W V = %.2e, |E_R - E|/E = %.2e, "
-              "max|f_R - R f|/max|f| = %.2e\n",
-              a.energy, e_energy_a, e_energy_rot_a, e_force_a);
+  std::printf(
+      "objectivity (a) homogeneous F0: energy %.12g N mm, |E - W V|/W V = %.2e, |E_R - E|/E = %.2e, "
+      "max|f_R - R f|/max|f| = %.2e\n",
+      a.energy, e_energy_a, e_energy_rot_a, e_force_a);
   EXPECT_LT(e_energy_a, kRoundoff);
   EXPECT_LT(e_energy_rot_a, kRoundoff);
   EXPECT_LT(e_force_a, kRoundoff);
@@ -134,9 +135,10 @@ TEST(VerificationObjectivity, TransverselyIsotropicEnergyAndReactionsAreFrameInd
   // The free faces make this state inhomogeneous: how far from F0 it is.
   double dev = 0.0;
   for (const Mat3& F : model.deformation_gradients(0, b.positions)) dev = std::max(dev, (F - F0).cwiseAbs().maxCoeff());
-  std::printf("objectivity (b) lateral boundary F0, faces free (%s; max|F - F0| = %.3f): energy %.12g N mm, "
-              "|E_R - E|/E = %.2e, max|x_R - (R x + t)|/max|x| = %.2e, max|r_R - R r|/max|r| = %.2e\n",
-              b.report.brief().c_str(), dev, eb, e_energy_b, e_pos_b, e_react_b);
+  std::printf(
+      "objectivity (b) lateral boundary F0, faces free (%s; max|F - F0| = %.3f): energy %.12g N mm, "
+      "|E_R - E|/E = %.2e, max|x_R - (R x + t)|/max|x| = %.2e, max|r_R - R r|/max|r| = %.2e\n",
+      b.report.brief().c_str(), dev, eb, e_energy_b, e_pos_b, e_react_b);
   EXPECT_LT(e_energy_b, kRoundoff);
   EXPECT_LT(e_pos_b, kRoundoff);
   // Reactions come from a converged Newton state: the free-dof residual (<= 1e-13 of
@@ -179,9 +181,10 @@ TEST(VerificationSimpleShear, AlongFibresGivesLongitudinalShearModulus) {
     P_exact(0, 1) = P_exact(1, 0) = params.mu_L * gamma;
     const double e_tau = std::abs(tau - G_L * gamma) / (G_L * gamma);
     const double e_P = (P - P_exact).cwiseAbs().maxCoeff() / (G_L * gamma);
-    std::printf("simple shear gamma = %g: tau = %.15g MPa, G_L gamma = %.15g MPa, rel. error %.2e; "
-                "tau/gamma = %.12g (G_L = %g); max|P - P_exact|/(G_L gamma) = %.2e; max|x - x_exact| = %.2e mm (%s)\n",
-                gamma, tau, G_L * gamma, e_tau, tau / gamma, G_L, e_P, e_pos, res.report.brief().c_str());
+    std::printf(
+        "simple shear gamma = %g: tau = %.15g MPa, G_L gamma = %.15g MPa, rel. error %.2e; "
+        "tau/gamma = %.12g (G_L = %g); max|P - P_exact|/(G_L gamma) = %.2e; max|x - x_exact| = %.2e mm (%s)\n",
+        gamma, tau, G_L * gamma, e_tau, tau / gamma, G_L, e_P, e_pos, res.report.brief().c_str());
     EXPECT_LT(e_tau, 1e-10);
     EXPECT_LT(e_P, 1e-10);
     EXPECT_LT(e_pos, 1e-12);

@@ -25,7 +25,8 @@ double tip_deflection(double e_f) {
   const std::string text = R"(
 materials:
   ideal:
-    transversely_isotropic: {E_f: )" + std::to_string(e_f) + R"(, E_T: 1, G_L: 0.5, G_T: 0.4}
+    transversely_isotropic: {E_f: )" +
+                           std::to_string(e_f) + R"(, E_T: 1, G_L: 0.5, G_T: 0.4}
     incompressible: true
     inextensible: true
 plies:
@@ -54,9 +55,10 @@ TEST(IdealFibreStrip, EndLoadDeflectionIsShearPlusFibreBending) {
     const double expected = P * L * L * L / (3.0 * e_f * I) + shear;
     const double got = tip_deflection(e_f);
     EXPECT_NEAR(got, expected, 0.02 * expected) << "E_f " << e_f;
-    std::printf("ideal-fibre strip, E_f/G_L = %.0f: tip %.5f mm, P L^3/(3 E_f I) + P L/(G_L b h) = %.5f mm (%.2f %%); "
-                "shear-beam limit %.5f mm\n",
-                e_f / G_L, got, expected, 100.0 * (got - expected) / expected, shear);
+    std::printf(
+        "ideal-fibre strip, E_f/G_L = %.0f: tip %.5f mm, P L^3/(3 E_f I) + P L/(G_L b h) = %.5f mm (%.2f %%); "
+        "shear-beam limit %.5f mm\n",
+        e_f / G_L, got, expected, 100.0 * (got - expected) / expected, shear);
   }
 }
 

@@ -6,11 +6,12 @@
 //
 // Prints, per run: the rotation error (deg) and translation error (mm) of the recovered
 // motion, the registration RMS distance (mm), the RMS of the major strain difference, and
-// the seconds of the analyses (not part of compare) and of compare itself (registration,
-// mapping of the marks and of the tessellated surface).
+// the seconds (wall clock and CPU of all threads) of the analyses (not part of compare) and of
+// compare itself (registration, mapping of the marks and of the tessellated surface).
 
 #include <Eigen/Geometry>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -50,13 +51,17 @@ void run(const std::string& shape, int n, double noise, bool shared_ids) {
     if (!shared_ids) meas.ids[static_cast<std::size_t>(p)] = "m" + meas.ids[static_cast<std::size_t>(p)];
   }
   const auto t0 = Clock::now();
+  const std::clock_t c0 = std::clock();
   const AnalysisResult rs = analyse(sim, {});
   const AnalysisResult rm = analyse(meas, {});
   const double t_analyse = since(t0);
+  const double cpu_analyse = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   const CompareSide ss = compare_side_from(sim, rs, "simulated"), sm = compare_side_from(meas, rm, "measured");
   const auto t1 = Clock::now();
+  const std::clock_t c1 = std::clock();
   const CompareResult r = compare(sm, ss, {});
   const double t_compare = since(t1);
+  const double cpu_compare = static_cast<double>(std::clock() - c1) / CLOCKS_PER_SEC;
   const fe::RigidTransform expect = t.inverse();
   const double rot_err =
       Eigen::AngleAxisd(r.registration.transform.rotation * expect.rotation.transpose()).angle() * 180.0 / kPi;
@@ -70,9 +75,11 @@ void run(const std::string& shape, int n, double noise, bool shared_ids) {
   const Statistics st = statistics_of(major);
   std::printf(
       "%-5s %6d marks noise %.3f mm  %-19s rotation error %.2e deg  translation error %.2e mm  RMS %.2e mm  "
-      "matched %lld  major diff RMS %.2e  analyses %.2f s  compare %.2f s (registration %.3f, mapping %.3f)\n",
+      "matched %lld  major diff RMS %.2e  analyses %.2f s (CPU %.2f s)  compare %.2f s (CPU %.2f s; registration %.3f, "
+      "mapping %.3f)  iterations %d\n",
       shape.c_str(), n * n, noise, r.registration.method.c_str(), rot_err, trans_err, r.registration.rms,
-      static_cast<long long>(matched), st.rms, t_analyse, t_compare, r.seconds_registration, r.seconds_mapping);
+      static_cast<long long>(matched), st.rms, t_analyse, cpu_analyse, t_compare, cpu_compare, r.seconds_registration,
+      r.seconds_mapping, r.registration.iterations);
   std::fflush(stdout);
 }
 }  // namespace

@@ -34,6 +34,8 @@ sf_gsa_cli_test(compare.self
   COMMAND compare data/gsa/dome/grid.csv data/gsa/dome/grid.csv --out ${sf_cmp}/self
   STDERR "441 of 441 measured marks compared. registration by shared marks \\(ids\\): rotation 0 deg, RMS distance 0 mm"
   EXISTS ${sf_cmp}/self/differences.csv|${sf_cmp}/self/summary.json|${sf_cmp}/self/report.html|${sf_cmp}/self/diff_major.png|${sf_cmp}/self/compare.vtp)
+# Two analyses and nine pictures: more than the default minute on a loaded machine.
+set_tests_properties(gsa.cli.compare.self PROPERTIES TIMEOUT 300)
 
 if(NOT COMMAND sf_forming_cli_test)
   return()

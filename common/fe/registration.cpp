@@ -339,17 +339,16 @@ class Icp {
 
   // Runs `iterations` more steps from s: point-to-point for the first few of a start.
   void run(IcpState& s, int iterations) const {
-    double previous = std::numeric_limits<double>::infinity();
     for (int it = 0; it < iterations && !s.converged; ++it, ++s.iterations) {
       const bool plane = s.iterations >= 5;
       locate(s, !plane || s.iterations % 10 == 0, s.iterations < o_.probe_iterations);
       if (!std::isfinite(s.score)) return;
       const double change = step(s, plane);
-      // Converged: a step at round-off, or (noisy data, where the reweighting keeps
-      // the steps from vanishing) a small step that no longer changes the robust RMS.
-      const bool settled = change <= 1e-6 && std::abs(s.score - previous) <= 1e-6 * s.score;
-      if (plane && (change <= o_.tolerance || settled)) s.converged = true;
-      previous = s.score;
+      // Converged: a step at round-off, or (noisy data, where the reweighting keeps the
+      // steps from vanishing) a step a thousand times below the robust scale of the
+      // distances (for exact data the scale is at its floor, so this is round-off too).
+      const bool below_noise = change * extent_ <= 1e-3 * s.scale;
+      if (plane && (change <= o_.tolerance || below_noise)) s.converged = true;
     }
   }
 

@@ -18,6 +18,7 @@
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/command_options.hpp"
+#include "gsa/compare_command.hpp"
 #include "gsa/digitise/commands.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/flc.hpp"
@@ -340,6 +341,7 @@ void register_commands(sf::cli::Program& program) {
   add_analyse_command(program);
   add_plot_command(program);
   add_synth_command(program);
+  add_compare_command(program);          // gsa/compare.hpp
   digitise::register_commands(program);  // calibrate, digitise, synth-images (docs/digitise.md)
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},

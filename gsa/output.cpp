@@ -14,6 +14,7 @@
 #include "common/io/csv.hpp"
 #include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
+#include "gsa/surfaces_file.hpp"
 
 namespace sf::gsa {
 
@@ -409,6 +410,9 @@ WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, Ana
         if (options.keep_surfaces) (deformed ? written.deformed : written.undeformed) = std::move(surface);
       }
       if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
+      // The fitted surfaces themselves, for `gsa compare` (gsa/surfaces_file.hpp).
+      write_surfaces_file(out.path("surfaces.json"), result.mesh, result.undeformed_parameters,
+                          result.deformed_parameters, options.units);
     }
   } catch (...) {
     csv.wait();

@@ -56,7 +56,7 @@ function(sf_gsa_cli_test name)
   add_test(NAME gsa.cli.${name}
            COMMAND ${CMAKE_COMMAND} ${defs} -P ${SF_CHECK_EXIT} -- $<TARGET_FILE:gsa> ${A_COMMAND}
            WORKING_DIRECTORY ${A_WORKING_DIRECTORY})
-  set_tests_properties(gsa.cli.${name} PROPERTIES LABELS "gsa;cli" TIMEOUT 60)
+  set_tests_properties(gsa.cli.${name} PROPERTIES LABELS "gsa;cli" TIMEOUT 300)
   foreach(prop FIXTURES_SETUP FIXTURES_REQUIRED RESOURCE_LOCK)
     if(A_${prop})
       set_tests_properties(gsa.cli.${name} PROPERTIES ${prop} "${A_${prop}}")

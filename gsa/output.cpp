@@ -217,6 +217,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                           {"beta", r.penalty_deformed.beta},
                           {"gamma", r.penalty_deformed.gamma},
                           {"delta", r.penalty_deformed.delta},
+                          {"boundary_third_order", r.penalty_deformed.boundary},
                           {"smooths", "displacement less its best-fit rigid motion"}};
     const Eigen::AngleAxisd turn(r.rigid.rotation);
     params["rigid_motion"] = {

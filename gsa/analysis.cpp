@@ -194,7 +194,7 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   if (res.relaxed_elements > 0) {
     const double least = *std::min_element(def.local.multiplier.begin(), def.local.multiplier.end());
     Penalty relaxed = def.fit.penalty;
-    for (double* w : {&relaxed.alpha, &relaxed.beta, &relaxed.gamma, &relaxed.delta}) *w *= least;
+    for (double* w : {&relaxed.alpha, &relaxed.beta, &relaxed.gamma, &relaxed.delta, &relaxed.boundary}) *w *= least;
     res.local_gauge_length = gauge_length(relaxed, setup.mark_spacing);
   }
   res.noise_outliers_undeformed = outliers.noise_undeformed;
@@ -205,7 +205,7 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
     const auto [lo, hi] = std::minmax_element(res.element_multiplier.begin(), res.element_multiplier.end());
     if (*hi - *lo <= 1e-12 * *hi) {
       for (double* w : {&res.penalty_deformed.alpha, &res.penalty_deformed.beta, &res.penalty_deformed.gamma,
-                        &res.penalty_deformed.delta})
+                        &res.penalty_deformed.delta, &res.penalty_deformed.boundary})
         *w *= *lo;
       res.gauge_length = gauge_length(res.penalty_deformed, res.mark_spacing);
       res.log10_delta_optimum += std::log10(*lo);

@@ -128,6 +128,7 @@ OutputOptions output_options(const AnalyseFlags& a) {
 PlotOptions plot_options(const std::string& size, const std::string& view) {
   PlotOptions o;
   o.size = render::parse_size(size, "--size");
+  o.fit_height = size == "1200x900";  // the default: cut to a long part's proportions
   o.view = render::parse_view(view, "--view");
   return o;
 }

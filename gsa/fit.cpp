@@ -87,7 +87,7 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh) {
 
 PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vector<double>& element_multiplier) {
   const Index n = mesh.n_dofs();
-  linalg::TripletAssembler k1(n, n), k2(n, n), k3(n, n), k4(n, n);
+  linalg::TripletAssembler k1(n, n), k2(n, n), k3(n, n), k4(n, n), kb(n, n);
   const auto rule = quadrature::gauss_2d(4, 4);
   // Precompute basis derivatives at the Gauss points.
   struct Orders {
@@ -126,6 +126,12 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
     add_element_block(k1, dm, me * a1);
     add_element_block(k2, dm, me * a2);
     add_element_block(k3, dm, me * a3);
+    // Boundary third order: the element's mean |u,sss|^2, on elements with a free edge.
+    bool on_boundary = false;
+    for (int edge = 0; edge < 4; ++edge)
+      on_boundary =
+          on_boundary || (mesh.neighbour(e, edge).element < 0 && !mesh::SurfaceMesh::is_degenerate_edge(el, edge));
+    if (on_boundary) add_element_block(kb, dm, (me / area) * a3);
   }
   // Jumps of the normal second derivative across interior edges (third-order term).
   const quadrature::Rule1D line = quadrature::gauss_legendre(4);
@@ -192,12 +198,13 @@ PenaltyMatrices assemble_penalties(const mesh::SurfaceMesh& mesh, const std::vec
     }
   }
   PenaltyMatrices out;
-  const std::array<linalg::SparseMatrix, 4> orders = {k1.compress(), k2.compress(), k3.compress(), k4.compress()};
+  const std::array<linalg::SparseMatrix, 5> orders = {k1.compress(), k2.compress(), k3.compress(), k4.compress(),
+                                                      kb.compress()};
   linalg::SparseMatrix identity(n, n);
   identity.setIdentity();
-  out.pattern = orders[0] + orders[1] + orders[2] + orders[3] + identity;
+  out.pattern = orders[0] + orders[1] + orders[2] + orders[3] + orders[4] + identity;
   out.pattern.makeCompressed();
-  for (int i = 0; i < 4; ++i) out.order[i] = values_on(out.pattern, orders[i]);
+  for (int i = 0; i < 5; ++i) out.order[i] = values_on(out.pattern, orders[i]);
   out.diagonal.resize(static_cast<std::size_t>(n));
   for (int c = 0; c < n; ++c) out.diagonal[static_cast<std::size_t>(c)] = position(out.pattern, c, c);
   out.maps = element_dof_maps(mesh);
@@ -368,9 +375,10 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
                                  int trace_probes, int passes) const {
   FitResult out;
   const Index n = mesh->n_dofs();
-  const std::array<VecX, 4>& order = penalties->order;
+  const std::array<VecX, 5>& order = penalties->order;
   Eigen::Map<VecX> pen_values(ws.pen.valuePtr(), ws.pen.nonZeros());
   pen_values = penalty.alpha * order[0] + penalty.beta * order[1] + penalty.gamma * order[2] + penalty.delta * order[3];
+  if (penalty.boundary > 0.0) pen_values += penalty.boundary * order[4];
   Eigen::Map<VecX> k_values(ws.k.valuePtr(), ws.k.nonZeros());
   k_values = normal_values + pen_values;
   MatX rhs = data_rhs + ws.pen * reference;

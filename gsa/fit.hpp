@@ -52,6 +52,12 @@ struct Penalty {
   double beta = 0.0;
   double gamma = 0.0;
   double delta = 0.0;  // fourth order (edge jumps of u,nn and u,nnn), units^6
+  // Third order on the elements at the mesh's boundary: the mean of |u,sss|^2 (1, 3, 3, 1
+  // weights) over each, units^6 like delta. It takes the cubic freedom out of the
+  // boundary elements, where the jumps alone leave a one-sided bicubic whose slope is
+  // noisy (the edge variance of a polynomial fit); automatic smoothing sets it by
+  // cross-validation (gsa/smoothing.hpp).
+  double boundary = 0.0;
 };
 
 // Location of a data point on the mesh.
@@ -67,7 +73,7 @@ struct MeshLocation {
 // formed by adding value arrays.
 struct PenaltyMatrices {
   linalg::SparseMatrix pattern;         // union pattern (its values are not used)
-  std::array<VecX, 4> order;            // first .. fourth order, values on the pattern
+  std::array<VecX, 5> order;            // first .. fourth order, boundary third order: values on the pattern
   std::vector<int> diagonal;            // position of (i, i) in the pattern's values
   std::vector<fe::ElementDofMap> maps;  // element dof maps
   // Per element: position in the pattern's values of (dofs[i], dofs[j]), at i + j * dofs.size().

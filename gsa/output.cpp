@@ -14,6 +14,7 @@
 #include "common/io/csv.hpp"
 #include "common/io/json.hpp"
 #include "common/io/vtk_xml.hpp"
+#include "gsa/measured_region.hpp"
 #include "gsa/surfaces_file.hpp"
 
 namespace sf::gsa {
@@ -218,6 +219,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                           {"beta", r.penalty_deformed.beta},
                           {"gamma", r.penalty_deformed.gamma},
                           {"delta", r.penalty_deformed.delta},
+                          {"boundary_third_order", r.penalty_deformed.boundary},
                           {"smooths", "displacement less its best-fit rigid motion"}};
     const Eigen::AngleAxisd turn(r.rigid.rotation);
     params["rigid_motion"] = {
@@ -309,6 +311,10 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   io::FieldArray dir1{"dir1", 3, {}}, dir2{"dir2", 3, {}}, disp{"displacement", 3, {}}, shear{"shear_angle_deg", 1, {}};
   io::FieldArray f1{"fibre1", 3, {}}, f2{"fibre2", 3, {}}, s1{"fibre1_stretch", 1, {}}, s2{"fibre2_stretch", 1, {}};
   const bool fibres = r.fibre_angles.size() == 2;
+  // Only the cells where the marks are (gsa/measured_region.hpp); every point is kept, so
+  // element e's points stay at e (subdiv + 1)^2 onwards.
+  const std::vector<bool> measured = measured_cells(r, subdiv);
+  std::vector<double> kept_element;
   Index pt = 0;
   for (Index e = 0; e < ne; ++e) {
     for (int j = 0; j < np; ++j)
@@ -351,8 +357,10 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
     const Index base = e * np * np;
     for (int j = 0; j < subdiv; ++j)
       for (int i = 0; i < subdiv; ++i) {
+        if (!measured[static_cast<std::size_t>((e * subdiv + j) * subdiv + i)]) continue;
         const Index a = base + j * np + i;
         pm.polygons.push_back({a, a + 1, a + np + 1, a + np});
+        kept_element.push_back(static_cast<double>(e));
       }
   }
   for (auto& s : scalars) pm.point_data.push_back(std::move(s));
@@ -362,10 +370,7 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   if (fibres) {
     for (auto* f : {&f1, &f2, &s1, &s2, &shear}) pm.point_data.push_back(std::move(*f));
   }
-  io::FieldArray elem{"element", 1, {}};
-  for (Index e = 0; e < ne; ++e)
-    for (int k = 0; k < subdiv * subdiv; ++k) elem.values.push_back(static_cast<double>(e));
-  pm.cell_data.push_back(std::move(elem));
+  pm.cell_data.push_back(io::FieldArray{"element", 1, std::move(kept_element)});
   return pm;
 }
 

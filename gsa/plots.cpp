@@ -90,22 +90,47 @@ Sampling sample_surface(const io::PolyMesh& m) {
   Index n_el = 0;
   if (element)
     for (double e : element->values) n_el = std::max<Index>(n_el, static_cast<Index>(e) + 1);
+  // Every element keeps its (subdiv + 1)^2 points; cells outside the measured region are
+  // left out (gsa/measured_region.hpp), so the element count comes from the points.
   int subdiv = 0;
-  if (n_el > 0 && m.polygons.size() % static_cast<std::size_t>(n_el) == 0) {
-    const auto per = static_cast<double>(m.polygons.size() / static_cast<std::size_t>(n_el));
-    subdiv = static_cast<int>(std::lround(std::sqrt(per)));
-    if (static_cast<double>(subdiv) * subdiv != per || m.n_points() != n_el * (subdiv + 1) * (subdiv + 1)) subdiv = 0;
+  for (int sd = 32; sd >= 1 && n_el > 0; --sd) {  // the finest that fits: 8 as gsa writes it
+    const Index per = static_cast<Index>(sd + 1) * (sd + 1);
+    if (m.n_points() % per == 0 && m.n_points() / per >= n_el &&
+        m.polygons.size() <= static_cast<std::size_t>(m.n_points() / per * sd * sd)) {
+      subdiv = sd;
+      n_el = m.n_points() / per;
+      break;
+    }
   }
+  // Points on a drawn cell: sampling points and element edges elsewhere are not drawn.
+  std::vector<char> drawn(static_cast<std::size_t>(m.n_points()), 0);
+  for (const auto& poly : m.polygons)
+    for (Index p : poly)
+      if (p >= 0 && p < m.n_points()) drawn[static_cast<std::size_t>(p)] = 1;
   if (subdiv > 0) {
     const int np = subdiv + 1;
     const int k =
         std::clamp(static_cast<int>(std::lround(kSamplesAcross / std::sqrt(double(n_el)))), 1, std::max(1, subdiv / 2));
     std::vector<int> at;
     for (int q = 0; q < k; ++q) at.push_back(static_cast<int>(std::lround((q + 0.5) * subdiv / k)));
+    // An element edge is drawn in runs of drawn points.
+    auto add_edge = [&](const std::vector<Index>& line) {
+      std::vector<Index> run;
+      for (Index p : line) {
+        if (drawn[static_cast<std::size_t>(p)]) {
+          run.push_back(p);
+          continue;
+        }
+        if (run.size() > 1) s.element_edges.push_back(run);
+        run.clear();
+      }
+      if (run.size() > 1) s.element_edges.push_back(run);
+    };
     for (Index e = 0; e < n_el; ++e) {
       const Index base = e * np * np;
       for (int j : at)
-        for (int i : at) s.points.push_back(base + j * np + i);
+        for (int i : at)
+          if (drawn[static_cast<std::size_t>(base + j * np + i)]) s.points.push_back(base + j * np + i);
       std::vector<Index> b0, b1, b2, b3;
       for (int t = 0; t < np; ++t) {
         b0.push_back(base + t);
@@ -113,7 +138,7 @@ Sampling sample_surface(const io::PolyMesh& m) {
         b2.push_back(base + t * np);
         b3.push_back(base + t * np + subdiv);
       }
-      s.element_edges.insert(s.element_edges.end(), {b0, b1, b2, b3});
+      for (const auto* b : {&b0, &b1, &b2, &b3}) add_edge(*b);
     }
   } else {
     // Any tessellation: the point nearest to the centre of each cell of a square grid over
@@ -128,6 +153,7 @@ Sampling sample_surface(const io::PolyMesh& m) {
     std::vector<Index> best(static_cast<std::size_t>(na * nb), -1);
     std::vector<double> dist(best.size(), HUGE_VAL);
     for (Index p = 0; p < m.n_points(); ++p) {
+      if (!drawn[static_cast<std::size_t>(p)]) continue;
       const double u = (m.points(p, a) - lo[a]) / h, v = (m.points(p, b) - lo[b]) / h;
       const int iu = std::min(na - 1, static_cast<int>(u)), iv = std::min(nb - 1, static_cast<int>(v));
       const double d = std::hypot(u - iu - 0.5, v - iv - 0.5);
@@ -560,6 +586,22 @@ render::Scene arrow_diagram(const PlotData& r, bool deformed, const PlotOptions&
 
 namespace {
 
+// With fit_height, the height that frames the undeformed part seen from above (X to the
+// right, Y up) at the picture's width: the frame takes about 72 % of the width (the
+// legend panel the rest) and the title and footnote about 200 px at 1200 px. Not below
+// 45 % of the width, which the colour bar and legend need.
+PlotOptions fitted_to_part(const Results& r, PlotOptions o) {
+  if (!o.fit_height || r.undeformed.n_points() == 0) return o;
+  const Eigen::RowVector3d lo = r.undeformed.points.colwise().minCoeff(),
+                           hi = r.undeformed.points.colwise().maxCoeff();
+  const Eigen::RowVector3d ext = hi - lo;
+  if (!(ext[0] > 0) || !(ext[2] < 0.5 * std::max(ext[0], ext[1]))) return o;  // not a blank seen from above
+  const double w = o.size.width;
+  const double wanted = 0.72 * w * ext[1] / ext[0] + 200.0 * w / 1200.0;
+  o.size.height = static_cast<int>(std::lround(std::clamp(wanted, 0.45 * w, static_cast<double>(o.size.height))));
+  return o;
+}
+
 // The pictures of the fitted surfaces (surface method), in report order.
 void draw_surface_pictures(const Results& r, const std::function<void(const std::string&, const render::Scene&)>& draw,
                            const PlotOptions& o, bool fibres) {
@@ -603,8 +645,9 @@ PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
   const auto display = render::acquire_display();  // one display for all pictures
   int done = 0;
   if (progress) progress(done, n_pictures);
+  const PlotOptions part = fitted_to_part(r, o);  // the pictures of the part; the strain plot keeps o.size
   auto draw = [&](const std::string& name, const render::Scene& scene) {
-    render::write_png(scene, o.size, out_path(name));
+    render::write_png(scene, part.size, out_path(name));
     summary.pictures.push_back(name);
     if (progress) progress(++done, n_pictures);
   };

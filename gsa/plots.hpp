@@ -45,6 +45,9 @@ struct PlotOptions {
   render::ImageSize size;  // pixels (--size WxH)
   render::View view;       // for the pictures of the formed part (--view); the undeformed
                            // blank is always seen along its mean normal
+  // Cut the height of the pictures of the part to its proportions (a long strip drawn
+  // 1200 x 900 filled 6 % of the picture): with the default size, not with --size.
+  bool fit_height = false;
 };
 
 // The results of one analysis as the pictures show them.

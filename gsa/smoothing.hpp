@@ -54,8 +54,9 @@ Penalty noise_rule_penalty(const SmoothingOptions& options, double sigma, double
 // Explicit weights, or the noise rule when automatic.
 Penalty penalty_for_noise(const SmoothingOptions& options, double sigma, double mark_spacing);
 
-// The jumps penalty with delta = 10^log10_delta d^6 (and the small third-order floor).
-Penalty jumps_penalty(double log10_delta, double mark_spacing);
+// The jumps penalty with delta = 10^log10_delta d^6 (and the small third-order floor);
+// the boundary elements' third-order weight is boundary_factor x delta.
+Penalty jumps_penalty(double log10_delta, double mark_spacing, double boundary_factor = 0.0);
 
 // Effective smoothing length (units) of a penalty: the largest of (gamma/rho)^(1/6),
 // (beta/rho)^(1/4), (delta/rho)^(1/8), rho = 1/d^2.
@@ -72,8 +73,13 @@ struct SmoothingChoice {
 // Generalised cross-validation of the deformed positions over log10(delta / d^6) in
 // [-6, 6], two candidates at a time (solved in parallel), each candidate fitted with two
 // passes; the weight used is 2 x the optimum (strains want more smoothing than
-// positions) times options.scale. Fits the problem's current data with its current
-// weights; leaves its data and weights as they are.
+// positions) times options.scale. The search runs twice, without and with the boundary
+// elements' third-order term (Penalty::boundary = kBoundaryThirdFactor x delta), and the
+// term is kept where it lowers GCV clearly (by 6 / N): the term cuts the strain error at the outline of nearly homogeneous
+// parts 2-5 x and GCV turns it down on curved ones, where it would bias the edge
+// (bench/gsa_edge_bench). Fits the problem's current data with its current weights;
+// leaves its data and weights as they are.
+inline constexpr double kBoundaryThirdFactor = 10.0;
 SmoothingChoice choose_smoothing_gcv(DeformedProblem& problem, const SmoothingOptions& options, double mark_spacing);
 
 // The same search minimising Mallows' Cp with correlated noise,

@@ -53,7 +53,9 @@ const Colour kNanColour{0.72, 0.72, 0.72};
 // ---------------------------------------------------------------------------------------
 // Sizes relative to a 1200 x 900 picture.
 
-double font_scale(const ImageSize& s) { return std::max(0.25, std::min(s.width / 1200.0, s.height / 900.0)); }
+// Text scales with the width, and with the height below 540 px per 1200 px of width, so a
+// long part's pictures, cut to its proportions (gsa/plots.cpp), keep their text size.
+double font_scale(const ImageSize& s) { return std::max(0.25, std::min(s.width / 1200.0, s.height / 540.0)); }
 double font_px(double base, double f) { return std::max(8.0, std::round(base * f)); }
 
 struct Fonts {

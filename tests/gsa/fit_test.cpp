@@ -114,7 +114,8 @@ TEST(GsaFit, ReproducesABicubicFieldExactlyWithoutSmoothing) {
 }
 
 // Each order leaves its null space unpenalised, however large the weight: constants for
-// alpha, affine fields for beta, quadratics for gamma, bicubic polynomials for delta.
+// alpha, affine fields for beta, quadratics for gamma and for the boundary elements' third
+// order, bicubic polynomials for delta.
 TEST(GsaFit, EachPenaltyOrderLeavesItsNullSpaceAlone) {
   const Problem p;
   struct Case {
@@ -122,13 +123,14 @@ TEST(GsaFit, EachPenaltyOrderLeavesItsNullSpaceAlone) {
     Penalty penalty;
     int degree;  // total degree of the polynomial it must leave alone (3: bicubic)
   };
-  Penalty alpha, beta, gamma, delta;
+  Penalty alpha, beta, gamma, delta, boundary;
   alpha.alpha = kHuge;
   beta.beta = kHuge;
   gamma.gamma = kHuge;
   delta.delta = kHuge;
-  for (const Case& c :
-       {Case{"alpha", alpha, 0}, Case{"beta", beta, 1}, Case{"gamma", gamma, 2}, Case{"delta", delta, 3}}) {
+  boundary.boundary = kHuge;  // every element of the 3 x 2 mesh is on its boundary: quadratics
+  for (const Case& c : {Case{"alpha", alpha, 0}, Case{"beta", beta, 1}, Case{"gamma", gamma, 2},
+                        Case{"delta", delta, 3}, Case{"boundary", boundary, 2}}) {
     SCOPED_TRACE(c.name);
     const Field f = random_bicubic(test::kSeed + 1, c.degree);
     const FitResult r = fit(p, p.values(f), c.penalty, p.zero_reference());

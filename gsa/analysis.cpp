@@ -213,20 +213,6 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   res.noise_outliers_undeformed = outliers.noise_undeformed;
   res.noise_outliers_deformed = outliers.noise_deformed;
   record_parameters(res, setup, und, problem, def, residuals, options);
-  // Every element relaxed alike is one lighter weight everywhere: reported as such.
-  if (!res.element_multiplier.empty() && res.relaxed_elements == static_cast<Index>(res.element_multiplier.size())) {
-    const auto [lo, hi] = std::minmax_element(res.element_multiplier.begin(), res.element_multiplier.end());
-    if (*hi - *lo <= 1e-12 * *hi) {
-      for (double* w : {&res.penalty_deformed.alpha, &res.penalty_deformed.beta, &res.penalty_deformed.gamma,
-                        &res.penalty_deformed.delta})
-        *w *= *lo;
-      res.gauge_length = gauge_length(res.penalty_deformed, res.mark_spacing);
-      res.log10_delta_optimum += std::log10(*lo);
-      std::fill(res.element_multiplier.begin(), res.element_multiplier.end(), 1.0);
-      res.relaxed_elements = 0;
-      res.local_gauge_length = 0.0;
-    }
-  }
   return res;
 }
 

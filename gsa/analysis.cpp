@@ -35,7 +35,7 @@ struct DeformedStages {
 DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const FitMarks& marks,
                                    const UndeformedFit& und, const NoiseEstimate& undeformed_noise,
                                    std::vector<OutlierFlag> flags, const AnalyseOptions& options,
-                                   const ProgressCallback& progress) {
+                                   const ProgressCallback& progress, StageTimes& times) {
   const double d = setup.mark_spacing;
   const SmoothingOptions& so = options.smoothing;
   DeformedStages out;
@@ -44,9 +44,11 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
   out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
   if (so.chooses_by_gcv()) {
     tell(progress, AnalysisStage::kSmoothingChoice, &setup);
+    const auto tc = Clock::now();
     if (so.rule == SmoothingRule::kGcv) {
       out.choice = choose_smoothing_gcv(problem, so, d);
     } else {
+      const auto tn = Clock::now();
       out.noise = deformed_noise(problem, marks, setup, undeformed_noise);
       // Noise correlated over less than a spacing is independent as far as the smoother
       // can tell: there cross-validation, which needs no noise level, is as good and
@@ -54,6 +56,9 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       // 0.03 mm independent noise smoothed 1.6 x worse). Cp where the correlation counts.
       const bool correlated = undeformed_noise.effective_length() >= d;
       const MatX probes = correlated ? noise_probes(out.noise, marks.undeformed, kCpNoiseProbes) : MatX();
+      const double noise_s = seconds_since(tn);
+      times.noise += noise_s;
+      times.choice -= noise_s;  // timed from tc on below
       auto choose = [&] {
         return correlated ? choose_smoothing_noise_model(problem, so, probes, d) : choose_smoothing_gcv(problem, so, d);
       };
@@ -65,6 +70,7 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       if (so.local && correlated)
         out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose);
     }
+    times.choice += seconds_since(tc);
     refit_deformed(problem, out.fit, out.choice);
   }
   readmit_deformed(problem, out.fit);
@@ -162,23 +168,30 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   Points3 deformed_at_marks(marks.size(), 3);
   for (Index k = 0; k < marks.size(); ++k)
     deformed_at_marks.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  const auto to = Clock::now();
   MarkOutliers outliers = find_outliers(marks, deformed_at_marks, setup.mark_spacing, options.outliers);
+  res.times.outliers = seconds_since(to);
 
   tell(progress, AnalysisStage::kUndeformedFit, &setup);
   const UndeformedFit und = fit_undeformed(
       setup, marks, {options.smoothing, std::move(outliers.undeformed), options.max_projection_iterations});
   const DeformedMarks deformed = deformed_marks(grid, marks, und);
   NoiseEstimate undeformed_noise;
-  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel)
+  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel) {
+    const auto tn = Clock::now();
     undeformed_noise = gsa::undeformed_noise(setup, marks, und);
+    res.times.noise = seconds_since(tn);
+  }
 
   tell(progress, AnalysisStage::kDeformedFit, &setup);
   const auto tf = Clock::now();
+  const double undeformed_noise_s = res.times.noise;
   DeformedProblem problem(setup, marks, und, deformed);
   // Deformed flags of marks the undeformed fit readmitted or that lack a deformed position stay as found.
   DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise, std::move(outliers.deformed),
-                                           options, progress);
-  res.times.fit = und.fit_seconds + seconds_since(tf);
+                                           options, progress, res.times);
+  // The deformed stages less the noise estimate and the smoothing choice timed in them.
+  res.times.fit = und.fit_seconds + seconds_since(tf) - (res.times.noise - undeformed_noise_s) - res.times.choice;
   res.times.project = und.project_seconds;
   const DeformedResiduals residuals = deformed_residuals(problem, def.fit);
 
@@ -200,20 +213,6 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   res.noise_outliers_undeformed = outliers.noise_undeformed;
   res.noise_outliers_deformed = outliers.noise_deformed;
   record_parameters(res, setup, und, problem, def, residuals, options);
-  // Every element relaxed alike is one lighter weight everywhere: reported as such.
-  if (!res.element_multiplier.empty() && res.relaxed_elements == static_cast<Index>(res.element_multiplier.size())) {
-    const auto [lo, hi] = std::minmax_element(res.element_multiplier.begin(), res.element_multiplier.end());
-    if (*hi - *lo <= 1e-12 * *hi) {
-      for (double* w : {&res.penalty_deformed.alpha, &res.penalty_deformed.beta, &res.penalty_deformed.gamma,
-                        &res.penalty_deformed.delta, &res.penalty_deformed.boundary})
-        *w *= *lo;
-      res.gauge_length = gauge_length(res.penalty_deformed, res.mark_spacing);
-      res.log10_delta_optimum += std::log10(*lo);
-      std::fill(res.element_multiplier.begin(), res.element_multiplier.end(), 1.0);
-      res.relaxed_elements = 0;
-      res.local_gauge_length = 0.0;
-    }
-  }
   return res;
 }
 

@@ -76,8 +76,12 @@ struct PointResult {
   std::optional<OutlierFlag> flag;  // why the point was flagged (outlier statuses), with its numbers
 };
 
+// Wall seconds per stage. `fit` is the least-squares fits alone; the blunder check
+// (`outliers`), the noise estimates (`noise`) and the smoothing choice with its local
+// relaxation (`choice`) are timed apart.
 struct StageTimes {
   double read = 0, mesh = 0, project = 0, fit = 0, strain = 0, write = 0;
+  double outliers = 0, noise = 0, choice = 0;
 };
 
 struct AnalysisResult {

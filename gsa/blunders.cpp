@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
 #include "common/mesh/neighbours.hpp"
 
 namespace sf::gsa {
@@ -72,6 +73,18 @@ double deviation(const Points3& X, const Points3& v, Index p, const std::vector<
   return c.row(0).norm() / std::sqrt(1.0 + e0[0]);
 }
 
+// The first `k` of `candidates` (nearest first) neither flagged nor `left_out`.
+std::vector<Index> nearest_unflagged(const std::vector<Index>& candidates, const std::vector<bool>& flagged, int k,
+                                     Index left_out = -1) {
+  std::vector<Index> nb;
+  nb.reserve(static_cast<std::size_t>(k));
+  for (Index q : candidates) {
+    if (static_cast<int>(nb.size()) == k) break;
+    if (q != left_out && !flagged[static_cast<std::size_t>(q)]) nb.push_back(q);
+  }
+  return nb;
+}
+
 }  // namespace
 
 void BlunderOptions::validate() const {
@@ -102,22 +115,19 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
   const int comps = normal_only ? 1 : 3;
   for (int pass = 0; pass < o.passes; ++pass) {
     std::vector<std::vector<Index>> nb(static_cast<std::size_t>(n));
-    for (Index p = 0; p < n; ++p) {
-      for (Index q : candidates[static_cast<std::size_t>(p)])
-        if (!out.flagged[static_cast<std::size_t>(q)] &&
-            static_cast<int>(nb[static_cast<std::size_t>(p)].size()) < o.neighbours)
-          nb[static_cast<std::size_t>(p)].push_back(q);
-    }
+    // Each point's neighbours and deviation (a flagged point keeps the deviation it was
+    // flagged with); points are independent, so on all cores.
+    parallel_for(n, [&](Index p) {
+      const auto pp = static_cast<std::size_t>(p);
+      if (out.flagged[pp]) return;
+      nb[pp] = nearest_unflagged(candidates[pp], out.flagged, o.neighbours);
+      out.deviation[pp] = X.row(p).allFinite() ? deviation(X, values, p, nb[pp], normal_only)
+                                               : std::numeric_limits<double>::quiet_NaN();
+    });
     std::vector<double> clean;
-    for (Index p = 0; p < n; ++p)
-      if (!out.flagged[static_cast<std::size_t>(p)])
-        out.deviation[static_cast<std::size_t>(p)] = std::numeric_limits<double>::quiet_NaN();
     for (Index p = 0; p < n; ++p) {
-      // A flagged point keeps the deviation it was flagged with.
-      if (!X.row(p).allFinite() || out.flagged[static_cast<std::size_t>(p)]) continue;
-      const double e = deviation(X, values, p, nb[static_cast<std::size_t>(p)], normal_only);
-      out.deviation[static_cast<std::size_t>(p)] = e;
-      if (std::isfinite(e) && !out.flagged[static_cast<std::size_t>(p)]) clean.push_back(e);
+      const auto pp = static_cast<std::size_t>(p);
+      if (!out.flagged[pp] && std::isfinite(out.deviation[pp])) clean.push_back(out.deviation[pp]);
     }
     out.noise = median_of(clean) / chi_median(comps);
     out.threshold = std::max(o.threshold * out.noise, o.floor);
@@ -140,10 +150,8 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
       // neighbours' local fits towards itself).
       std::vector<double> around;
       for (Index q : nb[static_cast<std::size_t>(p)]) {
-        std::vector<Index> others;
-        for (Index r : candidates[static_cast<std::size_t>(q)])
-          if (r != p && !out.flagged[static_cast<std::size_t>(r)] && static_cast<int>(others.size()) < o.neighbours)
-            others.push_back(r);
+        const std::vector<Index> others =
+            nearest_unflagged(candidates[static_cast<std::size_t>(q)], out.flagged, o.neighbours, p);
         const double eq = deviation(X, values, q, others, normal_only);
         if (std::isfinite(eq)) around.push_back(eq);
         if (around.size() == 8) break;

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "common/basis/hermite.hpp"
+#include "common/core/parallel.hpp"
 #include "common/fe/surface_field.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/quadrature/gauss.hpp"
@@ -338,13 +339,21 @@ FitSystem::~FitSystem() = default;
 void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
   Impl& s = *impl_;
   s.values = values;
-  // Phi^T W z over the points with weight > 0 (the others may be NaN).
+  // Phi^T W z over the points with weight > 0 (the others may be NaN). A column at a
+  // time (contiguous in z), the columns on all cores; each entry sums over the points
+  // in their order whatever the threads.
   s.data_rhs = MatX::Zero(s.phi.cols(), values.cols());
-  for (Index d = 0; d < s.phi.rows(); ++d) {
-    if (!(s.w[d] > 0.0)) continue;
-    for (decltype(s.phi)::InnerIterator it(s.phi, d); it; ++it)
-      s.data_rhs.row(it.col()) += (s.w[d] * it.value()) * values.row(d);
-  }
+  parallel_for(
+      values.cols(),
+      [&](Index c) {
+        const double* z = values.col(c).data();
+        double* out = s.data_rhs.col(c).data();
+        for (Index d = 0; d < s.phi.rows(); ++d) {
+          if (!(s.w[d] > 0.0)) continue;
+          for (decltype(s.phi)::InnerIterator it(s.phi, d); it; ++it) out[it.col()] += (s.w[d] * it.value()) * z[d];
+        }
+      },
+      1);
 }
 
 void FitSystem::set_probes(const MatX& p) {

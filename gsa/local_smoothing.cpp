@@ -69,6 +69,20 @@ LocalSmoothing relax_smoothing(DeformedProblem& problem, SmoothingChoice& choice
     problem.set_element_multipliers(out.multiplier);
     choice = choose();
   }
+  // Every element relaxed alike is one lighter weight everywhere: folded into the
+  // choice's weights (and the problem's multipliers back to 1), reported as such.
+  if (out.relaxed() == mesh.n_elements() && !out.multiplier.empty()) {
+    const auto [lo, hi] = std::minmax_element(out.multiplier.begin(), out.multiplier.end());
+    if (*hi - *lo <= 1e-12 * *hi) {
+      const double factor = *lo;
+      for (double* w : {&choice.penalty.alpha, &choice.penalty.beta, &choice.penalty.gamma, &choice.penalty.delta,
+                        &choice.penalty.boundary})
+        *w *= factor;
+      choice.log10_delta_optimum += std::log10(factor);
+      out.multiplier.assign(out.multiplier.size(), 1.0);
+      problem.set_element_multipliers(out.multiplier);
+    }
+  }
   return out;
 }
 

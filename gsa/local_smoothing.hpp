@@ -13,7 +13,9 @@
 //      marks, correlation included) holds a feature the smoothing would flatten;
 //   2. those elements get a penalty multiplier of 0.01 (their edges the smaller one of
 //      the two elements), and the weight is chosen again for the rest of the part;
-//   3. repeated (at most three rounds) until no further element is found.
+//   3. repeated (at most three rounds) until no further element is found;
+//   4. every element relaxed alike is one lighter weight everywhere: the multiplier is
+//      folded into the chosen weights and the elements reported as not relaxed.
 //
 // Each element's multiplier is reported with the local gauge length it gives.
 

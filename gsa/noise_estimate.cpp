@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "common/fe/surface_field.hpp"
@@ -36,16 +37,35 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-bool confirms(const NoiseEstimate& heavier, const NoiseEstimate& lighter, double d) {
+// The lighter pilot's estimate confirms the heavier one's: the total sigma agrees and,
+// when `length` counts (the blank's ladder fits the correlation length), the effective
+// length too.
+bool confirms(const NoiseEstimate& heavier, const NoiseEstimate& lighter, double d, bool length) {
   const double sh = heavier.sigma_total(), sl = lighter.sigma_total();
   const double lh = heavier.effective_length(), ll = lighter.effective_length();
   return std::abs(sh - sl) <= kSigmaAgreement * sl &&
-         std::abs(lh - ll) <= kLengthAgreement * std::max(lh, ll) + 0.5 * d;
+         (!length || std::abs(lh - ll) <= kLengthAgreement * std::max(lh, ll) + 0.5 * d);
 }
 
 // No smooth bias in the pilot's residuals: b r_max^2 below a fraction of the noise variance.
 bool unbiased(const NoiseEstimate& e, double max_lag) {
   return e.bias_slope * max_lag * max_lag < kBiasFraction * e.sigma_total() * e.sigma_total();
+}
+
+// The pilot ladder delta = 10^k d^6, k = heaviest .. lightest: `estimate(k)` (nothing
+// when the pilot fit fails) is run lazily, heaviest first; taken is the first estimate
+// without smooth bias that the next lighter one confirms, else the lightest one run.
+template <class Estimate>
+NoiseEstimate pilot_ladder(int heaviest, int lightest, double max_lag, double d, bool length,
+                           const Estimate& estimate) {
+  std::optional<NoiseEstimate> heavier;
+  for (int k = heaviest; k >= lightest; --k) {
+    std::optional<NoiseEstimate> e = estimate(k);
+    if (!e) break;
+    if (heavier && unbiased(*heavier, max_lag) && confirms(*heavier, *e, d, length)) return *heavier;
+    heavier = std::move(e);
+  }
+  return heavier ? *heavier : NoiseEstimate{};
 }
 
 }  // namespace
@@ -68,29 +88,21 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
   VariogramOptions vo;
   vo.max_lag = kUndeformedMaxLag * d;
   const VariogramPairs pairs(marks.undeformed, usable, d, vo);
-  std::vector<NoiseEstimate> ladder;
   MatX residual(m, 1);
   const ProbeBank bank = make_probe_bank(marks.undeformed, d);
-  for (int k = 8; k >= 1; --k) {
+  return pilot_ladder(8, 1, vo.max_lag, d, true, [&](int k) -> std::optional<NoiseEstimate> {
     const Penalty pilot = jumps_penalty(k, d);
     system.set_values(marks.undeformed);
     const FitResult f = system.solve(pilot, mesh.geometry(), 0, 1);
-    if (!f.ok) break;
+    if (!f.ok) return std::nullopt;
     for (Index i = 0; i < m; ++i) residual(i, 0) = (marks.undeformed.row(i) - f.fitted.row(i)).dot(normal.row(i));
     auto shrink = [&](const MatX& probes) {
       system.set_values(probes);
       const FitResult g = system.solve(pilot, MatX::Zero(mesh.n_dofs(), probes.cols()), 0, 1);
       return MatX(probes - g.fitted);
     };
-    ladder.push_back(fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink));
-    // The lighter pilots are only needed until one confirms its heavier neighbour.
-    if (ladder.size() >= 2) {
-      const NoiseEstimate& e = ladder[ladder.size() - 2];
-      if (unbiased(e, vo.max_lag) && confirms(e, ladder.back(), d)) return e;
-    }
-  }
-  if (ladder.empty()) return {};
-  return ladder.back();
+    return fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink);
+  });
 }
 
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
@@ -106,22 +118,25 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
   // smooth bias whose estimate the next lighter one confirms. A deformation the pilot
   // cannot follow leaves bias that looks like noise; lighter pilots leave less of it,
   // while true noise gives the same estimate at every pilot (the shrinkage correction).
-  std::vector<NoiseEstimate> ladder;
   // Independent noise is a correlated one with a length far below the spacing.
   const ProbeBank bank = make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
-  for (int k = 4; k >= -1; --k) {
+  // The pairs depend on the points left out only: kept while the same points are usable.
+  std::vector<bool> paired;
+  std::optional<VariogramPairs> pairs;
+  return pilot_ladder(4, -1, vo.max_lag, d, false, [&](int k) -> std::optional<NoiseEstimate> {
     const Penalty pilot = jumps_penalty(k, d);
     const FitResult f = problem.fit(pilot, 1);
-    if (!f.ok) break;
+    if (!f.ok) return std::nullopt;
     const MatX residual = MatX(problem.data()) - f.fitted;
     // Misfit exclusion: neighbourhood mean square residual far above the median.
+    const VecX square = residual.rowwise().squaredNorm();
     std::vector<double> ms(static_cast<std::size_t>(m), 0.0), all;
     for (Index i = 0; i < m; ++i) {
       if (!(w[i] > 0)) continue;
-      double sum = residual.row(i).squaredNorm();
+      double sum = square[i];
       int count = 1;
       for (Index q : around[static_cast<std::size_t>(i)])
-        if (w[q] > 0) sum += residual.row(q).squaredNorm(), ++count;
+        if (w[q] > 0) sum += square[q], ++count;
       ms[static_cast<std::size_t>(i)] = sum / count;
       all.push_back(sum / count);
     }
@@ -129,21 +144,16 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
     std::vector<bool> usable(static_cast<std::size_t>(m));
     for (Index i = 0; i < m; ++i)
       usable[static_cast<std::size_t>(i)] = w[i] > 0 && ms[static_cast<std::size_t>(i)] <= kMisfitFactor * typical;
-    const VariogramPairs pairs(marks.undeformed, usable, d, vo);
+    if (!pairs || usable != paired) {
+      pairs.emplace(marks.undeformed, usable, d, vo);
+      paired = usable;
+    }
     auto shrink = [&](const MatX& probes) { return MatX(probes - problem.smooth(probes, pilot, 1)); };
-    NoiseEstimate e = fit_noise_model(pairs, pairs.gamma(residual, 3), bank, shrink);
+    NoiseEstimate e = fit_noise_model(*pairs, pairs->gamma(residual, 3), bank, shrink);
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;
-    ladder.push_back(e);
-    // Lighter pilots only until one confirms its heavier neighbour.
-    if (ladder.size() >= 2) {
-      const NoiseEstimate& h = ladder[ladder.size() - 2];
-      const double sh = h.sigma_total(), sl = ladder.back().sigma_total();
-      if (unbiased(h, vo.max_lag) && std::abs(sh - sl) <= kSigmaAgreement * sl) return h;
-    }
-  }
-  if (ladder.empty()) return {};
-  return ladder.back();
+    return e;
+  });
 }
 
 }  // namespace sf::gsa

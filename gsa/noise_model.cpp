@@ -5,11 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <optional>
 #include <random>
 
-#include "common/mesh/neighbours.hpp"
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
+#include "common/mesh/neighbours.hpp"
 
 namespace sf::gsa {
 
@@ -212,10 +212,15 @@ ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed
   const Index n = positions.rows();
   const int nl = static_cast<int>(bank.lengths.size());
   bank.probes.resize(n, 3 * (nl + 1));
-  for (int l = 0; l < nl; ++l) {
-    const CorrelatedField f(1.0, bank.lengths[static_cast<std::size_t>(l)], 500u + static_cast<unsigned>(l), 48);
-    for (Index p = 0; p < n; ++p) bank.probes.block<1, 3>(p, 3 * l) = f.at(positions.row(p).transpose()).transpose();
-  }
+  std::vector<CorrelatedField> fields;
+  for (int l = 0; l < nl; ++l)
+    fields.emplace_back(1.0, bank.lengths[static_cast<std::size_t>(l)], 500u + static_cast<unsigned>(l), 48);
+  // The cosines are most of the cost of the noise estimate: on all cores, by point.
+  parallel_for(n, [&](Index p) {
+    const Vec3 x = positions.row(p).transpose();
+    for (int l = 0; l < nl; ++l)
+      bank.probes.block<1, 3>(p, 3 * l) = fields[static_cast<std::size_t>(l)].at(x).transpose();
+  });
   std::mt19937_64 rng(777);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (Index p = 0; p < n; ++p)
@@ -281,13 +286,17 @@ MatX noise_probes(const NoiseEstimate& noise, const Points3& positions, int coun
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (int f = 0; 3 * f < count; ++f) {
-    std::optional<CorrelatedField> field;
-    if (noise.sigma_correlated > 0 && noise.correlation_length > 0)
-      field.emplace(noise.sigma_correlated, noise.correlation_length, seed + 1000u + static_cast<unsigned>(f), 64);
-    for (Index k = 0; k < n; ++k) {
-      const Vec3 v = field ? field->at(positions.row(k).transpose()) : Vec3::Zero();
-      for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) = v[c] + noise.sigma_white * normal(rng);
+    // The correlated part on all cores, then the white part in the generator's order.
+    if (noise.sigma_correlated > 0 && noise.correlation_length > 0) {
+      const CorrelatedField field(noise.sigma_correlated, noise.correlation_length,
+                                  seed + 1000u + static_cast<unsigned>(f), 64);
+      parallel_for(n, [&](Index k) {
+        const Vec3 v = field.at(positions.row(k).transpose());
+        for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) = v[c];
+      });
     }
+    for (Index k = 0; k < n; ++k)
+      for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) += noise.sigma_white * normal(rng);
   }
   return P;
 }

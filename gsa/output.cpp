@@ -294,6 +294,7 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   if (r.fibre_angles.size() == 2) j["strain_ranges"]["shear_angle_deg"] = range_of(shear);
   j["timings_s"] = {{"read", r.times.read}, {"mesh", r.times.mesh},     {"project", r.times.project},
                     {"fit", r.times.fit},   {"strain", r.times.strain}, {"write", r.times.write}};
+  j["timings_s"].update({{"outliers", r.times.outliers}, {"noise", r.times.noise}, {"choice", r.times.choice}});
   j["warnings"] = r.warnings;
   return j;
 }

@@ -11,6 +11,8 @@
 #include <iterator>
 #include <utility>
 
+#include "common/core/parallel.hpp"
+
 namespace sf::mesh {
 
 namespace {
@@ -39,15 +41,16 @@ std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k)
   const std::vector<Sample> samples = finite_samples(points);
   if (samples.size() < 2 || k <= 0) return out;
   Tree tree(samples.begin(), samples.end());
-  tree.build();
-  for (const Sample& s : samples) {
+  tree.build();  // before the queries: a built tree is searched from several threads
+  parallel_for(static_cast<Index>(samples.size()), [&](Index i) {
+    const Sample& s = samples[static_cast<std::size_t>(i)];
     // k + 1: the query point finds itself first.
     Search search(tree, s.first, static_cast<unsigned>(k) + 1);
     std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
     nb.reserve(static_cast<std::size_t>(k));
     for (auto it = search.begin(); it != search.end(); ++it)
       if (it->first.second != s.second && static_cast<int>(nb.size()) < k) nb.push_back(it->first.second);
-  }
+  });
   return out;
 }
 
@@ -57,14 +60,14 @@ std::vector<std::vector<Index>> neighbours_within(const Points3& points, double 
   if (samples.size() < 2 || !(radius > 0.0)) return out;
   Tree tree(samples.begin(), samples.end());
   tree.build();
-  std::vector<Sample> found;
-  for (const Sample& s : samples) {
-    found.clear();
+  parallel_for(static_cast<Index>(samples.size()), [&](Index i) {
+    const Sample& s = samples[static_cast<std::size_t>(i)];
+    std::vector<Sample> found;
     tree.search(std::back_inserter(found), Sphere(s.first, radius, 0.0));
     std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
     for (const Sample& f : found)
       if (f.second != s.second) nb.push_back(f.second);
-  }
+  });
   return out;
 }
 
@@ -75,15 +78,17 @@ std::vector<std::vector<Index>> neighbours_within(const Points3& points, double 
   if (samples.size() < 2 || !(radius > 0.0)) return out;
   Tree tree(samples.begin(), samples.end());
   tree.build();
-  std::vector<Sample> found;
-  for (std::size_t i = 0; i < query.size(); ++i) {
-    const Index p = query[i];
-    if (!points.row(p).allFinite()) continue;
-    found.clear();
-    tree.search(std::back_inserter(found), Sphere(Point(points(p, 0), points(p, 1), points(p, 2)), radius, 0.0));
-    for (const Sample& f : found)
-      if (f.second != p) out[i].push_back(f.second);
-  }
+  parallel_for(
+      static_cast<Index>(query.size()),
+      [&](Index i) {
+        const Index p = query[static_cast<std::size_t>(i)];
+        if (!points.row(p).allFinite()) return;
+        std::vector<Sample> found;
+        tree.search(std::back_inserter(found), Sphere(Point(points(p, 0), points(p, 1), points(p, 2)), radius, 0.0));
+        for (const Sample& f : found)
+          if (f.second != p) out[static_cast<std::size_t>(i)].push_back(f.second);
+      },
+      16);
   return out;
 }
 

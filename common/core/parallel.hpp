@@ -1,0 +1,48 @@
+#pragma once
+// A loop over independent items on all cores (std::thread; blocks of items claimed
+// in turn). Each item must write only its own results, so what the loop computes does
+// not depend on the number of threads nor on the order the items are taken in.
+// The first exception thrown by an item is rethrown once every thread has stopped.
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "common/core/types.hpp"
+
+namespace sf {
+
+// fn(i) for i in [0, n); `block` items at a time; `threads` 0 = one per core.
+template <class Fn>
+void parallel_for(Index n, const Fn& fn, Index block = 256, int threads = 0) {
+  if (n <= 0) return;
+  int n_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  n_threads = static_cast<int>(std::min<Index>(n_threads, (n + block - 1) / block));
+  if (n_threads <= 1) {
+    for (Index i = 0; i < n; ++i) fn(i);
+    return;
+  }
+  std::atomic<Index> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&] {
+    try {
+      for (Index start = next.fetch_add(block); start < n; start = next.fetch_add(block))
+        for (Index i = start; i < std::min(n, start + block); ++i) fn(i);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+      next.store(n);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < n_threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace sf

@@ -40,9 +40,10 @@ int main(int argc, char** argv) {
   so.not_measured = 0.02;
   const SyntheticSeries syn = make_synthetic_series(so);
   const io::GridSeries& series = syn.series;
-  std::printf("gsa_series_bench: %zu stages of %ld marks (%d x %d, 1 mm apart), noise %.3g mm, 2 %% not measured "
-              "per stage\n",
-              series.n_stages(), static_cast<long>(series.n_points()), so.n, so.n, so.noise);
+  std::printf(
+      "gsa_series_bench: %zu stages of %ld marks (%d x %d, 1 mm apart), noise %.3g mm, 2 %% not measured "
+      "per stage\n",
+      series.n_stages(), static_cast<long>(series.n_points()), so.n, so.n, so.noise);
   const auto tmp = std::filesystem::temp_directory_path() / "gsa_series_bench";
   std::filesystem::remove_all(tmp);
   const auto t_all = Clock::now();
@@ -53,8 +54,7 @@ int main(int argc, char** argv) {
   const double undeformed_s = since(t0);
   std::printf("smoothing chosen %s; undeformed stages%s: %.3f s (mesh %s, %ld elements)\n",
               each ? "on each stage" : "once, on the last stage", each ? "" : " and the last stage in full",
-              undeformed_s,
-              analysis.undeformed().setup.layout.c_str(),
+              undeformed_s, analysis.undeformed().setup.layout.c_str(),
               static_cast<long>(analysis.undeformed().setup.mesh.n_elements()));
   std::printf("%6s %8s %8s %8s %8s %10s %10s %9s\n", "stage", "fit_s", "strain_s", "write_s", "wall_s", "rms_err",
               "max_E1", "gauge_mm");
@@ -94,9 +94,10 @@ int main(int argc, char** argv) {
   const double n = static_cast<double>(series.n_stages());
   std::printf("per stage (mean, each on its own thread): fit %.3f s, strain %.3f s, write %.3f s\n", sum_fit / n,
               sum_strain / n, sum_write / n);
-  std::printf("total %.2f s wall, %.2f s CPU (all threads) for %zu stages (undeformed %.2f s, stages %.2f s); worst "
-              "stage RMS error %.2e\n",
-              total, cpu, series.n_stages(), undeformed_s, total - undeformed_s, worst);
+  std::printf(
+      "total %.2f s wall, %.2f s CPU (all threads) for %zu stages (undeformed %.2f s, stages %.2f s); worst "
+      "stage RMS error %.2e\n",
+      total, cpu, series.n_stages(), undeformed_s, total - undeformed_s, worst);
   std::filesystem::remove_all(tmp);
   return 0;
 }

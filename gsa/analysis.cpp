@@ -43,7 +43,8 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
   if (options.fixed_smoothing && so.chooses_by_gcv()) {  // chosen elsewhere (a stage series): one matrix
     const FixedSmoothing& fixed = *options.fixed_smoothing;
     out.local.multiplier = fixed.multiplier;
-    if (out.local.multiplier.empty()) out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
+    if (out.local.multiplier.empty())
+      out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
     if (!fixed.multiplier.empty()) problem.set_element_multipliers(fixed.multiplier);
     out.fit = fit_deformed(problem, fixed.choice.penalty, std::move(flags));
     out.choice = fixed.choice;
@@ -130,8 +131,9 @@ void fill_point_results(std::vector<PointResult>& points, const GridData& grid, 
 }
 
 // The parameters used, from the stage results.
-void record_parameters(AnalysisResult& r, const FrameAndMesh& setup, const UndeformedFit& und, const DeformedProblem& problem,
-                       const DeformedStages& def, const DeformedResiduals& residuals, const AnalyseOptions& options) {
+void record_parameters(AnalysisResult& r, const FrameAndMesh& setup, const UndeformedFit& und,
+                       const DeformedProblem& problem, const DeformedStages& def, const DeformedResiduals& residuals,
+                       const AnalyseOptions& options) {
   r.mesh = setup.mesh;
   r.centroid = setup.frame.centroid;
   r.axis1 = setup.frame.a1;
@@ -188,8 +190,9 @@ UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& 
 
   tell(progress, AnalysisStage::kUndeformedFit, &u.setup);
   u.weights = sigma_weights(grid.sigma_undeformed, u.marks.point, options.sigma_weights);
-  u.fit = fit_undeformed(u.setup, u.marks,
-                         {options.smoothing, u.outliers.undeformed, options.max_projection_iterations, u.weights.weight});
+  u.fit =
+      fit_undeformed(u.setup, u.marks,
+                     {options.smoothing, u.outliers.undeformed, options.max_projection_iterations, u.weights.weight});
   if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel)
     u.noise = gsa::undeformed_noise(u.setup, u.marks, u.fit);
   return u;

@@ -33,7 +33,7 @@ struct AnalyseFlags {
   int sample = 0;
   bool no_plots = false;
   std::string measure = "true", size = "1200x900", view = "auto", flc;  // pictures
-  bool no_sigma_weights = false;  // --no-sigma-weights
+  bool no_sigma_weights = false;                                        // --no-sigma-weights
   // Stage series (gsa/series_output.hpp): --stages files/folders, or GRID --stage-column.
   std::vector<std::string> stages;
   std::string stage_column, reference_stage, path_ids, stage_smoothing = "once";

@@ -247,9 +247,10 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                             {"max_weight", w.max_weight}};
     };
     params["weights"] = {
-        {"rule", "w = (sigma_ref / sigma)^2 from the input's per-point sigma, sigma_ref = median sigma (equal sigmas: "
-                 "the unweighted fit); weight 1 where a point has no sigma; sigma below 0.01 sigma_ref counts as that; weight "
-                 "below 1e-6 is 0 (left out); --no-sigma-weights: all 1"},
+        {"rule",
+         "w = (sigma_ref / sigma)^2 from the input's per-point sigma, sigma_ref = median sigma (equal sigmas: "
+         "the unweighted fit); weight 1 where a point has no sigma; sigma below 0.01 sigma_ref counts as that; weight "
+         "below 1e-6 is 0 (left out); --no-sigma-weights: all 1"},
         {"undeformed", weights(r.weights_undeformed)},
         {"deformed", weights(r.weights_deformed)}};
     if (r.noise.sigma_total() > 0 || r.noise_undeformed.sigma_total() > 0) {

@@ -21,7 +21,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 void check_series(const io::GridSeries& s) {
-  if (s.n_stages() == 0) throw InputError((s.sources.empty() ? std::string("series") : s.sources.front()) + ": no stages");
+  if (s.n_stages() == 0)
+    throw InputError((s.sources.empty() ? std::string("series") : s.sources.front()) + ": no stages");
   // With a reference file (or stage) every stage id is the reference's: the reader checked.
   if (s.sources.size() == s.n_stages() + 1) return;  // sources: the reference file, then the stage files
   const io::GridStage& first = s.stages.front();
@@ -48,8 +49,8 @@ void check_series(const io::GridSeries& s) {
   }
 }
 
-SeriesAnalysis::SeriesAnalysis(const io::GridSeries& series, const AnalyseOptions& options,
-                               SeriesSmoothing smoothing, const ProgressCallback& progress)
+SeriesAnalysis::SeriesAnalysis(const io::GridSeries& series, const AnalyseOptions& options, SeriesSmoothing smoothing,
+                               const ProgressCallback& progress)
     : series_(series), options_(options) {
   options_.validate();
   options_.fixed_smoothing.reset();
@@ -83,8 +84,7 @@ AnalysisResult SeriesAnalysis::analyse_stage(std::size_t k, const GridData& stag
 }
 
 void run_stages(const SeriesAnalysis& analysis,
-                const std::function<void(std::size_t k, GridData& grid, AnalysisResult& result)>& take,
-                int ahead) {
+                const std::function<void(std::size_t k, GridData& grid, AnalysisResult& result)>& take, int ahead) {
   if (ahead <= 0) ahead = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   struct Done {
     GridData grid;

@@ -86,8 +86,7 @@ class SeriesAnalysis {
 // calling thread (which writes them meanwhile). An exception of a stage is rethrown here,
 // after the stages in flight have finished.
 void run_stages(const SeriesAnalysis& analysis,
-                const std::function<void(std::size_t k, GridData& grid, AnalysisResult& result)>& take,
-                int ahead = 0);
+                const std::function<void(std::size_t k, GridData& grid, AnalysisResult& result)>& take, int ahead = 0);
 
 // Principal strains of every point at every stage, kept while the stages run (floats: 8
 // bytes a point and stage), for the strain paths.

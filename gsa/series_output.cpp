@@ -70,12 +70,11 @@ nlohmann::json stage_entry(std::size_t k, const io::GridStage& st, const std::st
   if (!surface.empty()) e["surface"] = surface;
   if (r.method == Method::kSurface) {
     e["fit"] = {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}};
-    e["smoothing"] = {
-        {"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
-        {"log10_delta_optimum", json_number(r.log10_delta_optimum)},
-        {"gauge_length", r.gauge_length},
-        {"relaxed_elements", r.relaxed_elements},
-        {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
+    e["smoothing"] = {{"criterion", r.smoothing_criterion.empty() ? nullptr : nlohmann::json(r.smoothing_criterion)},
+                      {"log10_delta_optimum", json_number(r.log10_delta_optimum)},
+                      {"gauge_length", r.gauge_length},
+                      {"relaxed_elements", r.relaxed_elements},
+                      {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
     e["noise_deformed_sigma_total"] = r.noise.sigma_total();
     e["sigma_weights"] = r.weights_deformed.used;
     e["rigid_translation"] = {r.rigid.translation[0], r.rigid.translation[1], r.rigid.translation[2]};
@@ -92,9 +91,9 @@ std::string stage_surface_name(std::size_t k, std::size_t n_stages) {
 }
 
 std::vector<std::string> series_strain_columns() {
-  return {"stage", "stage_name", "time",   "id",      "status",  "E1",       "E2",
-          "eng1",  "eng2",       "true1",  "true2",   "thickness_change_pct", "dir1_x", "dir1_y",
-          "dir1_z", "residual",  "flag_reason"};
+  return {"stage",  "stage_name", "time",   "id",       "status",     "E1",
+          "E2",     "eng1",       "eng2",   "true1",    "true2",      "thickness_change_pct",
+          "dir1_x", "dir1_y",     "dir1_z", "residual", "flag_reason"};
 }
 
 struct SeriesWriter::Impl {
@@ -145,8 +144,12 @@ void SeriesWriter::add_stage(std::size_t k, const GridData& grid, const Analysis
   io::CsvWriter& w = *s.csv;
   for (Index p = 0; p < grid.n_points(); ++p) {
     const PointResult& pr = r.points[static_cast<std::size_t>(p)];
-    w.begin_row().add(static_cast<Index>(k)).add(st.name).add(st.time).add(grid.ids[static_cast<std::size_t>(p)]).add(
-        pr.status);
+    w.begin_row()
+        .add(static_cast<Index>(k))
+        .add(st.name)
+        .add(st.time)
+        .add(grid.ids[static_cast<std::size_t>(p)])
+        .add(pr.status);
     if (pr.strain) {
       const SurfaceStrain& e = *pr.strain;
       w.add(e.green(0))
@@ -172,7 +175,7 @@ void SeriesWriter::add_stage(std::size_t k, const GridData& grid, const Analysis
 }
 
 nlohmann::json SeriesWriter::finish(const std::vector<StrainPath>& paths, double undeformed_seconds,
-                                   const std::string& smoothing) {
+                                    const std::string& smoothing) {
   Impl& s = *impl_;
   s.csv.reset();
   s.csv_file.close();
@@ -196,21 +199,22 @@ nlohmann::json SeriesWriter::finish(const std::vector<StrainPath>& paths, double
   }
   nlohmann::json ids = nlohmann::json::array();
   for (const StrainPath& p : paths) ids.push_back(p.id);
-  return {{"n_stages", s.series->n_stages()},
-          {"n_points", s.series->n_points()},
-          {"top_level_results", "strains.csv, undeformed.vtp, deformed.vtp and the pictures are those of the last stage"},
-          {"outputs",
-           {{"table", "series_strains.csv"},
-            {"surfaces", s.pvd.empty() ? nullptr : nlohmann::json("series.pvd")},
-            {"strain_paths", "strain_paths.csv"}}},
-          {"time_axis", s.times ? "stage time (s, from the stage names or values)" : "stage index"},
-          {"undeformed_seconds", undeformed_seconds},
-          {"smoothing", smoothing},
-          {"reuse",
-           "one undeformed fit (mesh, material coordinates, penalty matrices, undeformed noise and correlation length) "
-           "for every stage; per stage: outlier check, weights, deformed fit, smoothing choice, strains"},
-          {"strain_paths", {{"measure", measure_name(s.options.measure)}, {"ids", ids}}},
-          {"stages", s.stages}};
+  return {
+      {"n_stages", s.series->n_stages()},
+      {"n_points", s.series->n_points()},
+      {"top_level_results", "strains.csv, undeformed.vtp, deformed.vtp and the pictures are those of the last stage"},
+      {"outputs",
+       {{"table", "series_strains.csv"},
+        {"surfaces", s.pvd.empty() ? nullptr : nlohmann::json("series.pvd")},
+        {"strain_paths", "strain_paths.csv"}}},
+      {"time_axis", s.times ? "stage time (s, from the stage names or values)" : "stage index"},
+      {"undeformed_seconds", undeformed_seconds},
+      {"smoothing", smoothing},
+      {"reuse",
+       "one undeformed fit (mesh, material coordinates, penalty matrices, undeformed noise and correlation length) "
+       "for every stage; per stage: outlier check, weights, deformed fit, smoothing choice, strains"},
+      {"strain_paths", {{"measure", measure_name(s.options.measure)}, {"ids", ids}}},
+      {"stages", s.stages}};
 }
 
 namespace {
@@ -298,8 +302,8 @@ int run_analyse_series(const AnalyseFlags& a, bool quiet) {
       if (p.strain) ++ok, peak = std::max(peak, p.strain->true_strain(0));
       if (p.status == kStatusMissingDeformed || p.status == kStatusNotMeasured) ++missing;
     }
-    std::string line = fmt::format("gsa: stage {}/{} {}: {} of {} points analysed", k + 1, n, series.stages[k].name,
-                                   ok, g.n_points());
+    std::string line =
+        fmt::format("gsa: stage {}/{} {}: {} of {} points analysed", k + 1, n, series.stages[k].name, ok, g.n_points());
     if (missing > 0) line += fmt::format(" ({} not measured in this stage)", missing);
     if (ok > 0) line += fmt::format(", major true strain up to {:.4g}", peak);
     if (r.method == Method::kSurface) line += fmt::format(", gauge length {:.3g} {}", r.gauge_length, output.units);
@@ -313,12 +317,12 @@ int run_analyse_series(const AnalyseFlags& a, bool quiet) {
   const std::vector<Index> points =
       choose_path_points(principal, last_grid, path_ids, a.strain_paths, 2.0 * spacing, "--path-ids");
   const std::vector<StrainPath> paths = strain_paths(principal, last_grid, points, output.measure);
-  nlohmann::json series_json = writer.finish(
-      paths, analysis.undeformed_seconds(),
-      analysis.fixed_smoothing() ? "chosen once, on the last stage (" + series.stages.back().name +
-                                       "), with its local relaxation, for every stage"
-      : options.smoothing.chooses_by_gcv() ? "chosen on each stage"
-                                           : "explicit weights");
+  nlohmann::json series_json =
+      writer.finish(paths, analysis.undeformed_seconds(),
+                    analysis.fixed_smoothing() ? "chosen once, on the last stage (" + series.stages.back().name +
+                                                     "), with its local relaxation, for every stage"
+                    : options.smoothing.chooses_by_gcv() ? "chosen on each stage"
+                                                         : "explicit weights");
   cli::status(quiet, "gsa: writing the results of the last stage");
   last.times.read = read_seconds;
   WrittenResults written = write_results(out, last_grid, last, output, info);

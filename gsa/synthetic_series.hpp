@@ -20,8 +20,8 @@
 namespace sf::gsa {
 
 struct SyntheticSeriesOptions {
-  int n = 21;                 // marks per side
-  double spacing = 2.0;       // d, mm
+  int n = 21;            // marks per side
+  double spacing = 2.0;  // d, mm
   int stages = 5;
   double stretch = 0.2;       // a: engineering major strain at the last stage (no bulge)
   double contraction = 0.08;  // b

@@ -25,7 +25,7 @@ struct UndeformedFitOptions {
   SmoothingOptions smoothing;
   std::vector<OutlierFlag> outliers;  // undeformed flags (find_outliers): left out unless readmitted
   int max_projection_iterations = 5;  // fit-and-project rounds per outer round (>= 1)
-  VecX weight;  // m: base weight of each mark (gsa/weights.hpp, from its sigma); empty: all 1
+  VecX weight;                        // m: base weight of each mark (gsa/weights.hpp, from its sigma); empty: all 1
 };
 
 struct UndeformedFit {

@@ -28,7 +28,7 @@ SigmaWeights sigma_weights(const std::vector<double>& sigma, const std::vector<I
   for (Index k = 0; k < m; ++k) {
     double s = sigma[static_cast<std::size_t>(points[static_cast<std::size_t>(k)])];
     if (std::isnan(s) || s < 0) continue;  // no sigma (or a negative one, no uncertainty): weight 1
-    if (s < floor) {                        // 0 or tiny: the floor
+    if (s < floor) {                       // 0 or tiny: the floor
       s = floor;
       ++out.n_floored;
     }

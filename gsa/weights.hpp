@@ -31,12 +31,12 @@ inline constexpr double kSigmaFloor = 0.01;
 inline constexpr double kNegligibleWeight = 1e-6;
 
 struct SigmaWeights {
-  VecX weight;                                                 // m: the base weight of each mark
-  bool used = false;                                           // sigma given and weighting on
-  double sigma_ref = std::numeric_limits<double>::quiet_NaN(); // median sigma (units)
-  Index n_with_sigma = 0;                                      // marks with a finite sigma > 0
-  Index n_floored = 0;                                         // marks whose sigma was raised to the floor
-  Index n_left_out = 0;                                        // marks of negligible weight (set to 0)
+  VecX weight;                                                  // m: the base weight of each mark
+  bool used = false;                                            // sigma given and weighting on
+  double sigma_ref = std::numeric_limits<double>::quiet_NaN();  // median sigma (units)
+  Index n_with_sigma = 0;                                       // marks with a finite sigma > 0
+  Index n_floored = 0;                                          // marks whose sigma was raised to the floor
+  Index n_left_out = 0;                                         // marks of negligible weight (set to 0)
   double min_weight = 1.0, max_weight = 1.0;
 };
 

@@ -193,8 +193,7 @@ TEST(GsaSeries, StrainPathsFollowTheHighestStrainPointsThroughEveryStage) {
     EXPECT_NEAR(path.minor[4], std::log(e.lambda2), 2e-3) << path.id;
   }
   // Chosen ids, in the order given; an unknown id names itself and the option.
-  EXPECT_EQ(choose_path_points(principal, g, {"m3_4", "m0_0"}, 5, 1.0),
-            (std::vector<Index>{3 * 15 + 4, 0}));
+  EXPECT_EQ(choose_path_points(principal, g, {"m3_4", "m0_0"}, 5, 1.0), (std::vector<Index>{3 * 15 + 4, 0}));
   EXPECT_THROW(
       {
         try {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -52,7 +53,7 @@ TEST(GsaWeights, NormalisedToTheMedianSigma) {
   EXPECT_EQ(w.sigma_ref, 0.02);  // median of {0.01, 0.01, 0.02, 1e9}: the upper middle
   EXPECT_DOUBLE_EQ(w.weight[0], 4.0);
   EXPECT_EQ(w.weight[1], 1.0);
-  EXPECT_EQ(w.weight[3], 1.0);                             // no sigma
+  EXPECT_EQ(w.weight[3], 1.0);                                       // no sigma
   EXPECT_DOUBLE_EQ(w.weight[4], 1.0 / (kSigmaFloor * kSigmaFloor));  // zero: the floor
   EXPECT_EQ(w.n_floored, 1);
   EXPECT_EQ(w.weight[5], 0.0);  // negligible: left out
@@ -96,7 +97,7 @@ TEST(GsaWeights, PointWithHugeSigmaHasNoInfluence) {
   const AnalysisResult unweighted = analyse(g, o);
   const double d_weighted = max_strain_difference(ref, weighted, bad);
   const double d_unweighted = max_strain_difference(ref, unweighted, bad);
-  EXPECT_LT(d_weighted, 1e-9);     // measured ~1e-14
+  EXPECT_LT(d_weighted, 1e-9);    // measured ~1e-14
   EXPECT_GT(d_unweighted, 1e-4);  // the displaced mark does move the unweighted fit
   // With automatic smoothing: a huge sigma of the deformed position only is the same as no
   // deformed position (negligible weights are 0: left out of the choice's counts too).
@@ -137,6 +138,7 @@ TEST(GsaWeights, NoisySubsetWithLargerSigmaGivesSmallerStrainErrorThanUnweighted
   const StrainError weighted = strain_error(g, analyse(g, o), exact);
   o.sigma_weights = false;
   const StrainError unweighted = strain_error(g, analyse(g, o), exact);
+  std::printf("RMS strain error: weighted %.3g, unweighted %.3g\n", weighted.rms(), unweighted.rms());
   EXPECT_LT(weighted.rms(), 0.8 * unweighted.rms()) << weighted.rms() << " vs " << unweighted.rms();
 }
 

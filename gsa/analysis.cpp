@@ -10,6 +10,7 @@
 #include "gsa/local_smoothing.hpp"
 #include "gsa/noise_estimate.hpp"
 #include "gsa/undeformed_fit.hpp"
+#include "gsa/weights.hpp"
 
 namespace sf::gsa {
 
@@ -39,6 +40,19 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
   const double d = setup.mark_spacing;
   const SmoothingOptions& so = options.smoothing;
   DeformedStages out;
+  if (options.fixed_smoothing && so.chooses_by_gcv()) {  // chosen elsewhere (a stage series): one matrix
+    const FixedSmoothing& fixed = *options.fixed_smoothing;
+    out.local.multiplier = fixed.multiplier;
+    if (out.local.multiplier.empty())
+      out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
+    if (!fixed.multiplier.empty()) problem.set_element_multipliers(fixed.multiplier);
+    out.fit = fit_deformed(problem, fixed.choice.penalty, std::move(flags));
+    out.choice = fixed.choice;
+    out.noise = fixed.noise;
+    refit_deformed(problem, out.fit, out.choice);
+    readmit_deformed(problem, out.fit);
+    return out;
+  }
   out.fit = fit_deformed(problem, penalty_for_noise(so, und.noise_estimate, d), std::move(flags));
   out.choice = {out.fit.penalty, out.fit.passes};
   out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
@@ -123,9 +137,10 @@ void fill_point_results(std::vector<PointResult>& points, const GridData& grid, 
 }
 
 // The parameters used, from the stage results.
-void record_parameters(AnalysisResult& r, FrameAndMesh& setup, const UndeformedFit& und, const DeformedProblem& problem,
-                       const DeformedStages& def, const DeformedResiduals& residuals, const AnalyseOptions& options) {
-  r.mesh = std::move(setup.mesh);
+void record_parameters(AnalysisResult& r, const FrameAndMesh& setup, const UndeformedFit& und,
+                       const DeformedProblem& problem, const DeformedStages& def, const DeformedResiduals& residuals,
+                       const AnalyseOptions& options) {
+  r.mesh = setup.mesh;
   r.centroid = setup.frame.centroid;
   r.axis1 = setup.frame.a1;
   r.axis2 = setup.frame.a2;
@@ -142,6 +157,7 @@ void record_parameters(AnalysisResult& r, FrameAndMesh& setup, const UndeformedF
   r.penalty_deformed = def.fit.penalty;
   r.noise_estimate = und.noise_estimate;
   r.log10_delta_optimum = def.choice.log10_delta_optimum;
+  r.fit_passes = def.fit.passes;
   r.smoothing_criterion = def.choice.criterion;
   r.smoothing_criterion_value = def.choice.criterion_value;
   r.gauge_length = gauge_length(def.fit.penalty, setup.mark_spacing);
@@ -155,44 +171,73 @@ void record_parameters(AnalysisResult& r, FrameAndMesh& setup, const UndeformedF
 }
 
 AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& options, const ProgressCallback& progress) {
+  const UndeformedStages u = analyse_undeformed(grid, options, progress);
+  AnalysisResult res = analyse_deformed(u, grid, options, progress);
+  res.times.mesh = u.mesh_seconds;
+  res.times.fit += u.fit.fit_seconds;
+  res.times.project = u.fit.project_seconds;
+  return res;
+}
+
+}  // namespace
+
+UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& options,
+                                    const ProgressCallback& progress) {
+  options.validate();
+  UndeformedStages u;
+  tell(progress, AnalysisStage::kFrameAndMesh, nullptr);
+  u.marks = fit_marks(grid);
+  const auto t0 = Clock::now();
+  u.setup = build_frame_and_mesh(grid, u.marks, options.mesh);
+  u.mesh_seconds = seconds_since(t0);
+
+  tell(progress, AnalysisStage::kOutliers, &u.setup);
+  const auto to = Clock::now();
+  u.outliers = find_undeformed_outliers(u.marks, u.setup.mark_spacing, options.outliers);
+  u.outliers_seconds = seconds_since(to);
+
+  tell(progress, AnalysisStage::kUndeformedFit, &u.setup);
+  u.weights = sigma_weights(grid.sigma_undeformed, u.marks.point, options.sigma_weights);
+  u.fit =
+      fit_undeformed(u.setup, u.marks,
+                     {options.smoothing, u.outliers.undeformed, options.max_projection_iterations, u.weights.weight});
+  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel) {
+    const auto tn = Clock::now();
+    u.noise = gsa::undeformed_noise(u.setup, u.marks, u.fit);
+    u.noise_seconds = seconds_since(tn);
+  }
+  return u;
+}
+
+AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid, const AnalyseOptions& options,
+                                const ProgressCallback& progress) {
+  const FitMarks& marks = u.marks;
+  const FrameAndMesh& setup = u.setup;
+  const UndeformedFit& und = u.fit;
   AnalysisResult res;
   res.method = Method::kSurface;
   res.points.resize(static_cast<std::size_t>(grid.n_points()));
-  tell(progress, AnalysisStage::kFrameAndMesh, nullptr);
-  const FitMarks marks = fit_marks(grid);
-  const auto t0 = Clock::now();
-  FrameAndMesh setup = build_frame_and_mesh(grid, marks, options.mesh);
-  res.times.mesh = seconds_since(t0);
-
-  tell(progress, AnalysisStage::kOutliers, &setup);
   Points3 deformed_at_marks(marks.size(), 3);
   for (Index k = 0; k < marks.size(); ++k)
     deformed_at_marks.row(k) = grid.deformed.row(marks.point[static_cast<std::size_t>(k)]);
+  MarkOutliers outliers = u.outliers;
   const auto to = Clock::now();
-  MarkOutliers outliers = find_outliers(marks, deformed_at_marks, setup.mark_spacing, options.outliers);
-  res.times.outliers = seconds_since(to);
-
-  tell(progress, AnalysisStage::kUndeformedFit, &setup);
-  const UndeformedFit und = fit_undeformed(
-      setup, marks, {options.smoothing, std::move(outliers.undeformed), options.max_projection_iterations});
-  const DeformedMarks deformed = deformed_marks(grid, marks, und);
-  NoiseEstimate undeformed_noise;
-  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel) {
-    const auto tn = Clock::now();
-    undeformed_noise = gsa::undeformed_noise(setup, marks, und);
-    res.times.noise = seconds_since(tn);
-  }
+  find_deformed_outliers(marks, deformed_at_marks, setup.mark_spacing, options.outliers, outliers);
+  res.times.outliers = u.outliers_seconds + seconds_since(to);
+  res.weights_undeformed = u.weights;
+  res.weights_deformed = sigma_weights(grid.sigma_deformed, marks.point, options.sigma_weights);
+  const DeformedMarks deformed = deformed_marks(grid, marks, und, res.weights_deformed.weight);
 
   tell(progress, AnalysisStage::kDeformedFit, &setup);
   const auto tf = Clock::now();
-  const double undeformed_noise_s = res.times.noise;
+  res.times.noise = u.noise_seconds;
   DeformedProblem problem(setup, marks, und, deformed);
   // Deformed flags of marks the undeformed fit readmitted or that lack a deformed position stay as found.
-  DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise, std::move(outliers.deformed),
-                                           options, progress, res.times);
-  // The deformed stages less the noise estimate and the smoothing choice timed in them.
-  res.times.fit = und.fit_seconds + seconds_since(tf) - (res.times.noise - undeformed_noise_s) - res.times.choice;
-  res.times.project = und.project_seconds;
+  DeformedStages def = run_deformed_stages(problem, setup, marks, und, u.noise, std::move(outliers.deformed), options,
+                                           progress, res.times);
+  // The deformed stages less the noise estimate and the smoothing choice timed in them
+  // (analyse_surface adds the undeformed fit's time).
+  res.times.fit = seconds_since(tf) - (res.times.noise - u.noise_seconds) - res.times.choice;
   const DeformedResiduals residuals = deformed_residuals(problem, def.fit);
 
   tell(progress, AnalysisStage::kStrains, &setup);
@@ -200,7 +245,7 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   const SurfacePair surfaces(setup.mesh, und.parameters, def.fit.fit.parameters);
   fill_point_results(res.points, grid, marks, und, def.fit, residuals, surfaces, options);
   res.times.strain = seconds_since(ts);
-  res.noise_undeformed = undeformed_noise;
+  res.noise_undeformed = u.noise;
   res.noise = def.noise;
   res.element_multiplier = def.local.multiplier;
   res.relaxed_elements = def.local.relaxed();
@@ -215,8 +260,6 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
   record_parameters(res, setup, und, problem, def, residuals, options);
   return res;
 }
-
-}  // namespace
 
 void AnalyseOptions::validate() const {
   if (mesh.elements1 < 0) throw OptionError("mesh.elements1", "expected a count >= 0" + found(mesh.elements1));

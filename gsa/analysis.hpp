@@ -36,10 +36,20 @@
 #include "gsa/plane.hpp"
 #include "gsa/smoothing.hpp"
 #include "gsa/strain.hpp"
+#include "gsa/undeformed_fit.hpp"
+#include "gsa/weights.hpp"
 
 namespace sf::gsa {
 
 enum class Method { kSurface, kTriangles };
+
+// A deformed smoothing chosen elsewhere and taken as it is: a stage series chooses it once,
+// on one stage, for every stage (gsa/series.hpp).
+struct FixedSmoothing {
+  SmoothingChoice choice;          // penalty, passes, criterion and its optimum
+  std::vector<double> multiplier;  // local smoothing: per element (empty: 1 everywhere)
+  NoiseEstimate noise;             // the deformed noise it was chosen with (reported)
+};
 
 struct AnalyseOptions {
   Method method = Method::kSurface;
@@ -48,6 +58,11 @@ struct AnalyseOptions {
   OutlierOptions outliers;            // both fits
   int max_projection_iterations = 5;  // undeformed fit
   std::vector<double> fibre_angles;   // none, or two: degrees from the X axis on the undeformed sheet
+  // Fit weights w = (sigma_ref / sigma)^2 from the input's per-point sigma (gsa/weights.hpp);
+  // false: every mark weight 1. No effect when the input has no sigma.
+  bool sigma_weights = true;
+  // Automatic smoothing only: the deformed fit takes this choice instead of choosing one.
+  std::optional<FixedSmoothing> fixed_smoothing;
 
   // Throws OptionError naming the field (e.g. "smoothing.scale") for a value out of range.
   void validate() const;
@@ -104,6 +119,7 @@ struct AnalysisResult {
   double gauge_length = 0.0;    // effective smoothing length (units)
   double log10_delta_optimum =
       std::numeric_limits<double>::quiet_NaN();  // criterion's optimum, log10(delta / spacing^6)
+  int fit_passes = 1;                            // passes of the deformed fit (iterated Tikhonov, gsa/fit.hpp)
   std::string smoothing_criterion;               // "GCV", "Cp" (noise model) or empty (explicit weights)
   double smoothing_criterion_value = std::numeric_limits<double>::quiet_NaN();
   double rms_undeformed = 0, max_undeformed = 0, rms_deformed = 0, max_deformed = 0;
@@ -118,6 +134,7 @@ struct AnalysisResult {
   Index relaxed_elements = 0;              // elements with a multiplier below 1
   double local_gauge_length = 0.0;         // gauge length in the relaxed elements (units; 0: none)
   double noise_outliers_undeformed = 0.0, noise_outliers_deformed = 0.0;  // noise levels of the outlier checks (units)
+  SigmaWeights weights_undeformed, weights_deformed;  // fit weights from the sigmas (used = false: all 1)
 };
 
 enum class AnalysisStage { kFrameAndMesh, kOutliers, kUndeformedFit, kDeformedFit, kSmoothingChoice, kStrains };
@@ -132,6 +149,28 @@ using ProgressCallback = std::function<void(const StageStart&)>;
 // Validates the options, then runs the method. Throws sf::InputError naming the file for
 // grids that cannot be analysed (too few marks, marks on a line, a singular fit).
 AnalysisResult analyse(const GridData& grid, const AnalyseOptions& options, const ProgressCallback& progress = {});
+
+// The surface method in two parts, for a stage series (gsa/series.hpp: one undeformed
+// state, many deformed ones). analyse_undeformed() runs the stages that do not depend on
+// the deformed state (frame and mesh, undeformed outliers, undeformed fit, undeformed
+// noise); analyse_deformed() runs the rest for one deformed state of the same marks (the
+// grid's undeformed positions must be those analyse_undeformed() had). analyse() is the
+// two in a row; analyse_deformed()'s times cover its own stages only.
+struct UndeformedStages {
+  FitMarks marks;
+  FrameAndMesh setup;
+  MarkOutliers outliers;  // the undeformed flags (deformed: empty)
+  SigmaWeights weights;   // of the undeformed positions
+  UndeformedFit fit;
+  NoiseEstimate noise;  // of the undeformed fit (noise-model rule; else zero)
+  double mesh_seconds = 0.0;
+  double outliers_seconds = 0.0;  // the undeformed blunder check
+  double noise_seconds = 0.0;     // the undeformed noise estimate
+};
+UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& options,
+                                    const ProgressCallback& progress = {});
+AnalysisResult analyse_deformed(const UndeformedStages& undeformed, const GridData& grid, const AnalyseOptions& options,
+                                const ProgressCallback& progress = {});
 
 // The classical method: triangles of neighbouring marks (grid i, j when every
 // point has them, else a Delaunay triangulation in the best-fit plane), homogeneous

@@ -110,6 +110,7 @@ AnalyseOptions analyse_options(const AnalyseFlags& a) {
   if (!std::isnan(a.delta)) o.smoothing.delta = a.delta;
   o.smoothing.scale = a.smoothing_scale;
   o.outliers.sigma = a.outlier_sigma;
+  o.sigma_weights = !a.no_sigma_weights;
   if (!a.fibres.empty()) o.fibre_angles = parse_angles(a.fibres);
   validate_for_the_command_line(o);
   return o;

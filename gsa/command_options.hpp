@@ -33,6 +33,11 @@ struct AnalyseFlags {
   int sample = 0;
   bool no_plots = false;
   std::string measure = "true", size = "1200x900", view = "auto", flc;  // pictures
+  bool no_sigma_weights = false;                                        // --no-sigma-weights
+  // Stage series (gsa/series_output.hpp): --stages files/folders, or GRID --stage-column.
+  std::vector<std::string> stages;
+  std::string stage_column, reference_stage, path_ids, stage_smoothing = "once";
+  int strain_paths = 5;
 };
 
 // --method, --penalty, --mesh/--elements, --alpha.. --delta, --smoothing-scale,

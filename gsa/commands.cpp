@@ -25,6 +25,7 @@
 #include "gsa/output.hpp"
 #include "gsa/plots.hpp"
 #include "gsa/results_folder.hpp"
+#include "gsa/series_output.hpp"
 #include "gsa/synthetic.hpp"
 
 namespace sf::gsa {
@@ -131,6 +132,7 @@ PictureProgress picture_bar(bool quiet) {
 }
 
 int run_analyse(const AnalyseFlags& a, bool quiet) {
+  if (!a.stages.empty() || !a.stage_column.empty()) return run_analyse_series(a, quiet);  // gsa/series_output.cpp
   const AnalyseOptions options = analyse_options(a);
   OutputOptions output = output_options(a);  // reads the forming limit curve, with or without pictures
   output.keep_surfaces = !a.no_plots;
@@ -296,6 +298,24 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_flag("--no-local-smoothing", args->no_local_smoothing,
                      "Keep one smoothing weight everywhere (by default it is relaxed where the fit cannot follow a "
                      "localised feature such as a neck)");
+        app.add_flag("--no-sigma-weights", args->no_sigma_weights,
+                     "Fit every point with weight 1 (by default a point with an uncertainty column, e.g. sigma, "
+                     "is weighted 1/sigma^2, normalised to the median sigma)");
+        app.add_option("--stages", args->stages,
+                       "Stage series: the deformed states, one file per stage, or folders of them (natural order); "
+                       "with --undeformed REF as the reference, else each point's reference position in its first "
+                       "stage (see docs/usage.md, Stage series)");
+        app.add_option("--stage-column", args->stage_column,
+                       "Stage series in one GRID file: the column naming each row's stage");
+        app.add_option("--reference-stage", args->reference_stage,
+                       "With --stage-column: the stage whose positions are the undeformed ones");
+        app.add_option("--stage-smoothing", args->stage_smoothing,
+                       "Stage series: choose the automatic smoothing once, on the last stage (default), or on each "
+                       "stage ('each'; slower)");
+        app.add_option("--strain-paths", args->strain_paths,
+                       "Stage series: draw the strain paths of the N highest-strain points (default 5; 0: none)");
+        app.add_option("--path-ids", args->path_ids,
+                       "Stage series: draw the strain paths of these point ids (comma separated) instead");
         app.add_option("--sample", args->sample, "Also write samples.csv with fields on N x N points per element");
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);

@@ -31,7 +31,8 @@ std::optional<Mat3> polar_rotation(const Mat3& f) {
 
 }  // namespace
 
-DeformedMarks deformed_marks(const GridData& grid, const FitMarks& marks, const UndeformedFit& undeformed) {
+DeformedMarks deformed_marks(const GridData& grid, const FitMarks& marks, const UndeformedFit& undeformed,
+                             const VecX& weight) {
   const Index m = marks.size();
   DeformedMarks out;
   out.position.resize(m, 3);
@@ -39,10 +40,11 @@ DeformedMarks deformed_marks(const GridData& grid, const FitMarks& marks, const 
   for (Index k = 0; k < m; ++k) {
     const Index p = marks.point[static_cast<std::size_t>(k)];
     out.position.row(k) = grid.deformed.row(p);
-    if (undeformed.weight[k] > 0 && grid.has_deformed(p)) out.weight[k] = 1.0;
+    if (undeformed.weight[k] > 0 && grid.has_deformed(p)) out.weight[k] = weight.size() == m ? weight[k] : 1.0;
   }
-  if (out.weight.sum() < 6)
-    throw InputError(marks.source + ": only " + std::to_string(static_cast<long>(out.weight.sum())) +
+  const auto both = (out.weight.array() > 0).count();
+  if (both < 6)
+    throw InputError((grid.sources.empty() ? marks.source : grid.sources.back()) + ": only " + std::to_string(both) +
                      " points have both positions; at least 6 are needed");
   return out;
 }
@@ -169,7 +171,7 @@ void readmit_deformed(DeformedProblem& problem, DeformedFit& fit) {
   // Distance of each flagged mark as digitised from the surface at its material point.
   const VecX residual = (fit.fit.fitted - MatX(problem.position())).rowwise().norm();
   const std::vector<OutlierFlag> back = take_readmitted(fit.flags, residual);
-  for (const OutlierFlag& f : back) problem.set_weight(f.mark, 1.0);
+  for (const OutlierFlag& f : back) problem.set_weight(f.mark, problem.base_weight(f.mark));
   if (!back.empty()) fit.fit = problem.fit(fit.penalty, fit.passes);
 }
 

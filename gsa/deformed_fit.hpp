@@ -37,10 +37,13 @@ namespace sf::gsa {
 // The deformed positions of the fit's marks.
 struct DeformedMarks {
   Points3 position;  // m x 3 (NaN where not digitised)
-  VecX weight;       // m: 1 where the mark has a deformed position and took part in the undeformed fit
+  VecX weight;       // m: its base weight (1, or from its sigma) where the mark has a deformed position and
+                     // took part in the undeformed fit; else 0
 };
+// `weight`: m base weights of the deformed positions (gsa/weights.hpp); empty: all 1.
 // Throws sf::InputError naming the file when fewer than 6 marks have both positions.
-DeformedMarks deformed_marks(const GridData& grid, const FitMarks& marks, const UndeformedFit& undeformed);
+DeformedMarks deformed_marks(const GridData& grid, const FitMarks& marks, const UndeformedFit& undeformed,
+                             const VecX& weight = VecX());
 
 // The deformed fit's data, reference and least-squares system for the current weights.
 // Holds references to its arguments: they must outlive it.
@@ -56,8 +59,10 @@ class DeformedProblem {
   // mark is left out, else the polar rotation of the deformation of `deformed`
   // (n_dofs x 3) at the mark.
   void carry_residuals(const MatX* deformed);
-  // Leaves mark k out (weight 0) or takes it in (1); the next fit rebuilds the system.
+  // Leaves mark k out (weight 0) or takes it in (its base weight, DeformedMarks::weight);
+  // the next fit rebuilds the system.
   void set_weight(Index k, double weight);
+  double base_weight(Index k) const { return deformed_.weight[k]; }
   // Fits the current data; throws sf::InputError naming the file when the system is singular.
   FitResult fit(const Penalty& penalty, int passes);
   // Two penalties at once (on two threads), with trace_probes Hutchinson probes for the

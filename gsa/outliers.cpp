@@ -31,32 +31,53 @@ std::string describe(const OutlierFlag& f, double sigma, const std::string& unit
                      units, f.threshold, units, sigma, f.noise, units);
 }
 
-MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
-                           const OutlierOptions& options) {
-  const Index m = marks.size();
+namespace {
+BlunderOptions blunder_options(double mark_spacing, const OutlierOptions& options) {
   BlunderOptions bo;
   bo.threshold = options.sigma;
   bo.isolation = options.isolation;
   bo.neighbours = options.neighbours;
   bo.floor = options.floor * mark_spacing;
+  return bo;
+}
+}  // namespace
+
+MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options) {
+  const Index m = marks.size();
   MarkOutliers out;
   const std::vector<bool> all(static_cast<std::size_t>(m), true);
-  const BlunderCheck u = find_blunders(marks.undeformed, marks.undeformed, all, true, bo);
+  const BlunderCheck u =
+      find_blunders(marks.undeformed, marks.undeformed, all, true, blunder_options(mark_spacing, options));
   out.noise_undeformed = u.noise;
-  std::vector<bool> usable(static_cast<std::size_t>(m));
   for (Index k = 0; k < m; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     if (u.flagged[kk])
       out.undeformed.push_back({k, OutlierReason::kUndeformedOffNeighbours, u.deviation[kk], u.threshold, u.noise});
-    usable[kk] = !u.flagged[kk] && deformed.row(k).allFinite();
   }
-  const BlunderCheck d = find_blunders(marks.undeformed, deformed, usable, false, bo);
+  return out;
+}
+
+void find_deformed_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
+                            const OutlierOptions& options, MarkOutliers& out) {
+  const Index m = marks.size();
+  std::vector<bool> usable(static_cast<std::size_t>(m));
+  for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = deformed.row(k).allFinite();
+  for (const OutlierFlag& f : out.undeformed) usable[static_cast<std::size_t>(f.mark)] = false;
+  const BlunderCheck d =
+      find_blunders(marks.undeformed, deformed, usable, false, blunder_options(mark_spacing, options));
   out.noise_deformed = d.noise;
+  out.deformed.clear();
   for (Index k = 0; k < m; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     if (d.flagged[kk])
       out.deformed.push_back({k, OutlierReason::kDeformedOffNeighbours, d.deviation[kk], d.threshold, d.noise});
   }
+}
+
+MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
+                           const OutlierOptions& options) {
+  MarkOutliers out = find_undeformed_outliers(marks, mark_spacing, options);
+  find_deformed_outliers(marks, deformed, mark_spacing, options, out);
   return out;
 }
 

@@ -58,6 +58,12 @@ struct MarkOutliers {
 // deformed: m x 3 deformed positions of the marks (NaN where not digitised).
 MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
                            const OutlierOptions& options);
+// The two halves of find_outliers, for a stage series (one undeformed state, many deformed
+// ones): the undeformed flags (deformed left empty), then a deformed state's flags against
+// them (`out.undeformed` kept; `out.deformed` and `out.noise_deformed` replaced).
+MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options);
+void find_deformed_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
+                            const OutlierOptions& options, MarkOutliers& out);
 
 // Removes from `flags` the marks whose residual (distance from the final surface, which
 // they took no part in) is within their threshold, and returns them.

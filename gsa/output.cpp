@@ -239,6 +239,23 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
         {"relaxed_elements", r.relaxed_elements},
         {"local_gauge_length", r.relaxed_elements > 0 ? nlohmann::json(r.local_gauge_length) : nullptr}};
     params["smoothing"] = smoothing;
+    auto weights = [](const SigmaWeights& w) {
+      if (!w.used) return nlohmann::json{{"used", false}};
+      return nlohmann::json{{"used", true},
+                            {"sigma_ref", w.sigma_ref},
+                            {"points_with_sigma", w.n_with_sigma},
+                            {"points_at_floor", w.n_floored},
+                            {"points_left_out", w.n_left_out},
+                            {"min_weight", w.min_weight},
+                            {"max_weight", w.max_weight}};
+    };
+    params["weights"] = {
+        {"rule",
+         "w = (sigma_ref / sigma)^2 from the input's per-point sigma, sigma_ref = median sigma (equal sigmas: "
+         "the unweighted fit); weight 1 where a point has no sigma; sigma below 0.01 sigma_ref counts as that; weight "
+         "below 1e-6 is 0 (left out); --no-sigma-weights: all 1"},
+        {"undeformed", weights(r.weights_undeformed)},
+        {"deformed", weights(r.weights_deformed)}};
     if (r.noise.sigma_total() > 0 || r.noise_undeformed.sigma_total() > 0) {
       auto model = [](const NoiseEstimate& e) {
         return nlohmann::json{{"sigma_correlated", e.sigma_correlated},

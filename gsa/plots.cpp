@@ -474,6 +474,34 @@ render::ChartSeries reference_line(double k, StrainMeasure m, const std::string&
   return s;
 }
 
+// Stage series: each path as a line through its stages with a dot at its last stage.
+void add_strain_paths(const std::vector<StrainPath>& paths, render::Chart& chart) {
+  static const render::Colour kPathColours[] = {{0.90, 0.50, 0.00}, {0.00, 0.60, 0.50}, {0.80, 0.10, 0.10},
+                                                {0.35, 0.20, 0.70}, {0.55, 0.35, 0.10}, {0.10, 0.45, 0.80}};
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const StrainPath& p = paths[i];
+    render::ChartSeries line, end;
+    line.style = render::ChartSeries::Style::kLine;
+    line.colour = end.colour = kPathColours[i % std::size(kPathColours)];
+    line.size_px = 2.5;
+    end.size_px = 6;
+    line.x = p.minor;
+    line.y = p.major;
+    for (std::size_t k = p.major.size(); k-- > 0;)
+      if (std::isfinite(p.major[k]) && std::isfinite(p.minor[k])) {
+        end.x = {p.minor[k]};
+        end.y = {p.major[k]};
+        break;
+      }
+    line.label = i < 8 ? "path of " + p.id : "";
+    chart.series.push_back(std::move(line));
+    chart.series.push_back(std::move(end));
+  }
+  if (!paths.empty())
+    chart.footnote += " Lines: strain paths through the " + std::to_string(paths.front().major.size()) +
+                      " stages (strain_paths.csv), a dot at the last.";
+}
+
 render::Chart principal_chart(const Results& r, PlotSummary& summary) {
   const MarkStrains& ms = r.marks;
   const FormingLimitCurve* flc = r.flc ? &*r.flc : nullptr;
@@ -538,6 +566,7 @@ render::Chart principal_chart(const Results& r, PlotSummary& summary) {
                    std::string(flc ? " Forming limit curve from " + fs::path(flc->source).filename().string() +
                                          ", in " + w + " strain."
                                    : "");
+  add_strain_paths(r.strain_paths, chart);
   return chart;
 }
 

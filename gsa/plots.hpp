@@ -63,6 +63,7 @@ struct PlotData {
   MarkStrains marks;                             // every mark's principal strains in `measure`
   std::optional<FormingLimitCurve> flc;          // drawn in the principal strain plot (in `measure`)
   std::optional<FlcMargins> margins;             // of the marks against it
+  std::vector<StrainPath> strain_paths;          // stage series: paths drawn on the principal strain plot
 };
 // From a results folder read back.
 PlotData plot_data(ResultsFolder folder, StrainMeasure measure);

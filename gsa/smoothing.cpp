@@ -115,7 +115,7 @@ BracketMinimum bracket_search(const PairScore& score_pair, double tolerance, dou
 double weighted_rss(const FitResult& f, const VecX& w) {
   double rss = 0.0;
   for (Index k = 0; k < w.size(); ++k)
-    if (w[k] > 0) rss += f.residual[k] * f.residual[k];
+    if (w[k] > 0) rss += w[k] * f.residual[k] * f.residual[k];  // weights 1 without sigmas
   return rss;
 }
 

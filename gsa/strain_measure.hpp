@@ -36,4 +36,11 @@ struct MarkStrains {
 };
 MarkStrains mark_strains(const AnalysisResult& result, StrainMeasure m);
 
+// The path of one point through the stages of a series (gsa/series.hpp), in a measure.
+struct StrainPath {
+  Index point = -1;
+  std::string id;
+  std::vector<double> major, minor;  // one per stage; NaN where the point has no strain
+};
+
 }  // namespace sf::gsa

@@ -47,13 +47,15 @@ double project_marks(const FrameAndMesh& setup, const FitMarks& marks, const Mat
 }
 
 // Noise estimate from a light fit's normal residuals, corrected for the fitted degrees of
-// freedom; NaN when the marks do not outnumber the unknowns enough.
+// freedom; NaN when the marks do not outnumber the unknowns enough. With weights from
+// the marks' sigmas (w = (sigma_ref / sigma)^2) the weighted sum estimates the noise of a
+// mark of weight 1; without, the weights are 1 and this is the plain estimate.
 double estimate_noise(const FitResult& fit, const VecX& weight, Index n_dofs) {
-  const double n_used = weight.sum();
+  double n_used = 0.0;
   const double dofs = static_cast<double>(n_dofs);
   double rss = 0.0;
   for (Index k = 0; k < weight.size(); ++k)
-    if (weight[k] > 0) rss += fit.residual[k] * fit.residual[k];
+    if (weight[k] > 0) rss += weight[k] * fit.residual[k] * fit.residual[k], n_used += 1.0;
   if (!(n_used > 1.2 * dofs)) return std::numeric_limits<double>::quiet_NaN();
   return std::sqrt(rss / (n_used - dofs));  // normal residuals: one component
 }
@@ -66,7 +68,8 @@ UndeformedFit fit_undeformed(const FrameAndMesh& setup, const FitMarks& marks, c
   const bool automatic = options.smoothing.automatic();
   UndeformedFit out;
   out.location = setup.start;
-  out.weight = VecX::Ones(marks.size());
+  const VecX base = options.weight.size() == marks.size() ? options.weight : VecX::Ones(marks.size());
+  out.weight = base;
   out.flags = options.outliers;
   for (const OutlierFlag& f : out.flags) out.weight[f.mark] = 0.0;
   out.penalty = penalty_for_noise(options.smoothing, 0.0, d);
@@ -99,7 +102,7 @@ UndeformedFit fit_undeformed(const FrameAndMesh& setup, const FitMarks& marks, c
     }
     if (round == 2) break;
     const std::vector<OutlierFlag> back = take_readmitted(out.flags, fit.residual);
-    for (const OutlierFlag& f : back) out.weight[f.mark] = 1.0;
+    for (const OutlierFlag& f : back) out.weight[f.mark] = base[f.mark];
     if (back.empty()) break;
   }
   out.parameters = fit.parameters;

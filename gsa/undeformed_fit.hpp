@@ -25,13 +25,14 @@ struct UndeformedFitOptions {
   SmoothingOptions smoothing;
   std::vector<OutlierFlag> outliers;  // undeformed flags (find_outliers): left out unless readmitted
   int max_projection_iterations = 5;  // fit-and-project rounds per outer round (>= 1)
+  VecX weight;                        // m: base weight of each mark (gsa/weights.hpp, from its sigma); empty: all 1
 };
 
 struct UndeformedFit {
   MatX parameters;                     // n_dofs x 3: the fitted surface X(xi)
   std::vector<MeshLocation> location;  // m: each mark's material coordinate (element, xi)
   VecX residual;                       // m: distance of each mark from X at its location (units)
-  VecX weight;                         // m: 1 where the mark took part, 0 where flagged
+  VecX weight;                         // m: its base weight where the mark took part (1 without sigma), 0 where flagged
   std::vector<OutlierFlag> flags;      // the marks left out (not readmitted), with reasons
   double rms = 0.0, max = 0.0;         // residuals over the marks that took part
   Penalty penalty;                     // the weights of the final fit

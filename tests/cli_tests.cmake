@@ -138,6 +138,46 @@ sf_gsa_cli_test(analyse_bad_method
 sf_gsa_cli_test(no_subcommand COMMAND EXIT 2)
 sf_gsa_cli_test(synth_unknown_case COMMAND synth nosuchcase --out ${SF_CLI_DIR}/x.csv EXIT 2 STDERR "nosuchcase")
 
+# Stage series (docs/usage.md, Stage series): a folder of GOM stage files, a stage column,
+# and bad series (a missing stage file, stages of another part) with clear messages.
+set(sf_series ${SF_CLI_DIR}/series)
+sf_gsa_cli_test(series_gom_folder
+  COMMAND analyse --stages data/formats/gom_series --no-plots --out ${sf_series}/gom
+  REMOVE ${sf_series}/gom
+  STDERR "stage 3/3 surface-1_10.000s: 47 of 49 points analysed \\(2 not measured in this stage\\)"
+  EXISTS "${sf_series}/gom/series.pvd|${sf_series}/gom/series_strains.csv|${sf_series}/gom/stages/stage_000.vtp|${sf_series}/gom/stages/stage_002.vtp|${sf_series}/gom/strain_paths.csv|${sf_series}/gom/strains.csv|${sf_series}/gom/summary.json")
+sf_gsa_cli_test(series_stage_column
+  COMMAND analyse data/formats/stage_column.csv --stage-column stage --reference-stage 0 --no-plots
+          --out ${sf_series}/column
+  REMOVE ${sf_series}/column
+  STDERR "2 stages.*stage 2/2 10: 49 of 49 points analysed"
+  EXISTS "${sf_series}/column/series.pvd|${sf_series}/column/series_strains.csv")
+sf_gsa_cli_test(series_missing_stage_file
+  COMMAND analyse --stages data/formats/gom_series/surface-1_0.000s.csv data/formats/gom_series/nope.csv --no-plots
+          --out ${sf_series}/missing
+  EXIT 1
+  STDERR "nope\\.csv.*no such file"
+  ABSENT ${sf_series}/missing)
+file(WRITE ${sf_series}/bad/s1.csv
+  "id,X,Y,Z,x,y,z\na,0,0,0,0,0,0\nb,1,0,0,1.1,0,0\nc,2,0,0,2.2,0,0\nd,0,1,0,0,1,0\ne,1,1,0,1.1,1,0\nf,2,1,0,2.2,1,0\ng,0,2,0,0,2,0\nh,1,2,0,1.1,2,0\ni,2,2,0,2.2,2,0\n")
+file(WRITE ${sf_series}/bad/s2.csv
+  "id,X,Y,Z,x,y,z\np,0,0,0,0,0,0\nq,1,0,0,1.1,0,0\nr,2,0,0,2.2,0,0\ns,0,1,0,0,1,0\nt,1,1,0,1.1,1,0\nu,2,1,0,2.2,1,0\nv,0,2,0,0,2,0\nw,1,2,0,1.1,2,0\nx,2,2,0,2.2,2,0\n")
+sf_gsa_cli_test(series_stage_of_another_part
+  COMMAND analyse --stages ${sf_series}/bad/s1.csv ${sf_series}/bad/s2.csv --no-plots --out ${sf_series}/other
+  EXIT 1
+  STDERR "s2\\.csv: 9 of its 9 point ids are not in the first stage file"
+  STDERR_NOT "internal error"
+  ABSENT ${sf_series}/other)
+sf_gsa_cli_test(series_stage_ids_not_in_reference
+  COMMAND analyse --undeformed ${sf_series}/bad/s1.csv --stages ${sf_series}/bad/s2.csv --no-plots
+          --out ${sf_series}/other_ref
+  EXIT 1
+  STDERR "s2\\.csv:2:1: id 'p'.*is not in the reference"
+  ABSENT ${sf_series}/other_ref)
+sf_gsa_cli_test(series_bad_stage_smoothing
+  COMMAND analyse --stages data/formats/gom_series --stage-smoothing sometimes --no-plots --out ${sf_series}/bad_flag
+  EXIT 2 STDERR "--stage-smoothing" ABSENT ${sf_series}/bad_flag)
+
 # ---------------------------------------------------------------- samples in data/
 
 file(GLOB sf_sample_dirs LIST_DIRECTORIES true ${PROJECT_SOURCE_DIR}/data/gsa/*)

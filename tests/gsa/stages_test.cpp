@@ -123,7 +123,8 @@ TEST(GsaStages, OutlierFlagsCarryReasonDeviationThresholdAndNoise) {
     EXPECT_GT(f.deviation, 1.0);  // about the 2 mm offset
     EXPECT_NE(describe(f, o.outliers.sigma, "mm").find("threshold"), std::string::npos);
   }
-  const UndeformedFit und = fit_undeformed(setup, marks, {o.smoothing, found.undeformed, o.max_projection_iterations});
+  const UndeformedFit und =
+      fit_undeformed(setup, marks, {o.smoothing, found.undeformed, o.max_projection_iterations, {}});
   const DeformedMarks data = deformed_marks(grid, marks, und);
   DeformedProblem problem(setup, marks, und, data);
   const double d = setup.mark_spacing;

@@ -17,6 +17,7 @@
 #include "common/io/grid_file.hpp"
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/batch_command.hpp"
 #include "gsa/command_options.hpp"
 #include "gsa/digitise/commands.hpp"
 #include "gsa/grid.hpp"
@@ -340,6 +341,7 @@ void register_commands(sf::cli::Program& program) {
   add_analyse_command(program);
   add_plot_command(program);
   add_synth_command(program);
+  add_batch_command(program);            // gsa/batch_command.cpp (docs/batch.md)
   digitise::register_commands(program);  // calibrate, digitise, synth-images (docs/digitise.md)
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},

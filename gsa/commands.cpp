@@ -17,6 +17,7 @@
 #include "common/io/grid_file.hpp"
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/batch_command.hpp"
 #include "gsa/command_options.hpp"
 #include "gsa/compare_command.hpp"
 #include "gsa/digitise/commands.hpp"
@@ -362,6 +363,7 @@ void register_commands(sf::cli::Program& program) {
   add_plot_command(program);
   add_synth_command(program);
   add_compare_command(program);          // gsa/compare.hpp
+  add_batch_command(program);            // gsa/batch_command.cpp (docs/batch.md)
   digitise::register_commands(program);  // calibrate, digitise, synth-images (docs/digitise.md)
   program.add_command(
       "info", "Print version and build information", [](CLI::App&) {},

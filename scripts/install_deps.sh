@@ -8,6 +8,8 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopencv-dev libcgal-dev libvtk9-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   libyaml-cpp-dev libfmt-dev xvfb xauth
+  pybind11-dev python3-dev python3-numpy  # the Python module `sheetform` (python/, docs/python.md)
+  dpkg-dev file  # cpack -G DEB: dpkg-shlibdeps finds the runtime packages of the .deb (docs/install.md)
   libopenblas0-serial  # optimised BLAS under CHOLMOD (reference BLAS is ~10x slower; serial: no spinning threads)
 )
 

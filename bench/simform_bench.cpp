@@ -3,6 +3,9 @@
 // a timed test.
 //
 //   build/bin/simform_bench [max_elements_per_side=40] [repeats=3]
+//   build/bin/simform_bench --factorisation N PLIES [repeats]   (orderings, CHOLMOD variants)
+//   build/bin/simform_bench --case N PLIES [repeats]            (one line of the table)
+//   build/bin/simform_bench --shear-stretch CASE.yaml
 //
 // For n x n bricks per ply (n = 10, 20, 40) and 1 or 4 plies (100 x 100 x 0.25 mm,
 // compressible transversely isotropic law, fibres 0/90/0/90, stacked as separate bodies:
@@ -21,7 +24,8 @@
 //   kern_GF, fact_GF GFLOP/s of the kernel (flops counted from the algorithm,
 //                    BrickKernel::tangent_flops) and of the factorisation (CHOLMOD's count)
 //   newton, static_s Newton iterations and wall time of the whole static solve (stretch
-//                    in one load step)
+//                    in two load steps sharing one TangentWorkspace, as a run's steps do)
+//   layouts          times the pattern was laid out in that solve (1: kept across steps)
 //   peak_MB          peak resident memory of the case's process
 // Times are medians over `repeats` repetitions, wall clock, seconds. The first line says
 // how many threads the element loop uses and which vector instructions the kernel runs.
@@ -95,7 +99,30 @@ TransverselyIsotropicParams ply_law() {
   return tp;
 }
 
-int run_case(int n, int plies, int repeats) {
+// Factorisations of K_ff of one case by ordering and CHOLMOD variant: flops, time, GFLOP/s.
+void factorisation_study(const linalg::SparseMatrix& k, int repeats) {
+  std::printf("# factorisation of K_ff (n %ld, nnz of the lower triangle %ld) by ordering; BLAS: %s\n",
+              static_cast<long>(k.rows()), static_cast<long>(k.nonZeros()), linalg::blas_description().c_str());
+  std::printf("%-20s %-8s %9s %9s %9s %8s\n", "solver", "ordering", "analyse_s", "GFLOP", "fact_s", "GFLOP/s");
+  for (linalg::SolverKind kind : {linalg::SolverKind::kCholmod, linalg::SolverKind::kCholmodSimplicial})
+    for (linalg::Ordering o :
+         {linalg::Ordering::kDefault, linalg::Ordering::kAmd, linalg::Ordering::kMetis, linalg::Ordering::kNesdis}) {
+      linalg::LinearSolver solver(kind, linalg::MatrixProperty::kSymmetricPositiveDefinite);
+      solver.set_ordering(o);
+      const linalg::SolveReport first = solver.factorize(k);
+      if (!first.ok()) {
+        std::printf("%-20s %-8s failed: %s\n", linalg::to_string(kind).c_str(), linalg::to_string(o).c_str(),
+                    first.brief().c_str());
+        continue;
+      }
+      const double fact_s = median_time(repeats, [&] { solver.factorize(k); });
+      std::printf("%-20s %-8s %9.3f %9.2f %9.3f %8.2f\n", linalg::to_string(kind).c_str(), linalg::to_string(o).c_str(),
+                  first.analyze_seconds, first.factor_flops / 1e9, fact_s, first.factor_flops / fact_s / 1e9);
+      std::fflush(stdout);
+    }
+}
+
+int run_case(int n, int plies, int repeats, bool study = false) {
   Model model;
   for (int k = 0; k < plies; ++k) {
     PlyMesh ply(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, k * kH), Vec3::UnitX(), Vec3::UnitY(), kL, kL, n, n), kH,
@@ -135,6 +162,11 @@ int run_case(int n, int plies, int repeats) {
   auto t0 = std::chrono::steady_clock::now();
   linalg::PatternAssembler pattern = model.make_pattern(is_free, solver.lower());
   const double layout_s = seconds_since(t0);
+  if (study) {
+    if (!model.assemble_into(x, InteractionContext{}, &pattern).ok) return 1;
+    factorisation_study(pattern.matrix(), repeats);
+    return 0;
+  }
 
   // Kernels alone: the model's loop without the writing (same threads, same buffers).
   const std::vector<linalg::ElementEntries>& entries = model.element_entries();
@@ -184,16 +216,26 @@ int run_case(int n, int plies, int repeats) {
   });
   const double iter_s = asm_s + resid_s + fact_s + solve_s;
 
+  // The stretch in two load steps, as a run takes them: one workspace (pattern, scatter
+  // tables, symbolic factorisation) for both, so the second step lays nothing out.
+  StaticOptions so;
+  so.workspace = std::make_shared<TangentWorkspace>();
+  std::vector<PrescribedDof> half = bcs;
+  for (PrescribedDof& p : half) p.value = 0.5 * (p.value + X(p.dof));
   t0 = std::chrono::steady_clock::now();
-  const StaticResult res = solve_static(model, X, bcs, VecX());
+  const StaticResult res1 = solve_static(model, X, half, VecX(), so);
+  const StaticResult res = solve_static(model, res1.positions, bcs, VecX(), so);
   const double static_s = seconds_since(t0);
-  if (!res.report.ok()) std::printf("# static solve: %s\n", res.report.brief().c_str());
+  if (!res1.report.ok()) std::printf("# static solve, step 1: %s\n", res1.report.brief().c_str());
+  if (!res.report.ok()) std::printf("# static solve, step 2: %s\n", res.report.brief().c_str());
+  const int newton = res1.report.total_iterations + res.report.total_iterations;
 
   const double kern_gf = n_el * model.kernel().tangent_flops() / kernel_s / 1e9;
-  std::printf("%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %8.2f %8.1f\n", n,
-              n, plies, static_cast<long>(nd), static_cast<long>(pattern.n_active()), layout_s, kernel_s,
-              asm_s - kernel_s, resid_s, analyse_s, fact_s, solve_s, iter_s, kern_gf, flops / fact_s / 1e9,
-              res.report.total_iterations, static_s, peak_mb());
+  std::printf(
+      "%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %7d %8.2f %8.1f\n", n, n,
+      plies, static_cast<long>(nd), static_cast<long>(pattern.n_active()), layout_s, kernel_s, asm_s - kernel_s,
+      resid_s, analyse_s, fact_s, solve_s, iter_s, kern_gf, flops / fact_s / 1e9, newton, so.workspace->layouts(),
+      static_s, peak_mb());
   std::fflush(stdout);
   return 0;
 }
@@ -239,6 +281,8 @@ int main(int argc, char** argv) {
   try {
     if (argc >= 4 && std::strcmp(argv[1], "--case") == 0)
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);
+    if (argc >= 4 && std::strcmp(argv[1], "--factorisation") == 0)
+      return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3, true);
     if (argc >= 3 && std::strcmp(argv[1], "--shear-stretch") == 0) return run_shear_stretch(argv[2]);
     const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
     const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
@@ -249,15 +293,15 @@ int main(int argc, char** argv) {
         kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
     std::printf(
         "# element loop on %d threads (OpenMP), kernel vector instructions: %s (processor's best: %s); "
-        "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n",
+        "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n# BLAS: %s\n",
         omp_get_max_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
-        linalg::to_string(linalg::best_kernel_isa()).c_str());
+        linalg::to_string(linalg::best_kernel_isa()).c_str(), linalg::blas_description().c_str());
     std::printf(
         "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
         repeats);
-    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %8s %8s\n", "n x n", "plies", "n_dofs",
+    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %7s %8s %8s\n", "n x n", "plies", "n_dofs",
                 "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s", "iter_s",
-                "kern_GF", "fact_GF", "newton", "static_s", "peak_MB");
+                "kern_GF", "fact_GF", "newton", "layouts", "static_s", "peak_MB");
     std::fflush(stdout);
     const std::string self = argv[0];
     for (int n : {10, 20, 40}) {

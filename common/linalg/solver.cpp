@@ -5,9 +5,15 @@
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <limits>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
 #include <utility>
 
 #include "common/core/error.hpp"
@@ -64,6 +70,50 @@ class Backend {
   virtual bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const = 0;
   // Flops of one numeric factorisation with the current analysis (0: unknown).
   virtual double factor_flops() const { return 0.0; }
+  // Fill-reducing ordering of the next analysis (back ends with a choice).
+  virtual void set_ordering(Ordering) {}
+};
+
+// OpenBLAS's thread control, looked up at run time (any BLAS may be installed as
+// libblas.so.3): null when the BLAS is not OpenBLAS.
+struct OpenBlas {
+  void (*set_num_threads)(int) = nullptr;
+  int (*get_parallel)() = nullptr;  // 0 sequential, 1 pthreads, 2 OpenMP
+  char* (*get_config)() = nullptr;
+  OpenBlas() {
+    set_num_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+    get_parallel = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+    get_config = reinterpret_cast<char* (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_config"));
+  }
+  bool threaded() const { return set_num_threads && get_parallel && get_parallel() != 0; }
+};
+
+const OpenBlas& openblas() {
+  static const OpenBlas o;
+  return o;
+}
+
+std::atomic<int> g_factor_threads{0};
+
+// Serialises the BLAS-calling (supernodal) factorisations and solves; while held, the
+// BLAS runs on factorisation_threads() threads, and on one after.
+class BlasSection {
+ public:
+  BlasSection() : lock_(mutex()) {
+    if (openblas().threaded()) openblas().set_num_threads(factorisation_threads());
+  }
+  ~BlasSection() {
+    if (openblas().threaded()) openblas().set_num_threads(1);
+  }
+  BlasSection(const BlasSection&) = delete;
+  BlasSection& operator=(const BlasSection&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
 };
 
 #if SF_LINALG_HAVE_SUITESPARSE
@@ -79,7 +129,21 @@ class CholmodLlt : public Wrapper {
 template <class Wrapper>
 class CholmodBackend final : public Backend {
  public:
-  explicit CholmodBackend(bool ldlt = false) : ldlt_(ldlt) { llt_.cholmod().print = 0; }  // report through SolveReport
+  CholmodBackend(bool ldlt, bool supernodal) : ldlt_(ldlt), supernodal_(supernodal) {
+    llt_.cholmod().print = 0;  // report through SolveReport
+  }
+
+  void set_ordering(Ordering ordering) override {
+    cholmod_common& c = llt_.cholmod();
+    if (ordering == Ordering::kDefault) {
+      c.nmethods = 0;
+      return;
+    }
+    c.nmethods = 1;
+    c.method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD
+                           : ordering == Ordering::kMetis ? CHOLMOD_METIS
+                                                          : CHOLMOD_NESDIS;
+  }
 
   Outcome analyze(const SparseMatrix& a) override {
     llt_.analyzePattern(a);
@@ -94,7 +158,12 @@ class CholmodBackend final : public Backend {
   double factor_flops() const override { return flops_; }
 
   Outcome factorize(const SparseMatrix& a) override {
-    llt_.factorize(a);
+    if (supernodal_) {
+      const BlasSection blas;
+      llt_.factorize(a);
+    } else {
+      llt_.factorize(a);
+    }
     if (llt_.info() == Eigen::Success) return {};
     const int status = llt_.cholmod().status;
     if (status < CHOLMOD_OK) {
@@ -113,13 +182,19 @@ class CholmodBackend final : public Backend {
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
-    x = llt_.solve(b);
+    if (supernodal_) {
+      const BlasSection blas;
+      x = llt_.solve(b);
+    } else {
+      x = llt_.solve(b);
+    }
     return llt_.info() == Eigen::Success;
   }
 
  private:
   CholmodLlt<Wrapper> llt_;
   bool ldlt_ = false;
+  bool supernodal_ = false;
   double flops_ = 0.0;
 };
 
@@ -228,11 +303,11 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
   switch (kind) {
 #if SF_LINALG_HAVE_SUITESPARSE
     case SolverKind::kCholmod:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>>>();
+      return std::make_unique<CholmodBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>>>(false, true);
     case SolverKind::kCholmodSimplicial:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>();
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>(false, false);
     case SolverKind::kCholmodLdlt:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true);
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true, false);
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif
@@ -306,6 +381,57 @@ bool reads_lower_triangle(SolverKind kind) {
   }
 }
 
+std::string to_string(Ordering ordering) {
+  switch (ordering) {
+    case Ordering::kDefault:
+      return "default";
+    case Ordering::kAmd:
+      return "amd";
+    case Ordering::kMetis:
+      return "metis";
+    case Ordering::kNesdis:
+      return "nesdis";
+  }
+  return "unknown";
+}
+
+Ordering parse_ordering(const std::string& name, const std::string& where) {
+  for (Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis})
+    if (name == to_string(o)) return o;
+  std::string message =
+      fmt::format("unknown fill-reducing ordering '{}' (expected one of: default, amd, metis, nesdis)", name);
+  if (!where.empty()) message = where + ": " + message;
+  throw InputError(message);
+}
+
+void set_factorisation_threads(int threads) {
+  SF_ASSERT(threads >= 0, "factorisation threads must be >= 0");
+  g_factor_threads.store(threads);
+}
+
+int factorisation_threads() {
+  const int n = g_factor_threads.load();
+  if (n > 0) return n;
+  // As OpenMP counts them: OMP_NUM_THREADS when set (its first entry), else the cores.
+  if (const char* env = std::getenv("OMP_NUM_THREADS")) {
+    const int k = std::atoi(env);
+    if (k > 0) return k;
+  }
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+std::string blas_description() {
+  const OpenBlas& o = openblas();
+  if (!o.get_config) return "a BLAS other than OpenBLAS (threads not controlled)";
+  std::string out = o.get_config();
+  if (o.threaded())
+    out += fmt::format(" ({}, {} thread{} per factorisation)", o.get_parallel() == 2 ? "OpenMP" : "pthreads",
+                       factorisation_threads(), factorisation_threads() == 1 ? "" : "s");
+  else
+    out += " (sequential: 1 thread per factorisation)";
+  return out;
+}
+
 std::string to_string(MatrixProperty property) {
   switch (property) {
     case MatrixProperty::kSymmetricPositiveDefinite:
@@ -348,6 +474,7 @@ struct LinearSolver::Impl {
   // compare against, and the matrix UMFPACK reads during solve().
   SparseMatrix matrix;
   bool analysed = false;
+  Ordering ordering = Ordering::kDefault;
   SolveReport report;
 
   // Starts a fresh report for `a`; false (and a kFailed report) if a is not square.
@@ -416,6 +543,22 @@ const SolveReport& LinearSolver::analyze_pattern(const SparseMatrix& a) {
     im.report.message = "pattern analysed; not factorised yet";
   }
   return im.report;
+}
+
+void LinearSolver::set_ordering(Ordering ordering) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  if (impl_->ordering == ordering) return;
+  impl_->ordering = ordering;
+  impl_->backend->set_ordering(ordering);
+  impl_->analysed = false;
+  impl_->report = SolveReport{};
+  impl_->report.used = impl_->kind;
+  impl_->report.message = "nothing factorised yet";
+}
+
+Ordering LinearSolver::ordering() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->ordering;
 }
 
 const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {

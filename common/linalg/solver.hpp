@@ -59,6 +59,30 @@ bool solver_available(SolverKind kind);
 // ones), so a matrix stored as its lower triangle may be passed.
 bool reads_lower_triangle(SolverKind kind);
 
+// Fill-reducing ordering of the CHOLMOD back ends (the others use their own):
+//   kDefault  CHOLMOD's choice: AMD, and METIS as well when AMD's fill looks high
+//   kAmd      approximate minimum degree
+//   kMetis    METIS nested dissection (through CHOLMOD)
+//   kNesdis   CHOLMOD's nested dissection (METIS partitions, constrained minimum degree)
+enum class Ordering { kDefault, kAmd, kMetis, kNesdis };
+// "default", "amd", "metis", "nesdis".
+std::string to_string(Ordering ordering);
+// Inverse of to_string(Ordering); sf::InputError otherwise (message starts with `where`).
+Ordering parse_ordering(const std::string& name, const std::string& where = "");
+
+// The BLAS under CHOLMOD's supernodal factorisation. With a threaded OpenBLAS
+// (Debian's libopenblas0-pthread chosen by update-alternatives) each supernodal
+// factorisation and solve runs on factorisation_threads() BLAS threads and on one thread
+// between them (so idle BLAS threads do not compete with the element loop); with a serial
+// BLAS on one. Supernodal factorisations and solves of all LinearSolvers are serialised
+// by one lock: the serial OpenBLAS is not safe to call from two threads at once.
+// Threads for one factorisation: by default OMP_NUM_THREADS when set, else the cores; set_factorisation_threads(n) overrides it (n >= 1), e.g. from a command-line option.
+void set_factorisation_threads(int threads);
+int factorisation_threads();
+// One line naming the BLAS and its threading, e.g.
+// "OpenBLAS 0.3.21 DYNAMIC_ARCH NO_AFFINITY SkylakeX MAX_THREADS=64 (pthreads, 2 threads per factorisation)".
+std::string blas_description();
+
 // What the caller knows about A. It selects the kAuto back end and is checked
 // against explicit back ends (kCholmod and kEigenLDLT need symmetry).
 enum class MatrixProperty { kSymmetricPositiveDefinite, kSymmetricIndefinite, kUnsymmetric };
@@ -117,6 +141,11 @@ class LinearSolver {
   // ignored by the Cholesky back ends. Drops any previous factorisation; on
   // success the status is kNotFactorized.
   const SolveReport& analyze_pattern(const SparseMatrix& a);
+
+  // Fill-reducing ordering for the next analysis (CHOLMOD back ends; ignored by the
+  // others). Drops the current analysis when it changes.
+  void set_ordering(Ordering ordering);
+  Ordering ordering() const;
 
   // Numeric factorisation of a. Analyses first when no analysis exists or when
   // a's pattern (size, column pointers, row indices) differs from the analysed

@@ -247,10 +247,11 @@ class TimeIntegration {
   std::vector<char> kind_;
   FreeDofs free_;
   double length_scale_ = 1e-300;
-  std::unique_ptr<TangentSolver> solver_;
-  std::unique_ptr<linalg::PatternAssembler> pattern_;  // S_ff, laid out for solver_
-  std::vector<std::int64_t> mass_pos_;                 // positions of M's entries in pattern_
-  int mass_generation_ = -1;                           // pattern_ generation mass_pos_ is for
+  std::shared_ptr<TangentWorkspace> workspace_;  // pattern and solver (kept between solves when shared)
+  TangentSolver* solver_ = nullptr;
+  linalg::PatternAssembler* pattern_ = nullptr;  // S_ff, laid out for solver_
+  std::vector<std::int64_t> mass_pos_;           // positions of M's entries in pattern_
+  int mass_generation_ = -1;                     // pattern_ generation mass_pos_ is for
   bool unsymmetric_ = false;
   bool fatal_ = false;
 
@@ -281,9 +282,12 @@ std::string TimeIntegration::start(const Eigen::Ref<const VecX>& x0, const Eigen
   if (std::string why = initial_acceleration(); !why.empty()) return why;
 
   // Effective-tangent solver: symmetric until an unsymmetric tangent shows up.
-  unsymmetric_ = !model_.symmetric_tangent();
-  solver_ = std::make_unique<TangentSolver>(options_.linear_solver, unsymmetric_);
-  pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(free_.is_free, solver_->lower()));
+  // (kept unsymmetric when an earlier solve of this model found an unsymmetric tangent).
+  workspace_ = options_.workspace ? options_.workspace : std::make_shared<TangentWorkspace>();
+  unsymmetric_ = !model_.symmetric_tangent() || workspace_->unsymmetric_for(model_);
+  workspace_->prepare(model_, free_.is_free, options_.linear_solver, unsymmetric_);
+  solver_ = &workspace_->solver();
+  pattern_ = &workspace_->pattern();
   return {};
 }
 
@@ -377,7 +381,7 @@ bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangen
     va = v_ + ((1.0 - af_) * s.h) * ((1.0 - gamma_) * a_ + gamma_ * a1);
     context.velocity = &va;
   }
-  const Assembly internal = model_.assemble_into(xa, context, want_tangent ? pattern_.get() : nullptr);
+  const Assembly internal = model_.assemble_into(xa, context, want_tangent ? pattern_ : nullptr);
   if (!internal.ok) {
     why = internal.message;
     return false;
@@ -398,14 +402,15 @@ bool TimeIntegration::balance(const TimeStep& s, const VecX& y, bool want_tangen
   if (has_nonzeros(ext.tangent) && !unsymmetric_) {
     // The first unsymmetric tangent: both triangles and an unsymmetric solver from now on.
     try {
-      solver_ = std::make_unique<TangentSolver>(options_.linear_solver, true);
+      workspace_->make_unsymmetric(model_);
     } catch (const InputError& e) {
       why = std::string("the external load has an unsymmetric tangent: ") + e.what();
       fatal_ = true;
       return false;
     }
     unsymmetric_ = true;
-    pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(free_.is_free, solver_->lower()));
+    solver_ = &workspace_->solver();
+    pattern_ = &workspace_->pattern();
     mass_generation_ = -1;
     return balance(s, y, want_tangent, out, why);
   }

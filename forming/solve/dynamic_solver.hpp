@@ -82,6 +82,7 @@
 // state, never an endless loop. Exceptions thrown by the caller's callbacks propagate.
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,8 @@
 #include "forming/solve/step_history.hpp"
 
 namespace sf::forming {
+
+class TangentWorkspace;
 
 // ---------------------------------------------------------------------------------
 // Loads and prescribed motion
@@ -163,6 +166,9 @@ struct DynamicOptions {
   int max_line_search = 8;         // halvings of a Newton correction
   bool keep_step_records = true;   // DynamicReport::steps holds every attempted step
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
+  // Tangent pattern and factorisation kept between solves of the same model (a run's
+  // output intervals, forming/solve/tangent_solver.hpp); null: laid out for this solve.
+  std::shared_ptr<TangentWorkspace> workspace;
 
   // Throws sf::InputError naming the option ("dynamic solver rho_inf: expected ...").
   void validate() const;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -23,6 +22,10 @@ namespace {
 // Relative size of the last Newton correction below which the state is converged even
 // when the residual test is not met (round-off floor of the residual).
 constexpr double kIncrementTolRel = 1e-14;
+// A load step whose last kStallWindow corrections were all damped by the line search
+// and reduced |r_f| by less than half, after at least kStallAfter iterations, is cut back.
+constexpr int kStallAfter = 8;
+constexpr std::size_t kStallWindow = 5;
 
 }  // namespace
 
@@ -97,7 +100,8 @@ class LoadStepping {
         x_start_(x_start),
         load_(load),
         options_(options),
-        solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()),
+        unsymmetric_(unsymmetric || !model.symmetric_tangent()),
+        workspace_(options.workspace ? options.workspace : std::make_shared<TangentWorkspace>()),
         rates_from_(options.clock.previous ? *options.clock.previous : VecX(x_start)),
         rates_time_(options.clock.previous ? options.clock.previous_time : options.clock.start) {
     last_rates_from_ = rates_from_;
@@ -131,8 +135,9 @@ class LoadStepping {
   VecX prescribed_at(double lambda, const VecX& x) const;
   // Line-search factor along dx; < 0 (rec.failure) when every trial inverted an element.
   // `at_step` receives the residual norm and force scale at the accepted step.
-  double line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec,
-                     std::pair<double, double>& at_step);
+  // dxf, rf: the correction and the residual on the free dofs (the slope dxf . r_f).
+  double line_search(double lam_new, const VecX& xt, const VecX& dx, const VecX& dxf, const VecX& rf, double rnorm,
+                     double scale, StepRecord& rec, std::pair<double, double>& at_step);
 
   Residual evaluate_with(double lambda, const VecX& x, bool want_tangent, const VecX* direction, const VecX& from,
                          double from_time);
@@ -141,13 +146,15 @@ class LoadStepping {
   const Eigen::Ref<const VecX>& x_start_;
   const LoadFunction& load_;
   const StaticOptions& options_;
-  TangentSolver solver_;
+  bool unsymmetric_ = false;
+  std::shared_ptr<TangentWorkspace> workspace_;  // pattern and solver (kept between solves when shared)
+  TangentSolver* solver_ = nullptr;
   VecX rates_from_, last_rates_from_;  // where the interactions' rates start (clock)
   double rates_time_ = 0.0, last_rates_time_ = 0.0;
   std::vector<char> kind_;
   VecX target_;
   FreeDofs free_;
-  std::unique_ptr<linalg::PatternAssembler> pattern_;  // K_ff, laid out once per solve
+  linalg::PatternAssembler* pattern_ = nullptr;  // K_ff, in workspace_
   double length_scale_ = 0.0;
 };
 
@@ -169,7 +176,9 @@ std::string LoadStepping::classify(const std::vector<PrescribedDof>& prescribed)
     is_free[static_cast<std::size_t>(d)] = kind_[d] == kFree;
   }
   free_ = FreeDofs(is_free);
-  pattern_ = std::make_unique<linalg::PatternAssembler>(model_.make_pattern(is_free, solver_.lower()));
+  workspace_->prepare(model_, is_free, options_.linear_solver, unsymmetric_);
+  solver_ = &workspace_->solver();
+  pattern_ = &workspace_->pattern();
   for (Index d = 0; d < n; ++d) length_scale_ = std::max(length_scale_, std::abs(x_start_(d)));
   length_scale_ = std::max(length_scale_, 1e-300);
   return {};
@@ -195,7 +204,7 @@ Residual LoadStepping::evaluate_with(double lambda, const VecX& x, bool want_tan
                                      const VecX& from, double from_time) {
   Residual st;
   const InteractionContext context{options_.clock.at(lambda), nullptr, &from, from_time};
-  st.a = model_.assemble_into(x, context, want_tangent ? pattern_.get() : nullptr, direction);
+  st.a = model_.assemble_into(x, context, want_tangent ? pattern_ : nullptr, direction);
   if (!st.a.ok) return st;
   ExternalLoad ext = load_(lambda, x, want_tangent || direction != nullptr);
   SF_ASSERT(ext.force.size() == model_.n_dofs(), "external load must have n_dofs entries");
@@ -238,12 +247,12 @@ LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, Vec
   // Linearised response to the load and prescribed-displacement increment:
   // K_ff dx_f = -(r_f(lambda_new, x) + K_fp dx_p).
   const VecX rhs = -free_.restrict(st.residual + a.tangent_times);
-  const linalg::SolveReport& sr = solver_.factorize(pattern_->matrix());
+  const linalg::SolveReport& sr = solver_->factorize(pattern_->matrix());
   if (!sr.ok()) {
     rec.failure = "predictor: linear solve " + sr.brief();
     return Predicted::kFailed;
   }
-  const VecX dxf = solver_.solve(rhs);
+  const VecX dxf = solver_->solve(rhs);
   xt = x_new + free_.expand(dxf);
   return Predicted::kOk;
 }
@@ -276,6 +285,20 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
           "diverged: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) + " iterations";
       return;
     }
+    // Stalled: the line search damped each of the last kStallWindow corrections to less
+    // than half and |r_f| fell by less than half over them. A smaller increment converges
+    // sooner than crawling on to max_iterations (full steps that converge slowly, as with
+    // an inexact contact tangent, are left to go on).
+    const std::size_t nr = rec.residual_norms.size(), ns = rec.step_lengths.size();
+    const bool damped = ns >= kStallWindow && std::all_of(rec.step_lengths.end() - kStallWindow, rec.step_lengths.end(),
+                                                          [](double a) { return a < 0.5; });
+    if (rec.iterations >= kStallAfter && damped && nr > kStallWindow &&
+        rnorm > 0.5 * rec.residual_norms[nr - 1 - kStallWindow]) {
+      rec.failure = "stalled: |r| " + detail::short_number(rnorm) + " after " + std::to_string(rec.iterations) +
+                    " iterations, damped corrections that did not halve |r| in " + std::to_string(kStallWindow) +
+                    " iterations";
+      return;
+    }
     if (rec.iterations >= options_.max_iterations) {
       rec.failure = "no convergence in " + std::to_string(options_.max_iterations) + " iterations (|r| " +
                     detail::short_number(rnorm) + ", tolerance " + detail::short_number(tol) + ")";
@@ -287,12 +310,12 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       return;
     }
     const VecX rf = free_.restrict(st.residual);
-    const linalg::SolveReport& sr = solver_.factorize(pattern_->matrix());
+    const linalg::SolveReport& sr = solver_->factorize(pattern_->matrix());
     if (!sr.ok()) {
       rec.failure = "linear solve " + sr.brief();
       return;
     }
-    const VecX dxf = solver_.solve(-rf);
+    const VecX dxf = solver_->solve(-rf);
     ++rec.iterations;
     if (!dxf.allFinite()) {
       rec.failure = "linear solve returned non-finite values";
@@ -310,7 +333,7 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
     std::pair<double, double> at_step{0.0, 0.0};
     double alpha = 1.0;
     if (options_.line_search) {
-      alpha = line_search(lam_new, xt, dx, rnorm, rec, at_step);
+      alpha = line_search(lam_new, xt, dx, dxf, rf, rnorm, scale, rec, at_step);
       if (alpha < 0.0) return;
     } else {
       const Residual trial = evaluate(lam_new, xt + dx, false);
@@ -327,23 +350,51 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
   }
 }
 
-double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx, double rnorm, StepRecord& rec,
-                                 std::pair<double, double>& at_step) {
-  std::vector<std::pair<double, std::pair<double, double>>> seen;  // step -> (|r_f|, force scale)
-  const double alpha =
-      detail::backtrack(rnorm, options_.max_line_search, [&](double trial_step, bool&) -> std::optional<double> {
-        const Residual trial = evaluate(lam_new, xt + trial_step * dx, false);
-        if (!trial.a.ok) return std::nullopt;
-        const double norm = free_.restrict(trial.residual).norm();
-        seen.push_back({trial_step, {norm, trial.scale}});
-        return norm;
-      }).step;
-  if (alpha < 0.0) {
-    rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
-    return alpha;
+double LoadStepping::line_search(double lam_new, const VecX& xt, const VecX& dx, const VecX& dxf, const VecX& rf,
+                                 double rnorm, double scale, StepRecord& rec, std::pair<double, double>& at_step) {
+  // Trials along dx from the full step. |r| alone is a poor merit when the fibres are
+  // stiff: a full Newton step towards the solution may raise |r| (a second-order fibre
+  // stretch) while the potential falls, and halving on |r| then crawls with steps of
+  // 1/128 for tens of iterations. So a trial is taken when
+  //   |r_f| fell sufficiently (Armijo on |r_f|), or
+  //   dx is a descent direction of the potential (s0 = dx . r_f < 0: K_ff positive
+  //   definite along dx) and the slope s = dx . r_f(trial) <= kSlopeAccept |s0|
+  //   (the potential fell: by the trapezoid rule Pi(step) - Pi(0) ~ step (s0 + s) / 2),
+  //   unless the trial is wild: |r_f| > kMaxGrowth max(|r_f|, force scale).
+  // A rejected trial is followed by the root of the slope's secant when it overshot the
+  // line minimum (s > 0), else by half the step. Inverted elements reject a trial.
+  // Failing all, the trial with the smallest |r_f|.
+  constexpr double kSlopeAccept = 0.8, kMaxGrowth = 1e3, kMinShrink = 0.1, kMaxShrink = 0.7;
+  const double s0 = dxf.dot(rf);
+  const bool descent = s0 < 0.0;
+  const double wild = kMaxGrowth * std::max(rnorm, scale);
+  double step = 1.0, best_norm = std::numeric_limits<double>::infinity(), alpha = -1.0;
+  for (int ls = 0; ls <= options_.max_line_search; ++ls) {
+    const Residual trial = evaluate(lam_new, xt + step * dx, false);
+    if (!trial.a.ok) {
+      step *= 0.5;
+      continue;
+    }
+    const VecX rt = free_.restrict(trial.residual);
+    const double norm = rt.norm();
+    const double s = dxf.dot(rt);
+    if (norm < best_norm) {
+      best_norm = norm;
+      alpha = step;
+      at_step = {norm, trial.scale};
+    }
+    const bool armijo = norm <= (1.0 - detail::kSufficientDecrease * step) * rnorm;
+    const bool downhill = descent && s <= kSlopeAccept * std::abs(s0) && norm <= wild;
+    if (armijo || downhill) {
+      at_step = {norm, trial.scale};
+      return step;
+    }
+    double next = 0.5;
+    if (descent && s > 0.0 && std::isfinite(s)) next = std::clamp(s0 / (s0 - s), kMinShrink, kMaxShrink);
+    step *= next;
   }
-  for (const auto& [step, values] : seen)
-    if (step == alpha) at_step = values;
+  if (alpha < 0.0)
+    rec.failure = "iteration " + std::to_string(rec.iterations) + ": every line-search trial inverted an element";
   return alpha;
 }
 
@@ -373,6 +424,10 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   VecX x = x_start;
   double lambda = 0.0;
   double increment = std::min(options.initial_increment, options.max_increment);
+  // A run's steps start with the increment the last solve ended with (had it to cut
+  // back, the next step would otherwise fail the same way first).
+  if (options.workspace && options.workspace->next_increment > 0.0)
+    increment = std::clamp(options.workspace->next_increment, options.min_increment, increment);
   int attempts = 0;
   while (lambda < 1.0) {
     if (attempts >= options.max_steps) {
@@ -410,6 +465,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       break;
     }
   }
+  if (options.workspace) options.workspace->next_increment = increment;
   if (lambda >= 1.0) {
     report.status = SolveStatus::kConverged;
     report.message.clear();

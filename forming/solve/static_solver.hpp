@@ -16,15 +16,22 @@
 // force_scale = max(|f_int| over all dofs (includes the reactions), |lambda f_ext|),
 // or until a correction is below 1e-14 of the largest |x_start| (the residual's
 // round-off floor: a smaller correction cannot reduce it).
-// Corrector steps are damped by a backtracking line search on |r_f| (optional). A step
+// Corrector steps are damped by a line search (optional): a trial is taken when |r_f|
+// fell, or, along a descent direction of the potential, when the slope dx . r_f fell to
+// 0.8 of its start and |r_f| stayed below 1000 max(|r_f|, force scale); a rejected
+// trial is followed by the secant root of the slope (or half the step). A step whose
+// last five corrections were all damped below 1/2 without halving |r_f| is cut back at
+// once (after at least eight iterations). A step
 // that fails (too many iterations, divergence, an inverted Gauss point, a singular
 // tangent) is retried from the last converged state with half the load increment;
 // after a step that converges in <= options.easy_iterations the increment grows by
-// options.growth (capped at max_increment). Every loop is bounded: the solve ends
+// options.growth (capped at max_increment); with a shared options.workspace (a run's
+// load steps) the next solve starts with the increment this one ended with. Every loop is bounded: the solve ends
 // with a report, never an endless loop, and returns the last converged state.
 //
 // Units: positions mm, forces N, stiffness N/mm (any consistent set).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +43,8 @@
 #include "forming/solve/step_history.hpp"
 
 namespace sf::forming {
+
+class TangentWorkspace;
 
 // Process time of a quasi-static solve (forming/solve/stepper.hpp sets it per load step):
 // the solve's load factor lambda in [0, 1] is the time start + lambda (end - start), s,
@@ -68,6 +77,9 @@ struct StaticOptions {
   int max_line_search = 8;  // halvings of the corrector step
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
   ProcessClock clock;  // time and rates the interactions see
+  // Tangent pattern and factorisation kept between solves of the same model (a run's
+  // load steps, forming/solve/tangent_solver.hpp); null: laid out for this solve only.
+  std::shared_ptr<TangentWorkspace> workspace;
   // Throws sf::InputError naming the option ("static solver max_iterations: ...").
   void validate() const;
 };

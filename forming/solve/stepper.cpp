@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "forming/solve/mass.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 namespace sf::forming {
 namespace {
@@ -54,7 +55,10 @@ int first_step_after(double lambda, int n) {
 
 class LoadStepper final : public Stepper {
  public:
-  LoadStepper(Problem& problem, const StepperSettings& settings) : problem_(problem), settings_(settings) {}
+  LoadStepper(Problem& problem, const StepperSettings& settings) : problem_(problem), settings_(settings) {
+    // One tangent pattern and symbolic factorisation for all the steps (and repeats).
+    if (!settings_.statics.workspace) settings_.statics.workspace = std::make_shared<TangentWorkspace>();
+  }
 
   SteppingReport run(SteppingState& state, StepObserver& observer) override {
     SteppingReport out;
@@ -129,7 +133,9 @@ class LoadStepper final : public Stepper {
 class DynamicStepper final : public Stepper {
  public:
   DynamicStepper(Problem& problem, const StepperSettings& settings)
-      : problem_(problem), settings_(settings), mass_(mass_matrix(problem.model, problem.density)) {}
+      : problem_(problem), settings_(settings), mass_(mass_matrix(problem.model, problem.density)) {
+    if (!settings_.dynamics.workspace) settings_.dynamics.workspace = std::make_shared<TangentWorkspace>();
+  }
 
   SteppingReport run(SteppingState& state, StepObserver& observer) override {
     SteppingReport out;

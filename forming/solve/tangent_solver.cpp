@@ -1,6 +1,9 @@
 #include "forming/solve/tangent_solver.hpp"
 
+#include <chrono>
+
 #include "common/core/error.hpp"
+#include "forming/model/model.hpp"
 
 namespace sf::forming {
 
@@ -64,6 +67,36 @@ VecX FreeDofs::expand(const VecX& v_free) const {
   VecX out = VecX::Zero(static_cast<Index>(is_free.size()));
   for (Index j = 0; j < size(); ++j) out(index[j]) = v_free(j);
   return out;
+}
+
+void TangentWorkspace::prepare(const Model& model, const std::vector<bool>& is_free, linalg::SolverKind kind,
+                               bool unsymmetric) {
+  const bool same = solver_ && pattern_ && model_ == &model && n_dofs_ == model.n_dofs() &&
+                    n_elements_ == model.element_entries().size() && kind_ == kind && unsymmetric_ == unsymmetric &&
+                    is_free_ == is_free;
+  if (same) return;
+  model_ = &model;
+  n_dofs_ = model.n_dofs();
+  n_elements_ = model.element_entries().size();
+  is_free_ = is_free;
+  kind_ = kind;
+  unsymmetric_ = unsymmetric;
+  solver_ = std::make_unique<TangentSolver>(kind, unsymmetric);
+  lay_out(model);
+}
+
+void TangentWorkspace::make_unsymmetric(const Model& model) {
+  solver_ = std::make_unique<TangentSolver>(kind_, true);
+  unsymmetric_ = true;
+  lay_out(model);
+}
+
+void TangentWorkspace::lay_out(const Model& model) {
+  const auto t0 = std::chrono::steady_clock::now();
+  pattern_.reset();  // release the old tables before building the new ones
+  pattern_ = std::make_unique<linalg::PatternAssembler>(model.make_pattern(is_free_, solver_->lower()));
+  layout_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++layouts_;
 }
 
 }  // namespace sf::forming

@@ -6,10 +6,13 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/linalg/pattern_assembler.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
 
 namespace sf::forming {
+
+class Model;
 
 // The free dofs of a solve, in ascending order, and the n x nf selection matrix S
 // (column j = unit vector of free dof j): K_ff = S^T K S, x += S dx_f.
@@ -52,6 +55,46 @@ class TangentSolver {
   bool lower_ = false;
   int skip_cholesky_ = 0;  // after a breakdown, the next few factorisations go to general_
   int n_indefinite_ = 0;
+};
+
+// The Newton tangent's pattern (scatter tables) and its solver (symbolic analysis)
+// kept between solves of one model: the load steps of a run (forming/solve/stepper.hpp),
+// the repeats of a step for multiplier updates, the output intervals of a dynamic run.
+// prepare() lays them out anew only when the model, its dof and element counts, the
+// free dofs, the symmetry or the solver kind differ from the last solve's; contact pairs
+// that appear later grow the kept pattern (linalg::PatternAssembler::flush), after which
+// the solver analyses the grown pattern once. Not thread-safe: one solve at a time.
+class TangentWorkspace {
+ public:
+  // Pattern and solver for a solve of `model` with these free dofs (n_dofs flags).
+  void prepare(const Model& model, const std::vector<bool>& is_free, linalg::SolverKind kind, bool unsymmetric);
+  TangentSolver& solver() { return *solver_; }
+  linalg::PatternAssembler& pattern() { return *pattern_; }
+  // Replaces the solver (and so the storage) by an unsymmetric one, keeping the model:
+  // a load whose tangent turned out unsymmetric.
+  void make_unsymmetric(const Model& model);  // may throw sf::InputError (as TangentSolver)
+  // True when the last prepare()/make_unsymmetric() was for `model` with an unsymmetric solver.
+  bool unsymmetric_for(const Model& model) const { return solver_ && model_ == &model && unsymmetric_; }
+  // The load-factor increment (fraction of a solve's load) the last static solve would
+  // have taken next; the next solve of the run starts with it (0: none yet).
+  double next_increment = 0.0;
+  // How many times prepare() laid the pattern out (1 for a run whose structure stays).
+  int layouts() const { return layouts_; }
+  // Seconds spent laying patterns out, in total.
+  double layout_seconds() const { return layout_seconds_; }
+
+ private:
+  void lay_out(const Model& model);
+  const Model* model_ = nullptr;
+  Index n_dofs_ = -1;
+  std::size_t n_elements_ = 0;
+  std::vector<bool> is_free_;
+  linalg::SolverKind kind_ = linalg::SolverKind::kAuto;
+  bool unsymmetric_ = false;
+  std::unique_ptr<TangentSolver> solver_;
+  std::unique_ptr<linalg::PatternAssembler> pattern_;
+  int layouts_ = 0;
+  double layout_seconds_ = 0.0;
 };
 
 }  // namespace sf::forming

@@ -15,6 +15,7 @@
 #include "common/mesh/surface_mesh.hpp"
 #include "forming/model/model.hpp"
 #include "forming/model/node_spring.hpp"
+#include "forming/solve/static_solver.hpp"
 #include "forming/solve/tangent_solver.hpp"
 #include "tests/common/tolerances.hpp"
 #include "tests/forming/fixtures.hpp"
@@ -181,6 +182,44 @@ TEST(FormingTangentSolver, IndefiniteTangentIsSolvedByLdlt) {
   ASSERT_TRUE(solver.factorize(k).ok());
   const linalg::SparseMatrix full2 = k.selfadjointView<Eigen::Lower>();
   EXPECT_LT((full2 * solver.solve(b) - b).norm(), 1e-8 * b.norm());
+}
+
+// A run's load steps share one TangentWorkspace: the pattern is laid out once for both
+// steps, and the solution is the one of separate solves (same iterates, same numbers).
+TEST(FormingTangentWorkspace, PatternKeptAcrossLoadStepsWithTheSameSolution) {
+  Model model;
+  model.add_ply(fixtures::rectangle_ply(20.0, 10.0, 1.0, 4, 2, 30.0), ti_model_material(fibre_from_layup_angle(30.0)));
+  const VecX X = model.reference_positions();
+  std::vector<PrescribedDof> half, full;  // edge x = 0 clamped, edge x = 20 pulled 0.2 mm along x
+  const PlyMesh& ply = model.ply(0);
+  for (Index s = 0; s < ply.n_surface_nodes(); ++s) {
+    const double xs = ply.surface().node_position(s).x();
+    if (std::abs(xs) > 1e-9 && std::abs(xs - 20.0) > 1e-9) continue;
+    for (int layer = 0; layer < 2; ++layer)
+      for (int d = 0; d < 4; ++d)
+        for (int i = 0; i < 3; ++i) {
+          const Index dof = model.dof(0, ply.node(s, layer), d, i);
+          const double move = xs > 1.0 && d == 0 && i == 0 ? 0.2 : 0.0;
+          half.push_back({dof, X(dof) + 0.5 * move});
+          full.push_back({dof, X(dof) + move});
+        }
+  }
+  StaticOptions kept;
+  kept.workspace = std::make_shared<TangentWorkspace>();
+  const StaticResult a1 = solve_static(model, X, half, VecX(), kept);
+  const StaticResult a2 = solve_static(model, a1.positions, full, VecX(), kept);
+  ASSERT_TRUE(a1.report.ok() && a2.report.ok()) << a1.report.brief() << " / " << a2.report.brief();
+  EXPECT_EQ(kept.workspace->layouts(), 1);
+  const StaticResult b1 = solve_static(model, X, half, VecX());
+  const StaticResult b2 = solve_static(model, b1.positions, full, VecX());
+  ASSERT_TRUE(b2.report.ok()) << b2.report.brief();
+  EXPECT_EQ(a2.report.total_iterations, b2.report.total_iterations);
+  EXPECT_LT(max_abs(MatX(a2.positions - b2.positions)), 1e-12 * max_abs(MatX(X)));
+  EXPECT_GT(max_abs(MatX(a2.positions - X)), 0.1);  // it moved
+  // Other free dofs: laid out anew.
+  std::vector<PrescribedDof> fewer(full.begin(), full.begin() + 12);
+  solve_static(model, X, fewer, VecX(), kept);
+  EXPECT_EQ(kept.workspace->layouts(), 2);
 }
 
 }  // namespace

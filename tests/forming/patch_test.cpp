@@ -210,7 +210,10 @@ TEST(FormingPatch, UnreachableStateEndsWithReportAndLastConvergedState) {
   EXPECT_EQ(res.report.status, StaticReport::Status::kStepFailed);
   EXPECT_THAT(res.report.message, ::testing::HasSubstr("failed"));
   EXPECT_GT(res.report.load_factor, 0.25);
-  EXPECT_LT(res.report.load_factor, 0.5);
+  // At lambda 1/2 the boundary nodes lie in one plane, but the Gauss points are inside
+  // and may keep det F > 0 (the line search that follows the potential reaches that
+  // state; the check below asserts it is admissible); no state beyond it is.
+  EXPECT_LE(res.report.load_factor, 0.5);
   EXPECT_GT(res.report.n_cutbacks, 0);
   EXPECT_LE(static_cast<int>(res.report.steps.size()), options.max_steps);
   EXPECT_TRUE(model.assemble(res.positions, false).ok);  // usable partial result

@@ -23,7 +23,8 @@ namespace sf::io::test {
 struct KillStudy {
   int kills = 0;
   int complete = 0;     // kills after which the folder held one complete set
-  int no_folder = 0;    // kills before the first commit (no folder yet: fine)
+  int no_folder = 0;    // kills after which there was no folder (never expected)
+  int replaced = 0;     // complete sets of a re-run (generation > 0), the others the first
   int temporaries = 0;  // temporaries left by the killed runs (then cleaned)
   int left_after_cleaning = 0;
   std::string first_problem;
@@ -34,20 +35,24 @@ inline std::string read_all(const std::filesystem::path& p) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+// Writes generation `gen` of the folder: `n_files` files (some in a subfolder), then commits.
+inline void write_generation(const std::filesystem::path& dir, int n_files, long gen) {
+  AtomicOutputDir out(dir, OutputDirOptions{{"*.csv", "summary.json", "steps"}, "", false});
+  for (int f = 0; f < n_files; ++f) {
+    std::ofstream os(
+        out.path(f % 3 == 0 ? "steps/part_" + std::to_string(f) + ".csv" : "f" + std::to_string(f) + ".csv"));
+    for (int line = 0; line < 200; ++line) os << gen << "," << f << "," << line << "\n";
+  }
+  std::ofstream(out.path("summary.json")) << "{\"generation\": " << gen << "}\n";
+  out.commit();
+}
+
 // Writes generation after generation into `dir` until killed (runs in the child).
 [[noreturn]] inline void rewrite_forever(const std::filesystem::path& dir, int n_files) {
   for (long gen = 1;; ++gen) {
     try {
-      AtomicOutputDir out(dir, OutputDirOptions{{"*.csv", "summary.json"}, "", false});
-      for (int f = 0; f < n_files; ++f) {
-        std::ofstream os(
-            out.path(f % 3 == 0 ? "steps/part_" + std::to_string(f) + ".csv" : "f" + std::to_string(f) + ".csv"));
-        for (int line = 0; line < 200; ++line) os << gen << "," << f << "," << line << "\n";
-      }
-      std::ofstream(out.path("summary.json")) << "{\"generation\": " << gen << "}\n";
-      out.commit();
+      write_generation(dir, n_files, gen);
     } catch (...) {
-      // the lock of the previous (killed) child cannot be held: flock dies with it
     }
   }
 }
@@ -56,7 +61,12 @@ inline KillStudy kill_during_replace(const std::filesystem::path& dir, int kills
   namespace fs = std::filesystem;
   KillStudy s;
   std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> wait_us(200, 30000);
+  // A complete folder first (generation 0); every kill then interrupts a re-run. The kill
+  // moments spread over three re-runs' time, so they land in every phase of one.
+  const auto t0 = std::chrono::steady_clock::now();
+  write_generation(dir, n_files, 0);
+  const auto one = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0);
+  std::uniform_int_distribution<long> wait_us(0, std::max<long>(1000, 3 * one.count()));
   for (int k = 0; k < kills; ++k) {
     const pid_t child = ::fork();
     if (child == 0) rewrite_forever(dir, n_files);
@@ -77,7 +87,7 @@ inline KillStudy kill_during_replace(const std::filesystem::path& dir, int kills
     const std::string summary = read_all(dir / "summary.json");
     const auto colon = summary.find(':');
     const std::string gen = colon == std::string::npos ? "" : std::to_string(std::atol(summary.c_str() + colon + 1));
-    bool ok = !gen.empty() && gen != "0";
+    bool ok = !gen.empty();
     int files = 0;
     for (int f = 0; f < n_files && ok; ++f) {
       const fs::path p =
@@ -92,6 +102,7 @@ inline KillStudy kill_during_replace(const std::filesystem::path& dir, int kills
         s.first_problem = "kill " + std::to_string(k) + ": " + p.string() + " is not of generation " + gen;
     }
     if (ok && files == n_files) ++s.complete;
+    if (ok && files == n_files && gen != "0") ++s.replaced;
   }
   // The next writer cleans every temporary of the dead runs.
   { AtomicOutputDir out(dir); }

@@ -271,8 +271,10 @@ void AnalyseOptions::validate() const {
                                                                           {"smoothing.gamma", &smoothing.gamma},
                                                                           {"smoothing.delta", &smoothing.delta}};
   for (const auto& [field, value] : weights)
-    if (*value && !(**value >= 0.0)) throw OptionError(field, "a smoothing weight must be >= 0" + found(**value));
-  if (!(smoothing.scale > 0.0)) throw OptionError("smoothing.scale", "must be > 0" + found(smoothing.scale));
+    if (*value && !(**value >= 0.0 && std::isfinite(**value)))
+      throw OptionError(field, "a smoothing weight must be a finite number >= 0" + found(**value));
+  if (!(smoothing.scale > 0.0) || !std::isfinite(smoothing.scale))
+    throw OptionError("smoothing.scale", "must be a finite number > 0" + found(smoothing.scale));
   if (!(outliers.sigma > 0.0) || !std::isfinite(outliers.sigma))
     throw OptionError("outliers.sigma", "must be a number > 0" + found(outliers.sigma));
   if (!fibre_angles.empty() && fibre_angles.size() != 2)

@@ -76,6 +76,16 @@ void validate_for_the_command_line(const Options& options) {
 
 }  // namespace
 
+void check_units_text(const std::string& units) {
+  if (units.size() > 40)
+    throw UsageError("--units: expected a short length unit such as mm, found " + std::to_string(units.size()) +
+                     " characters");
+  for (const char c : units)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ',' || c == '"')
+      throw UsageError(
+          "--units: expected a length unit such as mm (no line breaks, control characters, commas or quotes)");
+}
+
 std::string flag_of_field(const std::string& field) {
   static const std::map<std::string, std::string> flags = {
       {"mesh.elements1", "--elements"},
@@ -104,10 +114,10 @@ AnalyseOptions analyse_options(const AnalyseFlags& a) {
   if (!a.mesh.empty() && !a.elements.empty()) throw UsageError("give either --mesh or --elements, not both");
   o.mesh.file = a.mesh;
   if (!a.elements.empty()) parse_elements(a.elements, o.mesh);
-  if (!std::isnan(a.alpha)) o.smoothing.alpha = a.alpha;
-  if (!std::isnan(a.beta)) o.smoothing.beta = a.beta;
-  if (!std::isnan(a.gamma)) o.smoothing.gamma = a.gamma;
-  if (!std::isnan(a.delta)) o.smoothing.delta = a.delta;
+  o.smoothing.alpha = a.alpha;
+  o.smoothing.beta = a.beta;
+  o.smoothing.gamma = a.gamma;
+  o.smoothing.delta = a.delta;
   o.smoothing.scale = a.smoothing_scale;
   o.outliers.sigma = a.outlier_sigma;
   o.sigma_weights = !a.no_sigma_weights;
@@ -117,6 +127,7 @@ AnalyseOptions analyse_options(const AnalyseFlags& a) {
 }
 
 OutputOptions output_options(const AnalyseFlags& a) {
+  check_units_text(a.units);
   OutputOptions o;
   o.units = a.units;
   o.sample = a.sample;
@@ -182,6 +193,7 @@ GridReadOptions grid_read_options(const AnalyseFlags& a) {
   o.skip_lines = a.skip_lines;
   o.header_line = a.header_line;
   if (a.units.empty()) throw UsageError("--units: empty");
+  check_units_text(a.units);
   o.units = a.units;
   if (!std::isnan(a.pixel_size) && !(a.pixel_size > 0 && std::isfinite(a.pixel_size)))
     throw UsageError("--pixel-size: must be > 0 (length units per pixel), found " + std::to_string(a.pixel_size));

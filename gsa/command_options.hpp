@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,8 @@ struct AnalyseFlags {
   std::string format = "auto", id, positions, decimal = "auto";
   int skip_lines = 0, header_line = 0;
   double pitch = std::numeric_limits<double>::quiet_NaN(), pixel_size = std::numeric_limits<double>::quiet_NaN();
-  double alpha = std::numeric_limits<double>::quiet_NaN(), beta = std::numeric_limits<double>::quiet_NaN(),
-         gamma = std::numeric_limits<double>::quiet_NaN(), delta = std::numeric_limits<double>::quiet_NaN();
+  // Smoothing weights: empty = not given (automatic); a given NaN or infinity is refused.
+  std::optional<double> alpha, beta, gamma, delta;
   double outlier_sigma = 4.5, smoothing_scale = 1.0;
   bool no_local_smoothing = false;
   int sample = 0;
@@ -58,6 +59,10 @@ GridReadOptions grid_read_options(const AnalyseFlags& flags);
 io::MeasurementFormat parse_format(const std::string& text);
 // "--id": column names separated by commas (the id joins their cells with '_'), or "row".
 std::vector<std::string> parse_id_columns(const std::string& text);
+
+// Throws sf::UsageError naming --units for a unit text that would break the outputs (line
+// breaks or other control characters, commas, quotes, more than 40 characters).
+void check_units_text(const std::string& units);
 
 // The flag that sets a field of AnalyseOptions or OutputOptions ("smoothing.scale" ->
 // "--smoothing-scale"); the field itself when no flag sets it.

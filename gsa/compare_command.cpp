@@ -94,7 +94,10 @@ int run_compare(const CompareArgs& a, bool quiet) {
   cli::status(quiet, "gsa: registering and mapping " + std::to_string(measured.n_marks()) + " measured marks onto " +
                          std::to_string(simulated.n_marks()) + " simulated");
   const CompareResult r = compare(measured, simulated, o);
-  io::AtomicOutputDir out(a.out);
+  // The comparison's own outputs are replaced as a set; other files in the folder are kept.
+  io::OutputDirOptions folder;
+  folder.owned = {"differences.csv", "summary.json", "compare.vtp", "*.png", "report.html"};
+  io::AtomicOutputDir out(a.out, folder);
   const std::string cmd = cli::command_line().empty() ? "gsa compare" : cli::command_line();
   const nlohmann::json summary = compare_summary(measured, simulated, r, cmd);
   write_differences_csv(out.path("differences.csv"), measured, r);

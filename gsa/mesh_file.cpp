@@ -4,18 +4,14 @@
 #include <nlohmann/json.hpp>
 
 #include "common/core/error.hpp"
+#include "common/io/json.hpp"
 
 namespace sf::gsa {
 
 mesh::SurfaceMesh read_mesh_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the mesh file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
+  // io::read_json: a missing file, a folder, bad JSON (line and column) or a number
+  // beyond the range of a double are input errors naming the file.
+  const nlohmann::json j = io::read_json(path);
   if (!j.is_object() || !j.contains("nodes") || !j.contains("elements") || !j["nodes"].is_array() ||
       !j["elements"].is_array())
     throw InputError(path + ": expected an object with arrays \"nodes\" and \"elements\"");

@@ -19,6 +19,13 @@
 
 namespace sf::gsa {
 
+io::OutputDirOptions analyse_results_folder() {
+  io::OutputDirOptions o;
+  o.owned = {"strains.csv", "summary.json",  "undeformed.vtp",     "deformed.vtp",     "samples.csv", "*.png",
+             "report.html", "surfaces.json", "series_strains.csv", "strain_paths.csv", "series.pvd",  "stages"};
+  return o;
+}
+
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 

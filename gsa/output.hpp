@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "common/io/atomic_file.hpp"
 #include "common/io/vtk_xml.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/flc.hpp"
@@ -18,6 +19,11 @@ class AtomicOutputDir;
 }
 
 namespace sf::gsa {
+
+// A results folder of `gsa analyse` (one state or a stage series) replaces the old one
+// whole: these are its outputs (an older run's pictures, surfaces or stages never stay
+// beside new strains); the user's own files in the folder are kept.
+io::OutputDirOptions analyse_results_folder();
 
 struct OutputOptions {
   std::string units = "mm";  // name of the grid's length unit, written into every file

@@ -22,6 +22,10 @@ ResultsFolder read_results_folder(const std::string& dir) {
   const std::string summary = (d / "summary.json").string();
   if (fs::exists(summary)) r.summary = io::read_json(summary);
   const std::string u = (d / "undeformed.vtp").string(), v = (d / "deformed.vtp").string();
+  // One surface without the other: the folder is incomplete (a file removed or lost).
+  if (fs::exists(u) != fs::exists(v))
+    throw InputError((fs::exists(u) ? v : u) + ": missing beside " + (fs::exists(u) ? u : v) +
+                     "; the results folder is incomplete (rerun gsa analyse)");
   if (fs::exists(u) && fs::exists(v)) {
     r.undeformed = io::read_vtp(u);
     r.deformed = io::read_vtp(v);

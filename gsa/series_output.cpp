@@ -288,7 +288,7 @@ int run_analyse_series(const AnalyseFlags& a, bool quiet) {
                                    gauge_length(analysis.fixed_smoothing()->choice.penalty,
                                                 analysis.undeformed().setup.mark_spacing),
                                    output.units));
-  io::AtomicOutputDir out(a.out);
+  io::AtomicOutputDir out(a.out, analyse_results_folder());
   SeriesWriter writer(out, series, output, true);
   StagePrincipalStrains principal(series.n_points());
   GridData last_grid;

@@ -51,6 +51,14 @@ void Program::add_command(const std::string& name, const std::string& descriptio
   commands_.push_back(std::move(cmd));
 }
 
+std::string shortened_message(const std::string& message, std::size_t limit) {
+  if (message.size() <= limit) return message;
+  // Keep the start (file, line, column, what went wrong) and the end (what was expected).
+  const std::size_t head = limit * 2 / 3, tail = limit / 3;
+  return message.substr(0, head) + " [... " + std::to_string(message.size() - head - tail) +
+         " characters left out ...] " + message.substr(message.size() - tail);
+}
+
 int Program::main(int argc, char** argv) {
   std::string line = name_;
   for (int i = 1; i < argc; ++i) line += " " + quoted_argument(argv[i]);
@@ -64,7 +72,7 @@ int Program::main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app_->exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << name_ << ": " << e.what() << "\n"
+    std::cerr << name_ << ": " << shortened_message(e.what()) << "\n"
               << "Run '" << name_ << " --help' for usage.\n";
     return kExitUsage;
   }
@@ -73,16 +81,17 @@ int Program::main(int argc, char** argv) {
     try {
       return cmd->run();
     } catch (const UsageError& e) {
-      std::cerr << name_ << ": " << e.what() << "\n";
+      std::cerr << name_ << ": " << shortened_message(e.what()) << "\n";
       return kExitUsage;
     } catch (const Error& e) {
-      std::cerr << name_ << ": error: " << e.what() << "\n";
+      std::cerr << name_ << ": error: " << shortened_message(e.what()) << "\n";
       return kExitFailure;
     } catch (const std::bad_alloc&) {
       std::cerr << name_ << ": error: out of memory\n";
       return kExitFailure;
     } catch (const std::exception& e) {
-      std::cerr << name_ << ": internal error: " << e.what() << " (please report this with the input that caused it)\n";
+      std::cerr << name_ << ": internal error: " << shortened_message(e.what())
+                << " (please report this with the input that caused it)\n";
       return kExitFailure;
     }
   }

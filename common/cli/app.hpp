@@ -24,6 +24,10 @@ inline constexpr int kExitUsage = 2;
 // the record in output files; empty before Program::main.
 const std::string& command_line();
 
+// `message` cut to about `limit` characters (its start and end kept, the middle replaced by
+// "[... N characters left out ...]"): a 30 MB header line is never echoed whole.
+std::string shortened_message(const std::string& message, std::size_t limit = 600);
+
 // Options every subcommand understands.
 struct CommonOptions {
   bool quiet = false;  // --quiet: no progress on stderr

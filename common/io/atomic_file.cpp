@@ -1,6 +1,11 @@
 #include "common/io/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <fnmatch.h>
+#include <signal.h>
+#include <stdio.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -21,47 +26,174 @@ namespace {
 
 std::atomic<unsigned> g_temp_counter{0};
 
-std::string temp_suffix() { return fmt::format(".tmp-{}-{}", static_cast<long>(::getpid()), g_temp_counter++); }
+std::string temp_suffix(const char* kind = ".tmp-") {
+  return fmt::format("{}{}-{}", kind, static_cast<long>(::getpid()), g_temp_counter++);
+}
 
 [[noreturn]] void throw_fs_error(const fs::path& path, const std::string& what, const std::error_code& ec) {
   throw Error(located_message(path.string(), 0, 0, fmt::format("{} ({})", what, ec.message())));
 }
 
-// Moves file `from` onto `to` (replacing it). Falls back to copy + rename when the two are on
-// different file systems.
-void move_file(const fs::path& from, const fs::path& to) {
+[[noreturn]] void throw_errno(const fs::path& path, const std::string& what) {
+  throw_fs_error(path, what, std::error_code(errno, std::generic_category()));
+}
+
+bool process_running(long pid) {
+  if (pid <= 0) return false;
+  if (::kill(static_cast<pid_t>(pid), 0) == 0) return true;
+  return errno == EPERM;  // exists, owned by someone else
+}
+
+// PID of a sibling "NAME<kind>PID-N" of `name`, or -1 when `entry` is not one.
+long temp_owner(const std::string& entry, const std::string& name, const std::string& kind) {
+  const std::string prefix = name + kind;
+  if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) return -1;
+  const std::string rest = entry.substr(prefix.size());
+  const std::size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || dash + 1 == rest.size()) return -1;
+  for (std::size_t i = 0; i < rest.size(); ++i)
+    if (i != dash && (rest[i] < '0' || rest[i] > '9')) return -1;
+  if (dash > 9) return -1;
+  return std::stol(rest.substr(0, dash));
+}
+
+// Hard-links `from` (a file, symlink or directory tree) to `to` where `to` does not exist
+// yet; directories present on both sides are merged; existing files at `to` win.
+void link_tree(const fs::path& from, const fs::path& to, const std::vector<std::string>* owned_top = nullptr) {
   std::error_code ec;
-  fs::rename(from, to, ec);
-  if (!ec) return;
-  const fs::path staging = fs::path(to.string() + temp_suffix());
-  std::error_code copy_ec;
-  fs::copy_file(from, staging, fs::copy_options::overwrite_existing, copy_ec);
-  if (!copy_ec) fs::rename(staging, to, copy_ec);
-  if (copy_ec) {
-    std::error_code ignored;
-    fs::remove(staging, ignored);
-    throw_fs_error(to, "cannot move the output file into place", ec);
+  const fs::file_status st = fs::symlink_status(from, ec);
+  if (ec) throw_fs_error(from, "cannot read", ec);
+  const fs::file_status st_to = fs::symlink_status(to, ec);
+  const bool to_exists = fs::exists(st_to);
+  if (fs::is_directory(st)) {
+    if (to_exists && !fs::is_directory(st_to)) return;  // the new output wins
+    if (!to_exists) {
+      fs::create_directory(to, ec);
+      if (ec) throw_fs_error(to, "cannot create directory", ec);
+    }
+    std::vector<fs::path> entries;
+    for (auto it = fs::directory_iterator(from, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+      entries.push_back(it->path());
+    if (ec) throw_fs_error(from, "cannot list", ec);
+    for (const fs::path& e : entries) {
+      const std::string name = e.filename().string();
+      if (owned_top) {
+        bool owned = false;
+        for (const std::string& pattern : *owned_top)
+          if (::fnmatch(pattern.c_str(), name.c_str(), FNM_PERIOD) == 0) owned = true;
+        if (owned) continue;
+      }
+      link_tree(e, to / name);
+    }
+    return;
   }
-  fs::remove(from, ec);
+  if (to_exists) return;
+  if (fs::is_symlink(st)) {
+    fs::copy_symlink(from, to, ec);
+    if (ec) throw_fs_error(to, "cannot copy link", ec);
+    return;
+  }
+  if (::link(from.c_str(), to.c_str()) == 0) return;
+  fs::copy_file(from, to, ec);  // no hard links on this file system
+  if (ec) throw_fs_error(to, "cannot copy the earlier file into the new output", ec);
 }
 
 }  // namespace
 
-AtomicOutputDir::AtomicOutputDir(const fs::path& final_dir) {
-  fs::path dir = final_dir.empty() ? fs::path(".") : final_dir;
-  dir = fs::absolute(dir).lexically_normal();
-  if (!dir.has_filename()) dir = dir.parent_path();  // "out/" -> "out"
-  final_dir_ = dir;
-  temp_dir_ = fs::path(dir.string() + temp_suffix());
+int clean_stale_temporaries(const fs::path& final_dir) {
+  const fs::path parent = final_dir.parent_path();
+  const std::string name = final_dir.filename().string();
   std::error_code ec;
-  fs::remove_all(temp_dir_, ec);  // a stale one from a killed process with the same pid
+  std::vector<fs::path> stale_tmp, stale_old;
+  for (auto it = fs::directory_iterator(parent, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string entry = it->path().filename().string();
+    const long tmp_pid = temp_owner(entry, name, ".tmp-");
+    const long old_pid = temp_owner(entry, name, ".old-");
+    if (tmp_pid > 0 && !process_running(tmp_pid)) stale_tmp.push_back(it->path());
+    if (old_pid > 0 && !process_running(old_pid)) stale_old.push_back(it->path());
+  }
+  int removed = 0;
+  // Killed between "old aside" and "new in": the old folder is the last complete one.
+  if (!fs::exists(fs::symlink_status(final_dir, ec)) && !stale_old.empty()) {
+    fs::rename(stale_old.back(), final_dir, ec);
+    if (!ec) stale_old.pop_back();
+  }
+  for (const auto* list : {&stale_tmp, &stale_old})
+    for (const fs::path& p : *list) {
+      fs::remove_all(p, ec);
+      if (!ec) ++removed;
+    }
+  return removed;
+}
+
+AtomicOutputDir::AtomicOutputDir(const fs::path& final_dir, const OutputDirOptions& options) : options_(options) {
+  if (final_dir.empty()) throw Error("output folder: the name is empty; give a folder to write the results into");
+  fs::path dir = fs::absolute(final_dir).lexically_normal();
+  if (!dir.has_filename()) dir = dir.parent_path();  // "out/" -> "out"
+  if (dir == dir.root_path() || dir.filename() == "..")
+    throw Error(located_message(final_dir.string(), 0, 0, "cannot write results into this folder; name a folder"));
+  std::error_code ec;
+  // The current folder or one above it cannot be swapped: the shell would be left in a
+  // removed folder.
+  const fs::path cwd = fs::current_path(ec).lexically_normal();
+  if (!ec) {
+    const auto rel = cwd.lexically_relative(dir);
+    if (!rel.empty() && *rel.begin() != "..")
+      throw Error(located_message(final_dir.string(), 0, 0,
+                                  "is the current folder or contains it; write the results into a folder below it "
+                                  "(e.g. --out results)"));
+  }
+  final_dir_ = dir;
+  fs::create_directories(dir.parent_path(), ec);
+  if (ec) throw_fs_error(dir.parent_path(), "cannot create the folder", ec);
+
+  // The lock: one run per output folder at a time.
+  const fs::path lock = dir.parent_path() / ("." + dir.filename().string() + ".lock");
+  lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) throw_errno(lock, "cannot create the lock file of the output folder");
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char buf[32] = {0};
+    const ssize_t n = ::pread(lock_fd_, buf, sizeof buf - 1, 0);
+    std::string holder = n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string("?");
+    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    if (err == EWOULDBLOCK)
+      throw Error(located_message(final_dir_.string(), 0, 0,
+                                  "another run (process " + holder +
+                                      ") is writing this folder now; wait for it to finish or choose another "
+                                      "output folder"));
+    errno = err;
+    throw_errno(lock, "cannot lock the output folder");
+  }
+  const std::string me = std::to_string(static_cast<long>(::getpid())) + "\n";
+  if (::ftruncate(lock_fd_, 0) == 0) {
+    [[maybe_unused]] const ssize_t w = ::pwrite(lock_fd_, me.data(), me.size(), 0);
+  }
+
+  clean_stale_temporaries(final_dir_);
+
+  if (options_.work_suffix.empty()) {
+    temp_dir_ = fs::path(dir.string() + temp_suffix());
+    fs::remove_all(temp_dir_, ec);
+  } else {
+    temp_dir_ = fs::path(dir.string() + options_.work_suffix);
+    if (!options_.resume) fs::remove_all(temp_dir_, ec);
+  }
   fs::create_directories(temp_dir_, ec);
-  if (ec) throw_fs_error(temp_dir_, "cannot create the temporary output directory", ec);
+  if (ec) {
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw_fs_error(temp_dir_, "cannot create the temporary output directory", ec);
+  }
 }
 
 AtomicOutputDir::~AtomicOutputDir() {
   std::error_code ec;
-  fs::remove_all(temp_dir_, ec);  // nothing left after commit(); everything when abandoned
+  // Nothing left after commit(); everything when abandoned (but a working folder stays).
+  if (committed_ || options_.work_suffix.empty()) fs::remove_all(temp_dir_, ec);
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
 }
 
 std::string AtomicOutputDir::path(const std::string& name) const {
@@ -79,40 +211,50 @@ std::string AtomicOutputDir::path(const std::string& name) const {
   return full.string();
 }
 
+bool AtomicOutputDir::seed_from_final() {
+  if (committed_) throw std::logic_error("AtomicOutputDir::seed_from_final() after commit()");
+  std::error_code ec;
+  if (!fs::is_directory(final_dir_, ec)) return false;
+  link_tree(final_dir_, temp_dir_);
+  return true;
+}
+
 void AtomicOutputDir::commit() {
   if (committed_) throw std::logic_error("AtomicOutputDir::commit() called twice");
   std::error_code ec;
-  if (!fs::exists(final_dir_, ec)) {
+  const fs::file_status st = fs::symlink_status(final_dir_, ec);
+  if (!fs::exists(st)) {
     fs::rename(temp_dir_, final_dir_, ec);
-    if (!ec) {
-      committed_ = true;
-      return;
-    }
+    if (ec) throw_fs_error(final_dir_, "cannot move the output folder into place", ec);
+    committed_ = true;
+    return;
   }
-  if (fs::exists(final_dir_, ec) && !fs::is_directory(final_dir_, ec)) {
-    throw Error(
-        located_message(final_dir_.string(), 0, 0, "cannot write the output: it exists and is not a directory"));
+  if (!fs::is_directory(st)) {
+    throw Error(located_message(final_dir_.string(), 0, 0,
+                                "cannot write the output: it exists and is not a directory (or is a link)"));
   }
-  fs::create_directories(final_dir_, ec);
-  if (ec) throw_fs_error(final_dir_, "cannot create the output directory", ec);
-  // List first, then move: a directory changed while iterating may be listed incompletely.
-  std::vector<fs::path> entries;
-  for (auto it = fs::recursive_directory_iterator(temp_dir_, ec); !ec && it != fs::recursive_directory_iterator();
-       it.increment(ec)) {
-    entries.push_back(it->path());
+  // The old folder's other files (not outputs of this command) come along.
+  link_tree(final_dir_, temp_dir_, &options_.owned);
+  // One step: exchange the two folders, then remove the old one.
+  if (::renameat2(AT_FDCWD, temp_dir_.c_str(), AT_FDCWD, final_dir_.c_str(), RENAME_EXCHANGE) == 0) {
+    committed_ = true;
+    fs::remove_all(temp_dir_, ec);
+    return;
   }
-  if (ec) throw_fs_error(temp_dir_, "cannot list the temporary output directory", ec);
-  for (const fs::path& entry : entries) {
-    const fs::path target = final_dir_ / entry.lexically_relative(temp_dir_);
-    if (fs::is_directory(entry, ec)) {
-      fs::create_directories(target, ec);
-      if (ec) throw_fs_error(target, "cannot create directory", ec);
-    } else {
-      move_file(entry, target);
-    }
+  if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP && errno != EPERM)
+    throw_errno(final_dir_, "cannot replace the output folder");
+  // No exchange on this file system: old aside, new in, old removed.
+  const fs::path old = fs::path(final_dir_.string() + temp_suffix(".old-"));
+  fs::rename(final_dir_, old, ec);
+  if (ec) throw_fs_error(final_dir_, "cannot move the earlier output folder aside", ec);
+  fs::rename(temp_dir_, final_dir_, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::rename(old, final_dir_, ignored);
+    throw_fs_error(final_dir_, "cannot move the output folder into place", ec);
   }
   committed_ = true;
-  fs::remove_all(temp_dir_, ec);
+  fs::remove_all(old, ec);
 }
 
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -21,6 +22,9 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 }
 
 nlohmann::json read_json(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(located_message(path, 0, 0, "is a folder; expected a JSON file"));
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw InputError(located_message(path, 0, 0, fmt::format("cannot open file ({})", std::strerror(errno))));
@@ -47,6 +51,11 @@ nlohmann::json read_json(const std::string& path) {
       what = what.substr(colon + 2);
     }
     throw InputError(located_message(path, line, column, "invalid JSON: " + what));
+  } catch (const nlohmann::json::exception& e) {
+    // out_of_range 406: "number overflow parsing '1e400'" (beyond the range of a double).
+    std::string what = e.what();
+    if (const auto bracket = what.find("] "); bracket != std::string::npos) what = what.substr(bracket + 2);
+    throw InputError(located_message(path, 0, 0, "invalid JSON: " + what + " (numbers must lie within +-1.8e308)"));
   }
 }
 

@@ -101,7 +101,7 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
 }
 
 std::optional<bool> face_of(Reader& r, const YAML::Node& n, const std::string& what) {
-  if (n.IsScalar() && (n.Scalar() == "top" || n.Scalar() == "bottom")) return n.Scalar() == "top";
+  if (case_yaml::is_scalar(n) && (n.Scalar() == "top" || n.Scalar() == "bottom")) return n.Scalar() == "top";
   r.problem(ProblemKind::kWrongType, n, what + ": expected top or bottom, found " + describe(n));
   return std::nullopt;
 }
@@ -213,7 +213,7 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   }
   std::vector<CasePly> plies;
   if (const YAML::Node l = r.required(n, "layup", what); l.IsDefined()) {
-    if (l.IsScalar()) {
+    if (case_yaml::is_scalar(l)) {
       lam.layup = l.Scalar();
       std::string error;
       std::size_t offset = 0;
@@ -240,7 +240,7 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
           plies.push_back(p);
         }
       }
-    } else if (l.IsSequence() && l.size() > 0) {
+    } else if (case_yaml::is_sequence(l) && l.size() > 0) {
       lam.layup = "list";
       ok = read_layup_list(r, l, what, thickness, material, spec, plies) && ok;
     } else {
@@ -446,7 +446,7 @@ std::optional<ToolMotion> read_motion(Reader& r, const YAML::Node& m, const std:
       return ToolMotion::constant_velocity(*v);
     }
     const YAML::Node t = m["table"];
-    if (!t.IsSequence() || t.size() == 0) {
+    if (!case_yaml::is_sequence(t) || t.size() == 0) {
       r.problem(ProblemKind::kWrongType, t,
                 mw + " table: expected a list of [t, dx, dy, dz] rows, found " + describe(t));
       return std::nullopt;
@@ -454,7 +454,7 @@ std::optional<ToolMotion> read_motion(Reader& r, const YAML::Node& m, const std:
     std::vector<std::pair<double, Vec3>> rows;
     for (std::size_t i = 0; i < t.size(); ++i) {
       const YAML::Node row = t[i];
-      if (!row.IsSequence() || row.size() != 4) {
+      if (!case_yaml::is_sequence(row) || row.size() != 4) {
         r.problem(ProblemKind::kWrongType, row,
                   mw + " table: expected a row [t (s), dx, dy, dz (mm)], found " + describe(row));
         return std::nullopt;
@@ -657,7 +657,7 @@ std::optional<std::vector<double>> parse_layup(const std::string& text, std::str
 }
 
 void read_laminates(Reader& r, const YAML::Node& n, FormingCase& spec) {
-  if (!n.IsSequence() || n.size() == 0) {
+  if (!case_yaml::is_sequence(n) || n.size() == 0) {
     r.problem(ProblemKind::kWrongType, n, "laminates: expected a list (- name: ...), found " + describe(n));
     return;
   }
@@ -665,7 +665,7 @@ void read_laminates(Reader& r, const YAML::Node& n, FormingCase& spec) {
 }
 
 void read_tools(Reader& r, const YAML::Node& n, const std::string& case_dir, FormingCase& spec) {
-  if (!n.IsSequence() || n.size() == 0) {
+  if (!case_yaml::is_sequence(n) || n.size() == 0) {
     r.problem(ProblemKind::kWrongType, n, "tools: expected a list (- name: ...), found " + describe(n));
     return;
   }
@@ -673,7 +673,7 @@ void read_tools(Reader& r, const YAML::Node& n, const std::string& case_dir, For
 }
 
 void read_contacts(Reader& r, const YAML::Node& n, FormingCase& spec) {
-  if (!n.IsSequence() || n.size() == 0) {
+  if (!case_yaml::is_sequence(n) || n.size() == 0) {
     r.problem(ProblemKind::kWrongType, n, "contact: expected a list (- ply: ...), found " + describe(n));
     return;
   }

@@ -1,10 +1,13 @@
 #include "forming/case/reader.hpp"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +18,7 @@
 #include "common/core/error.hpp"
 #include "forming/case/checks.hpp"
 #include "forming/case/contact_reader.hpp"
+#include "forming/case/model_checks.hpp"
 #include "forming/case/yaml_reader.hpp"
 
 namespace sf::forming {
@@ -173,7 +177,7 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
     ok = false;
   }
   if (const YAML::Node o = n["origin"]; o.IsDefined()) {
-    if (!o.IsSequence() || o.size() != 3) {
+    if (!case_yaml::is_sequence(o) || o.size() != 3) {
       r.problem(ProblemKind::kWrongType, o, what + " origin: expected [x, y, z] (mm), found " + describe(o));
       ok = false;
     } else {
@@ -243,7 +247,7 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
 }
 
 std::optional<PlySide> side_of(Reader& r, const YAML::Node& n, const std::string& what, bool allow_bottom) {
-  if (n.IsScalar()) {
+  if (case_yaml::is_scalar(n)) {
     const std::string& s = n.Scalar();
     if (s == "x0") return PlySide::kX0;
     if (s == "x1") return PlySide::kX1;
@@ -296,14 +300,14 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   if (bc.kind == CaseBoundary::Kind::kDisplacement) {
     const YAML::Node v = r.required(b, "value", bw);
     if (v.IsDefined()) {
-      if (!v.IsSequence() || v.size() != 3) {
+      if (!case_yaml::is_sequence(v) || v.size() != 3) {
         r.problem(ProblemKind::kWrongType, v,
                   bw + " value: expected [ux, uy, uz] (mm; ~ for a free component), found " + describe(v));
         ok = false;
       } else {
         int given = 0;
         for (int i = 0; i < 3; ++i) {
-          if (v[i].IsNull() || (v[i].IsScalar() && v[i].Scalar() == "free")) continue;
+          if (case_yaml::is_null(v[i]) || (case_yaml::is_scalar(v[i]) && v[i].Scalar() == "free")) continue;
           const auto u = r.number(v[i], bw + " value");
           if (u) {
             bc.value[i] = *u;
@@ -328,7 +332,7 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
 bool read_pressure(Reader& r, const YAML::Node& b, const std::string& lw, CaseLoad& load) {
   bool ok = true;
   if (const YAML::Node f = r.required(b, "face", lw); f.IsDefined()) {
-    if (f.IsScalar() && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
+    if (case_yaml::is_scalar(f) && (f.Scalar() == "top" || f.Scalar() == "bottom")) {
       load.top = f.Scalar() == "top";
     } else {
       r.problem(ProblemKind::kWrongType, f, lw + " face: expected top or bottom, found " + describe(f));
@@ -412,11 +416,11 @@ bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, con
   } else
     ok = false;
   if (const YAML::Node l = b["layer"]; l.IsDefined()) {
-    if (l.IsScalar() && l.Scalar() == "bottom")
+    if (case_yaml::is_scalar(l) && l.Scalar() == "bottom")
       load.layer = 0;
-    else if (l.IsScalar() && l.Scalar() == "top")
+    else if (case_yaml::is_scalar(l) && l.Scalar() == "top")
       load.layer = 1;
-    else if (l.IsScalar() && l.Scalar() == "both")
+    else if (case_yaml::is_scalar(l) && l.Scalar() == "both")
       load.layer = -1;
     else {
       r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
@@ -493,7 +497,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   s.control_place = place_of(n["control"]);
   s.analysis_place = place_of(n["analysis"]);
   if (const YAML::Node c = n["control"]; c.IsDefined()) {
-    if (c.IsScalar() && (c.Scalar() == "load" || c.Scalar() == "arc_length"))
+    if (case_yaml::is_scalar(c) && (c.Scalar() == "load" || c.Scalar() == "arc_length"))
       arc = c.Scalar() == "arc_length";
     else
       r.problem(ProblemKind::kWrongType, c, "solver control: expected load or arc_length, found " + describe(c));
@@ -514,7 +518,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                   std::string("solver ") + key + ": only used with control: arc_length");
   }
   if (const YAML::Node a = n["analysis"]; a.IsDefined()) {
-    if (a.IsScalar() && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
+    if (case_yaml::is_scalar(a) && (a.Scalar() == "static" || a.Scalar() == "dynamic"))
       s.dynamic = a.Scalar() == "dynamic";
     else
       r.problem(ProblemKind::kWrongType, a, "solver analysis: expected static or dynamic, found " + describe(a));
@@ -526,8 +530,23 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
       s.process_time = *v;
   if (n["time_step"].IsDefined())
     if (const auto v = r.positive(n["time_step"], "solver time_step", "s")) s.time_step = *v;
+  // Absurd durations run "forever" without a word: a forming process lasts seconds to hours.
+  constexpr double kLongestProcess = 1e5;  // s (28 hours)
+  for (const char* key : {"end_time", "process_time"}) {
+    const double value = std::string(key) == "end_time" ? s.end_time : s.process_time;
+    if (n[key].IsDefined() && value > kLongestProcess)
+      r.problem(ProblemKind::kOutOfRange, n[key],
+                std::string("solver ") + key + ": " + n[key].Scalar() +
+                    " s is beyond any forming process (at most 1e5 s = 28 hours); check the value and its unit (s)");
+  }
+  if (n["time_step"].IsDefined() && s.time_step > 0.0 && s.end_time / s.time_step > 1e7)
+    r.problem(ProblemKind::kOutOfRange, n["time_step"],
+              "solver time_step: " + n["time_step"].Scalar() + " s makes " +
+                  fmt::format("{:.3g}", s.end_time / s.time_step) +
+                  " time steps over end_time (at most 1e7); give a larger time_step or a shorter end_time");
   if (const YAML::Node i = n["integrator"]; i.IsDefined()) {
-    if (i.IsScalar() && (i.Scalar() == "generalized-alpha" || i.Scalar() == "hht-alpha" || i.Scalar() == "newmark"))
+    if (case_yaml::is_scalar(i) &&
+        (i.Scalar() == "generalized-alpha" || i.Scalar() == "hht-alpha" || i.Scalar() == "newmark"))
       s.integrator = i.Scalar();
     else
       r.problem(ProblemKind::kWrongType, i,
@@ -542,7 +561,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
       s.rho_inf = *v;
   }
   for (const char* key : {"end_time", "time_step", "integrator", "rho_inf"})
-    if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !n["analysis"].IsScalar()))
+    if (n[key].IsDefined() && !s.dynamic && !(n["analysis"].IsDefined() && !case_yaml::is_scalar(n["analysis"])))
       r.problem(ProblemKind::kUnsupported, n[key], std::string("solver ") + key + ": only used with analysis: dynamic");
   if (n["constraint_tolerance"].IsDefined()) {
     const auto v = r.number(n["constraint_tolerance"], "solver constraint_tolerance");
@@ -601,28 +620,28 @@ void drop_unknown_names(std::vector<CaseProblem>& problems, std::size_t from, Pr
 
 // Names of the tools listed (read or not); false when there are none.
 bool ts_names(const YAML::Node& root, std::set<std::string>& names) {
-  if (const YAML::Node ts = root["tools"]; ts.IsDefined() && ts.IsSequence())
+  if (const YAML::Node ts = root["tools"]; ts.IsDefined() && case_yaml::is_sequence(ts))
     for (const YAML::Node& t : ts)
-      if (t.IsMap() && t["name"].IsScalar()) names.insert(t["name"].Scalar());
+      if (case_yaml::is_map(t) && case_yaml::is_scalar(t["name"])) names.insert(t["name"].Scalar());
   return !names.empty();
 }
 
 void read_document(Reader& r, const YAML::Node& root, const std::string& case_dir, FormingCase& spec,
                    std::vector<CaseProblem>& problems) {
-  if (!root.IsDefined() || root.IsNull()) {
+  if (!root.IsDefined() || case_yaml::is_null(root)) {
     r.problem(ProblemKind::kMissing, SourcePlace{1, 1},
               "empty case file: expected materials, plies, boundary_conditions");
     return;
   }
   if (!r.mapping(root, "case", kTopKeys)) return;
   if (const YAML::Node u = root["units"]; u.IsDefined()) {
-    if (u.IsScalar())
+    if (case_yaml::is_scalar(u))
       spec.units = u.Scalar();
     else
       r.problem(ProblemKind::kWrongType, u, "units: expected a note such as \"mm, N, MPa\", found " + describe(u));
   }
   if (const YAML::Node ms = r.required(root, "materials", "case"); ms.IsDefined()) {
-    if (!ms.IsMap()) {
+    if (!case_yaml::is_map(ms)) {
       r.problem(ProblemKind::kWrongType, ms,
                 "materials: expected a mapping of names to laws (gfpp: {transversely_isotropic: ...}), found " +
                     describe(ms));
@@ -641,12 +660,12 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
   }
   // Names of materials that failed to read must not also be reported as "unknown".
   std::set<std::string> material_names;
-  if (const YAML::Node ms = root["materials"]; ms.IsMap())
+  if (const YAML::Node ms = root["materials"]; case_yaml::is_map(ms))
     for (auto it = ms.begin(); it != ms.end(); ++it) material_names.insert(it->first.Scalar());
   // Plies come from `plies`, `laminates` or both.
   const YAML::Node ps = root["laminates"].IsDefined() ? root["plies"] : r.required(root, "plies", "case");
   if (ps.IsDefined()) {
-    if (!ps.IsSequence() || ps.size() == 0) {
+    if (!case_yaml::is_sequence(ps) || ps.size() == 0) {
       r.problem(ProblemKind::kWrongType, ps, "plies: expected a list of plies (- name: ...), found " + describe(ps));
     } else {
       for (std::size_t i = 0; i < ps.size(); ++i) {
@@ -663,14 +682,14 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
     drop_unknown_names(problems, before, ProblemKind::kUnknownMaterial, material_names);
   }
   std::set<std::string> ply_names;
-  if (const YAML::Node listed = root["plies"]; listed.IsDefined() && listed.IsSequence())
+  if (const YAML::Node listed = root["plies"]; listed.IsDefined() && case_yaml::is_sequence(listed))
     for (const YAML::Node& p : listed)
-      if (p.IsMap() && p["name"].IsScalar()) ply_names.insert(p["name"].Scalar());
+      if (case_yaml::is_map(p) && case_yaml::is_scalar(p["name"])) ply_names.insert(p["name"].Scalar());
   // A name "<laminate>.<k>" of a laminate that failed to read: its own problem is enough.
   std::set<std::string> failed_laminates;
-  if (const YAML::Node ls = root["laminates"]; ls.IsDefined() && ls.IsSequence())
+  if (const YAML::Node ls = root["laminates"]; ls.IsDefined() && case_yaml::is_sequence(ls))
     for (const YAML::Node& l : ls)
-      if (l.IsMap() && l["name"].IsScalar() &&
+      if (case_yaml::is_map(l) && case_yaml::is_scalar(l["name"]) &&
           std::none_of(spec.laminates.begin(), spec.laminates.end(),
                        [&](const CaseLaminate& c) { return c.name == l["name"].Scalar(); }))
         failed_laminates.insert(l["name"].Scalar());
@@ -686,7 +705,7 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
                    problems.end());
   };
   if (const YAML::Node bs = r.required(root, "boundary_conditions", "case"); bs.IsDefined()) {
-    if (!bs.IsSequence() || bs.size() == 0) {
+    if (!case_yaml::is_sequence(bs) || bs.size() == 0) {
       r.problem(ProblemKind::kWrongType, bs,
                 "boundary_conditions: expected a list (- clamp: ...), found " + describe(bs));
     } else {
@@ -698,7 +717,7 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
     }
   }
   if (const YAML::Node ls = root["loads"]; ls.IsDefined()) {
-    if (!ls.IsSequence()) {
+    if (!case_yaml::is_sequence(ls)) {
       r.problem(ProblemKind::kWrongType, ls, "loads: expected a list (- pressure: ...), found " + describe(ls));
     } else {
       for (std::size_t i = 0; i < ls.size(); ++i) {
@@ -718,6 +737,47 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
     if (ts_names(root, tool_names)) drop_unknown_names(problems, before, ProblemKind::kUnknownTool, tool_names);
   }
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
+}
+
+// The values of `node` under `path`, flattened in file order (see FormingCase::fingerprint).
+void flatten(const YAML::Node& node, const std::string& path, std::vector<std::pair<std::string, std::string>>& out) {
+  if (case_yaml::is_map(node)) {
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string key = case_yaml::is_scalar(it->first) ? it->first.Scalar() : "?";
+      if (path.empty() && key == "output") continue;  // output settings may change for a restart
+      flatten(it->second, path.empty() ? key : path + "." + key, out);
+    }
+  } else if (case_yaml::is_sequence(node)) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      // A named item ("- name: top") is known by its name, so inserting one names it.
+      const YAML::Node item = node[i];
+      const std::string id =
+          case_yaml::is_map(item) && case_yaml::is_scalar(item["name"]) ? item["name"].Scalar() : std::to_string(i);
+      flatten(item, path + "[" + id + "]", out);
+    }
+    if (node.size() == 0) out.emplace_back(path, "[]");
+  } else if (case_yaml::is_scalar(node)) {
+    out.emplace_back(path, node.Scalar());
+  } else {
+    out.emplace_back(path, "null");
+  }
+}
+
+// FNV-1a of a file's bytes ("" when it cannot be read).
+std::string file_checksum(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::uint64_t h = 1469598103934665603ULL;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    for (std::streamsize i = 0; i < in.gcount(); ++i) {
+      h ^= static_cast<unsigned char>(buf[i]);
+      h *= 1099511628211ULL;
+    }
+  }
+  char hex[20];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
 }
 
 }  // namespace
@@ -740,9 +800,15 @@ CaseCheck check_case_text(const std::string& text, const std::string& name) {
     result.problems.push_back(
         {ProblemKind::kUnreadable, {e.mark.line + 1, e.mark.column + 1}, std::string("cannot read: ") + e.msg, {}});
   }
+  flatten(root, "", result.spec.fingerprint);
+  for (const CaseTool& t : result.spec.tools)
+    if (!t.file.empty())
+      result.spec.fingerprint.emplace_back("tools[" + t.name + "] file " + t.file, file_checksum(t.file));
   check_solver_rules(result.spec, result.problems);
   // Conditions are discretised only for a case that read cleanly (valid plies).
   if (result.ok()) check_boundary_conditions(result.spec, result.problems);
+  // The model itself: held plies, sane geometry, a size the machine can solve.
+  if (result.ok()) check_model(result.spec, result.problems, machine_memory_bytes());
   std::stable_sort(result.problems.begin(), result.problems.end(), [](const CaseProblem& a, const CaseProblem& b) {
     return std::tie(a.place.line, a.place.column) < std::tie(b.place.line, b.place.column);
   });

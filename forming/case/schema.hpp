@@ -45,6 +45,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/core/types.hpp"
@@ -212,6 +213,10 @@ struct FormingCase {
   std::vector<CaseContact> contacts;
   CaseSolver solver;
   CaseOutput output;
+  // Every value of the case file except `output`, flattened ("materials.carbon.E_T",
+  // "1000"), and a checksum of each file it names (tool STLs): what a restart must match
+  // (forming/output/restart.hpp). Filled by the reader; empty for a case built in code.
+  std::vector<std::pair<std::string, std::string>> fingerprint;
 
   int find_ply(const std::string& name) const;  // -1 when absent
 };

@@ -21,6 +21,14 @@
 
 namespace sf::forming::case_yaml {
 
+// Type tests that are false for a node that is not there: yaml-cpp's own IsScalar() etc.
+// throw InvalidNode on the "zombie" node a const operator[] returns for a missing key (the
+// "cannot read: invalid node" with no place, which stopped the whole check).
+inline bool is_scalar(const YAML::Node& n) { return n.IsDefined() && n.IsScalar(); }
+inline bool is_map(const YAML::Node& n) { return n.IsDefined() && n.IsMap(); }
+inline bool is_sequence(const YAML::Node& n) { return n.IsDefined() && n.IsSequence(); }
+inline bool is_null(const YAML::Node& n) { return n.IsDefined() && n.IsNull(); }
+
 inline SourcePlace place_of(const YAML::Node& n) {
   if (!n.IsDefined()) return {};
   const YAML::Mark m = n.Mark();
@@ -59,7 +67,8 @@ class Reader {
 
   // `n` must be a mapping whose keys are all in `allowed` (no duplicates).
   bool mapping(const YAML::Node& n, const std::string& what, const std::vector<std::string>& allowed) {
-    if (!n.IsMap()) {
+    if (!n.IsDefined()) return false;  // missing: required() said so
+    if (!is_map(n)) {
       problem(ProblemKind::kWrongType, n, what + ": expected a mapping (key: value), found " + describe(n));
       return false;
     }
@@ -79,7 +88,8 @@ class Reader {
   }
 
   std::optional<double> number(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar()) {
+    if (!n.IsDefined()) return std::nullopt;  // missing: required() said so
+    if (!is_scalar(n)) {
       problem(ProblemKind::kWrongType, n, what + ": expected a number, found " + describe(n));
       return std::nullopt;
     }
@@ -104,7 +114,8 @@ class Reader {
   }
 
   std::optional<int> integer(const YAML::Node& n, const std::string& what, int lo, int hi) {
-    if (!n.IsScalar()) {
+    if (!n.IsDefined()) return std::nullopt;  // missing: required() said so
+    if (!is_scalar(n)) {
       problem(ProblemKind::kWrongType, n, what + ": expected an integer, found " + describe(n));
       return std::nullopt;
     }
@@ -125,7 +136,8 @@ class Reader {
   }
 
   std::optional<bool> boolean(const YAML::Node& n, const std::string& what) {
-    if (n.IsScalar()) {
+    if (!n.IsDefined()) return std::nullopt;  // missing: required() said so
+    if (is_scalar(n)) {
       const std::string& s = n.Scalar();
       if (s == "true" || s == "yes" || s == "on") return true;
       if (s == "false" || s == "no" || s == "off") return false;
@@ -135,7 +147,8 @@ class Reader {
   }
 
   std::optional<std::string> text(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar() || n.Scalar().empty()) {
+    if (!n.IsDefined()) return std::nullopt;  // missing: required() said so
+    if (!is_scalar(n) || n.Scalar().empty()) {
       problem(ProblemKind::kWrongType, n, what + ": expected a name, found " + describe(n));
       return std::nullopt;
     }
@@ -155,7 +168,7 @@ class Reader {
 
 // [a, b] of positive numbers, or [n1, n2] of integers.
 inline bool pair_of(Reader& r, const YAML::Node& n, const std::string& what) {
-  if (!n.IsSequence() || n.size() != 2) {
+  if (!is_sequence(n) || n.size() != 2) {
     r.problem(ProblemKind::kWrongType, n, what + ": expected a list of two values [x, y], found " + describe(n));
     return false;
   }
@@ -183,9 +196,9 @@ inline bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, cons
 inline bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ramp& ramp) {
   const YAML::Node rp = b["ramp"];
   if (!rp.IsDefined()) return true;
-  if (rp.IsScalar() && rp.Scalar() == "linear") {
+  if (is_scalar(rp) && rp.Scalar() == "linear") {
     ramp = Ramp::kLinear;
-  } else if (rp.IsScalar() && rp.Scalar() == "smooth") {
+  } else if (is_scalar(rp) && rp.Scalar() == "smooth") {
     ramp = Ramp::kSmooth;
   } else {
     r.problem(ProblemKind::kWrongType, rp, what + " ramp: expected linear or smooth, found " + describe(rp));
@@ -195,7 +208,7 @@ inline bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ram
 }
 
 inline std::optional<Vec3> vector3(Reader& r, const YAML::Node& n, const std::string& what, const std::string& unit) {
-  if (!n.IsSequence() || n.size() != 3) {
+  if (!is_sequence(n) || n.size() != 3) {
     r.problem(ProblemKind::kWrongType, n, what + ": expected [x, y, z] (" + unit + "), found " + describe(n));
     return std::nullopt;
   }

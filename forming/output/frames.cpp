@@ -96,6 +96,14 @@ void FrameSeries::write(const io::AtomicOutputDir& out, int k, double lambda, co
   frames_.erase(std::remove_if(frames_.begin(), frames_.end(), [&](const auto& f) { return f.second == name; }),
                 frames_.end());
   frames_.emplace_back(lambda, name);
+  // The parts of a frame of the same step written before (a restart) are replaced too.
+  char number[16];
+  std::snprintf(number, sizeof number, "_%04d.vtu", k);
+  parts_.erase(std::remove_if(parts_.begin(), parts_.end(),
+                              [&](const io::PvdDataSet& p) {
+                                return p.file.size() > 16 && p.file.compare(p.file.size() - 9, 9, number) == 0;
+                              }),
+               parts_.end());
   if (context) write_contact_parts(out, k, lambda, x, *context);
 }
 

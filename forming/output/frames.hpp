@@ -50,6 +50,10 @@ class FrameSeries {
              const InteractionContext* context = nullptr);
   // A frame already in the output folder (kept by a restart).
   void keep(double lambda, const std::string& name) { frames_.emplace_back(lambda, name); }
+  // A tool or contact part already in the output folder (kept by a restart).
+  void keep_part(const io::PvdDataSet& part) { parts_.push_back(part); }
+  // The tool and contact parts of every frame, in the order written.
+  const std::vector<io::PvdDataSet>& parts() const { return parts_; }
   // (load factor, file name) of every frame, in the order written.
   const std::vector<std::pair<double, std::string>>& frames() const { return frames_; }
   // result.pvd listing them (and the tool and contact parts written by this run).

@@ -1,6 +1,7 @@
 #include "forming/output/restart.hpp"
 
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -21,6 +22,27 @@ std::string model_fingerprint(const FormingCase& spec, const Model& model) {
   return os.str();
 }
 
+// What changed between the case values a restart file was written with and `now`
+// ("materials.carbon.E_T: 1000 -> 2000"), at most a few, or "" when nothing did.
+std::string case_changes(const nlohmann::json& then, const std::vector<std::pair<std::string, std::string>>& now) {
+  std::map<std::string, std::string> before, after(now.begin(), now.end());
+  for (const auto& e : then) before[e.at(0).get<std::string>()] = e.at(1).get<std::string>();
+  std::vector<std::string> changes;
+  for (const auto& [key, value] : before) {
+    const auto it = after.find(key);
+    if (it == after.end())
+      changes.push_back(key + " removed (was " + value + ")");
+    else if (it->second != value)
+      changes.push_back(key + ": " + value + " -> " + it->second);
+  }
+  for (const auto& [key, value] : after)
+    if (!before.count(key)) changes.push_back(key + " added (" + value + ")");
+  std::string out;
+  for (std::size_t i = 0; i < changes.size() && i < 5; ++i) out += (i ? "; " : "") + changes[i];
+  if (changes.size() > 5) out += "; and " + std::to_string(changes.size() - 5) + " more";
+  return out;
+}
+
 }  // namespace
 
 void write_restart(const std::string& path, const FormingCase& spec, const Model& model, const RestartState& s) {
@@ -28,6 +50,9 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   j["format"] = "simform-restart-1";
   j["case"] = spec.file;
   j["fingerprint"] = model_fingerprint(spec, model);
+  nlohmann::json values = nlohmann::json::array();
+  for (const auto& [key, value] : spec.fingerprint) values.push_back({key, value});
+  j["case_values"] = values;
   j["step"] = s.step;
   j["load_factor"] = s.load_factor;
   j["positions"] = std::vector<double>(s.positions.data(), s.positions.data() + s.positions.size());
@@ -39,6 +64,9 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   nlohmann::json f = nlohmann::json::array();
   for (const auto& [lam, name] : s.frames) f.push_back({lam, name});
   j["frames"] = f;
+  nlohmann::json parts = nlohmann::json::array();
+  for (const io::PvdDataSet& p : s.parts) parts.push_back({p.time, p.file, p.part});
+  j["parts"] = parts;
   io::write_file_atomic(path, j.dump());
 }
 
@@ -52,6 +80,18 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
     throw InputError(path + ": not a readable restart file (" + e.what() + ")");
   }
   if (j.value("format", "") != "simform-restart-1") throw InputError(path + ": not a simform restart file");
+  if (j.contains("case_values") && !spec.fingerprint.empty()) {
+    std::string changes;
+    try {
+      changes = case_changes(j.at("case_values"), spec.fingerprint);
+    } catch (const std::exception& e) {
+      throw InputError(path + ": not a readable restart file (" + e.what() + ")");
+    }
+    if (!changes.empty())
+      throw InputError(path + ": written for a different case; changed since: " + changes +
+                       " (only the output settings may change for a restart; run without --restart to start "
+                       "again)");
+  }
   if (j.value("fingerprint", "") != model_fingerprint(spec, model))
     throw InputError(path +
                      ": written for a different model (plies, meshes or materials changed since; only solver, "
@@ -70,7 +110,14 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
     if (model.constrained(b))
       model.set_multipliers(b, m[b].at("p").get<std::vector<double>>(), m[b].at("T").get<std::vector<double>>());
   s.history_rows = j.value("history_rows", "");
-  for (const auto& f : j.at("frames")) s.frames.emplace_back(f.at(0).get<double>(), f.at(1).get<std::string>());
+  try {
+    for (const auto& f : j.at("frames")) s.frames.emplace_back(f.at(0).get<double>(), f.at(1).get<std::string>());
+    if (j.contains("parts"))
+      for (const auto& p : j.at("parts"))
+        s.parts.push_back({p.at(0).get<double>(), p.at(1).get<std::string>(), p.at(2).get<int>()});
+  } catch (const std::exception& e) {
+    throw InputError(path + ": not a readable restart file (" + e.what() + ")");
+  }
   if (s.positions.size() != model.n_dofs()) throw InputError(path + ": wrong number of positions");
   return s;
 }

@@ -7,16 +7,21 @@
 //   case           the case file
 //   fingerprint    what must not change for a restart: dofs, and every ply's name,
 //                  origin, size, thickness, elements, angle and material
+//   case_values    [key, value] of every value of the case file except `output`, and a
+//                  checksum of each tool file (FormingCase::fingerprint); a restart
+//                  with any of them changed is refused, naming what changed
 //   step, load_factor  of the state
 //   positions      n_dofs (mm); velocities n_dofs (mm/s, dynamic runs) or empty
 //   multipliers    per body {p, T}: element pressures and fibre tensions (MPa)
 //   history_rows   the rows of history.csv so far (without the header)
 //   frames         [load factor, file name] of every frame written so far
+//   parts          [load factor, file name, part] of the tool and contact parts so far
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/io/vtk_xml.hpp"
 #include "forming/case/schema.hpp"
 #include "forming/model/model.hpp"
 
@@ -29,6 +34,7 @@ struct RestartState {
   VecX velocities;  // dynamic runs (mm/s); empty for static ones
   std::string history_rows;
   std::vector<std::pair<double, std::string>> frames;
+  std::vector<io::PvdDataSet> parts;  // tool and contact parts (part >= 1)
 };
 
 // The multipliers come from `model`.

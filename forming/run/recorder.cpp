@@ -24,6 +24,23 @@ std::string sci(double v) {
   return buf;
 }
 
+// The working folder OUT.partial holds the frames and restart.json of a run in progress;
+// it survives a kill, and `--restart` continues in it. Committed, it replaces OUT whole:
+// the outputs of an earlier run (its frames, series, history, summary) never stay beside
+// those of this one; other files in OUT (the user's) are kept.
+io::OutputDirOptions folder_options(const RunOptions& options) {
+  io::OutputDirOptions o;
+  o.owned = {"steps", "result.pvd", "history.csv", "summary.json", "restart.json"};
+  o.work_suffix = ".partial";
+  // Continue in the working folder of a killed run when it got as far as a restart file.
+  std::filesystem::path dir = std::filesystem::path(options.out_dir).lexically_normal();
+  if (!dir.has_filename()) dir = dir.parent_path();  // "out/" -> "out"
+  std::error_code ec;
+  o.resume = options.restart && !options.out_dir.empty() &&
+             std::filesystem::exists(std::filesystem::path(dir.string() + o.work_suffix) / "restart.json", ec);
+  return o;
+}
+
 }  // namespace
 
 RunRecorder::RunRecorder(const FormingCase& spec, Problem& problem, const RunOptions& options)
@@ -31,10 +48,10 @@ RunRecorder::RunRecorder(const FormingCase& spec, Problem& problem, const RunOpt
       problem_(problem),
       options_(options),
       X_(problem.model.reference_positions()),
-      out_(options.out_dir),
+      out_(options.out_dir, folder_options(options)),
       frames_(problem.model, spec.output.samples_inplane, spec.output.samples_thickness),
       history_(problem.model, tool_edge(spec, problem.model)),
-      restart_path_((std::filesystem::path(options.out_dir) / "restart.json").string()),
+      restart_path_((out_.temp_dir() / "restart.json").string()),
       created_(Clock::now()) {
   report_.status = RunReport::Status::kConverged;
 }
@@ -42,16 +59,35 @@ RunRecorder::RunRecorder(const FormingCase& spec, Problem& problem, const RunOpt
 SteppingState RunRecorder::start() {
   SteppingState state{X_, VecX::Zero(problem_.model.n_dofs()), 0.0};
   if (options_.restart) {
+    // A killed run's working folder, or else the committed results (linked in whole).
+    const bool killed_run = std::filesystem::exists(restart_path_);
+    if (!killed_run) out_.seed_from_final();
     restart_ = read_restart(restart_path_, spec_, problem_.model);
     state.x = restart_.positions;
     if (spec_.solver.dynamic && restart_.velocities.size() == problem_.model.n_dofs()) state.v = restart_.velocities;
     state.load_factor = restart_.load_factor;
-    // Earlier frames still present in the folder stay in the collection.
-    for (const auto& [lambda, name] : restart_.frames)
-      if (std::filesystem::exists(std::filesystem::path(options_.out_dir) / name)) frames_.keep(lambda, name);
+    // Earlier frames (and their tool and contact parts) of this run stay in the collection;
+    // they lie in the same folder as the restart file, so they are this run's own.
+    int missing = 0;
+    for (const auto& [lambda, name] : restart_.frames) {
+      if (std::filesystem::exists(out_.temp_dir() / name))
+        frames_.keep(lambda, name);
+      else
+        ++missing;
+    }
+    for (const io::PvdDataSet& part : restart_.parts) {
+      if (std::filesystem::exists(out_.temp_dir() / part.file))
+        frames_.keep_part(part);
+      else
+        ++missing;
+    }
     history_.append_rows(restart_.history_rows);
     cli::status(options_.quiet, "simform: restarting from load factor " + std::to_string(state.load_factor) +
-                                    " (step " + std::to_string(restart_.step) + " of the earlier run)");
+                                    " (step " + std::to_string(restart_.step) + " of the earlier run" +
+                                    (killed_run ? ", from the folder of the interrupted run" : "") + ")");
+    if (missing > 0)
+      cli::status(options_.quiet, "simform: warning: " + std::to_string(missing) +
+                                      " earlier frame files are missing; the series lists the others");
   } else {
     history_.add_row(0, 0.0, state.x, VecX::Zero(problem_.model.n_dofs()), 0, 0, 0.0);
     const Clock::time_point t0 = Clock::now();
@@ -137,8 +173,7 @@ void RunRecorder::write_step(int k, double load_factor) {
   restart_.velocities = spec_.solver.dynamic ? last_.v : VecX();
   restart_.history_rows = history_.rows();
   restart_.frames = frames_.frames();
-  std::error_code ec;
-  std::filesystem::create_directories(options_.out_dir, ec);
+  restart_.parts = frames_.parts();
   write_restart(restart_path_, spec_, problem_.model, restart_);
   seconds_write_ += seconds_since(t0);
 }

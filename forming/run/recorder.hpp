@@ -12,8 +12,11 @@
 //              history.csv and summary.json, committed together; then the grid file of
 //              a converged run.
 //
-// Everything is written into an io::AtomicOutputDir, except restart.json, which goes
-// straight into the final folder with every frame so that it survives a killed run.
+// Everything is written into an io::AtomicOutputDir whose working folder is OUT.partial
+// (kept when the run is killed): the frames and restart.json land there together, so a
+// `--restart` after a kill continues in it with every frame written so far (tool and
+// contact parts too); a `--restart` after a clean stop links the committed OUT into it.
+// Committing replaces OUT whole (the outputs of an older run never stay beside these).
 #include <chrono>
 #include <string>
 

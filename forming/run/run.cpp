@@ -5,7 +5,11 @@
 #include <memory>
 #include <sstream>
 
+#include <fmt/format.h>
+
+#include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
+#include "forming/case/model_checks.hpp"
 #include "forming/case/build.hpp"
 #include "forming/model/problem.hpp"
 #include "forming/run/recorder.hpp"
@@ -50,10 +54,17 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   options.validate();
   check_options_against(spec, options);
 
-  // Build the problem and translate the solver settings, once.
+  // Build the problem and translate the solver settings, once. Large models take a while
+  // to set up: say how large first.
+  const ModelEstimate size = estimate_model(spec);
+  cli::status(options.quiet, fmt::format("simform: setting up {} unknowns (about {:.0f} MB to solve)", size.unknowns,
+                                         size.total_bytes() / 1e6));
   Problem problem = build_problem(spec);
   const StepperSettings settings = stepper_settings(spec);
   const double seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  cli::status(options.quiet, fmt::format("simform: model set up in {:.1f} s; the first step also analyses the "
+                                         "matrix pattern",
+                                         seconds_build));
 
   // The recorder writes every output; stepping starts where it says (reference or restart).
   RunRecorder recorder(spec, problem, options);

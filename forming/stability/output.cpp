@@ -271,7 +271,9 @@ render::Chart direction_chart(const StabilityResult& r) {
 }  // namespace
 
 std::vector<std::string> write_stability_outputs(const StabilityResult& result, const OutputOptions& options) {
-  io::AtomicOutputDir out(options.out_dir);
+  io::OutputDirOptions folder;
+  folder.owned = {"growth_rate.csv", "summary.json", "*.png"};  // an older run's maps never stay
+  io::AtomicOutputDir out(options.out_dir, folder);
   std::vector<std::string> files = {"growth_rate.csv", "summary.json"};
   io::write_file_atomic(out.path("growth_rate.csv"), [&](std::ostream& os) { write_csv(result, os); });
   if (options.plots) {

@@ -373,7 +373,9 @@ int run_synth_images(const SynthImagesArgs& a, bool quiet) {
   const std::vector<synth::Scene> boards = synth::example_calibration_boards(o);
   const synth::Scene flat = synth::example_part(o, synth::SheetShape::kFlat);
   const synth::Scene formed = synth::example_part(o, o.shape);
-  io::AtomicOutputDir out(a.out);
+  io::OutputDirOptions folder;
+  folder.owned = {"calib", "flat", "formed", "truth.csv", "rig_true.json", "README.txt"};
+  io::AtomicOutputDir out(a.out, folder);
   const long total = static_cast<long>(cams.size() * (boards.size() + 2));
   cli::Progress progress("gsa: rendering", total, quiet);
   long done = 0;

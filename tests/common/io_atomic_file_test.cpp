@@ -1,12 +1,16 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fstream>
 #include <stdexcept>
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
 #include "tests/common/io_test_util.hpp"
+#include "tests/common/kill_replace.hpp"
 
 namespace sf::io {
 namespace {
@@ -102,6 +106,115 @@ TEST(IoAtomicFile, WriteFileAtomicReplacesWholeFile) {
   EXPECT_EQ(test::read_text(path), "second");
   EXPECT_EQ(count_entries(scratch.path(), "a.txt"), 1);
   EXPECT_THROW(write_file_atomic(scratch.file("missing/dir/a.txt"), std::string("x")), Error);
+}
+
+// A pid that ran and is gone (a child that exited).
+long dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return static_cast<long>(child);
+}
+
+TEST(IoAtomicFile, CommitReplacesTheWholeFolderKeepingTheUsersFiles) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  fs::create_directories(out / "steps");
+  test::write_text(out / "strains.csv", "old\n");
+  test::write_text(out / "major_strain.png", "old picture\n");  // an output the new run does not write
+  test::write_text(out / "steps" / "step_9.vtu", "old frame\n");
+  test::write_text(out / "notes.txt", "mine\n");
+  OutputDirOptions o;
+  o.owned = {"strains.csv", "*.png", "steps"};
+  AtomicOutputDir dir(out, o);
+  test::write_text(dir.path("strains.csv"), "new\n");
+  test::write_text(dir.path("steps/step_1.vtu"), "new frame\n");
+  dir.commit();
+  EXPECT_EQ(test::read_text(out / "strains.csv"), "new\n");
+  EXPECT_EQ(test::read_text(out / "steps" / "step_1.vtu"), "new frame\n");
+  EXPECT_FALSE(fs::exists(out / "major_strain.png"));       // the old run's: gone
+  EXPECT_FALSE(fs::exists(out / "steps" / "step_9.vtu"));   // the old run's: gone
+  EXPECT_EQ(test::read_text(out / "notes.txt"), "mine\n");  // the user's: kept
+  EXPECT_EQ(count_entries(scratch.path(), "results"), 1);
+}
+
+TEST(IoAtomicFile, SecondWriterOfTheSameFolderStopsWithAClearMessage) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  AtomicOutputDir first(out);
+  const std::string msg = test::message_of<Error>([&] { AtomicOutputDir second(out); });
+  EXPECT_THAT(msg, ::testing::HasSubstr("another run (process " + std::to_string(::getpid()) + ")"));
+  EXPECT_THAT(msg, ::testing::HasSubstr(out.string()));
+  // Another folder beside it is free.
+  EXPECT_NO_THROW(AtomicOutputDir other(scratch.path() / "results2"));
+}
+
+TEST(IoAtomicFile, StaleTemporariesOfDeadRunsAreRemoved) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  const long dead = dead_pid();
+  const fs::path stale = scratch.path() / ("results.tmp-" + std::to_string(dead) + "-3");
+  const fs::path live = scratch.path() / ("results.tmp-" + std::to_string(::getppid()) + "-0");
+  const fs::path other = scratch.path() / ("resultsX.tmp-" + std::to_string(dead) + "-0");
+  for (const auto& d : {stale, live, other}) fs::create_directories(d / "steps");
+  test::write_text(stale / "steps" / "a.vtu", "x");
+  { AtomicOutputDir dir(out); }
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(live));   // its process runs
+  EXPECT_TRUE(fs::exists(other));  // another folder's
+}
+
+TEST(IoAtomicFile, FolderLostBetweenTheFallbackRenamesIsPutBack) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  const fs::path aside = scratch.path() / ("results.old-" + std::to_string(dead_pid()) + "-0");
+  fs::create_directories(aside);
+  test::write_text(aside / "strains.csv", "complete\n");
+  { AtomicOutputDir dir(out); }
+  EXPECT_EQ(test::read_text(out / "strains.csv"), "complete\n");
+  EXPECT_FALSE(fs::exists(aside));
+}
+
+TEST(IoAtomicFile, EmptyOrCurrentFolderIsRefused) {
+  EXPECT_THROW(AtomicOutputDir(""), Error);
+  EXPECT_THROW(AtomicOutputDir("."), Error);
+  EXPECT_THROW(AtomicOutputDir(fs::current_path().parent_path()), Error);
+}
+
+TEST(IoAtomicFile, WorkingFolderSurvivesAFailureAndIsResumed) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "run";
+  OutputDirOptions o;
+  o.work_suffix = ".partial";
+  {
+    AtomicOutputDir dir(out, o);
+    test::write_text(dir.path("steps/step_1.vtu"), "1");
+  }  // abandoned (a failure): kept
+  EXPECT_TRUE(fs::exists(scratch.path() / "run.partial" / "steps" / "step_1.vtu"));
+  o.resume = true;
+  {
+    AtomicOutputDir dir(out, o);
+    EXPECT_TRUE(fs::exists(dir.path("steps/step_1.vtu")));
+    test::write_text(dir.path("steps/step_2.vtu"), "2");
+    dir.commit();
+  }
+  EXPECT_TRUE(fs::exists(out / "steps" / "step_1.vtu"));
+  EXPECT_TRUE(fs::exists(out / "steps" / "step_2.vtu"));
+  EXPECT_FALSE(fs::exists(scratch.path() / "run.partial"));
+  // Seeding from the committed folder links its files in.
+  o.resume = false;
+  AtomicOutputDir dir(out, o);
+  EXPECT_TRUE(dir.seed_from_final());
+  EXPECT_EQ(test::read_text(dir.temp_dir() / "steps" / "step_2.vtu"), "2");
+}
+
+// The fast version of the kill-during-replace study (100 kills: ctest -L long).
+TEST(IoAtomicFile, KillsDuringReplaceAlwaysLeaveOneCompleteSet) {
+  test::ScratchDir scratch;
+  const test::KillStudy s = test::kill_during_replace(scratch.path() / "results", 12, 12, 7);
+  EXPECT_EQ(s.complete, s.kills) << s.first_problem;
+  EXPECT_EQ(s.left_after_cleaning, 0);
 }
 
 }  // namespace

@@ -88,7 +88,14 @@ TEST(GsaMeshFile, BadFilesAreNamed) {
       "d.json", R"({"nodes": [[0,0,0],[1,0,0],[2,0,0],[0,1,0],[1,1,0],[2,1,0]], "elements": [[0,1,3,4],[2,1,5,4]]})");
   EXPECT_THAT(message_of([&] { read_mesh_file(d); }), HasSubstr("disagreeing xi directions"));
   const std::string f = write_temp("f.json", "{ not json");
-  EXPECT_THAT(message_of([&] { read_mesh_file(f); }), HasSubstr("not valid JSON"));
+  EXPECT_THAT(message_of([&] { read_mesh_file(f); }), HasSubstr("invalid JSON"));
+  EXPECT_THAT(message_of([&] { read_mesh_file(f); }), HasSubstr("f.json:1:"));  // line and column
+  // Issue 20: a number beyond a double and a folder were "internal error, please report".
+  const std::string g =
+      write_temp("g.json", R"({"nodes": [[0,0,1e400],[1,0,0],[0,1,0],[1,1,0]], "elements": [[0,1,3,2]]})");
+  EXPECT_THAT(message_of([&] { read_mesh_file(g); }), HasSubstr("1e400"));
+  const std::string folder = std::filesystem::path(f).parent_path().string();
+  EXPECT_THAT(message_of([&] { read_mesh_file(folder); }), HasSubstr("is a folder"));
 }
 
 }  // namespace

@@ -113,6 +113,7 @@ void add_contacts(const FormingCase& spec, Model& model) {
     o.normal = c.law.normal;
     o.friction = c.law.friction;
     o.points = c.law.points;
+    o.band = c.law.band;
     ContactSurface slave = ContactSurface::whole_face(model, c.ply, c.top);
     if (c.tool >= 0) {
       model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),

@@ -41,8 +41,8 @@ int find_material(const FormingCase& spec, const std::string& name) {
   return -1;
 }
 
-const std::vector<std::string> kLawKeys = {"stiffness",      "tolerance",  "viscous", "coulomb",
-                                           "stick_velocity", "engage_gap", "points",  "two_pass"};
+const std::vector<std::string> kLawKeys = {"stiffness",  "tolerance", "viscous",  "coulomb", "stick_velocity",
+                                           "engage_gap", "points",    "two_pass", "band"};
 
 // The contact law keys of mapping n (those present in kLawKeys); false on a problem.
 bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
@@ -94,6 +94,12 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
   if (n["points"].IsDefined()) {
     if (const auto v = r.integer(n["points"], what + " points (per face direction)", 1, 12))
       law.points = *v;
+    else
+      ok = false;
+  }
+  if (n["band"].IsDefined()) {
+    if (const auto v = r.positive(n["band"], what + " band", "mm"))
+      law.band = *v;
     else
       ok = false;
   }

@@ -177,6 +177,7 @@ struct CaseContactLaw {
   FrictionLaw friction;   // viscous c_f (N s/mm^3), coulomb mu, stick_velocity (mm/s), engage_gap (mm)
   int points = 6;         // contact points per face direction
   bool two_pass = false;  // ply-ply: two half-passes (forming/contact/surface_contact.hpp)
+  double band = 0.0;      // mm, rounded kink of the normal law; 0: default (1e-3 ply thicknesses)
 };
 
 struct CaseTool {

@@ -64,6 +64,11 @@ void ContactOptions::validate() const {
   friction.validate();
   if (points < 1 || points > 12)
     throw InputError("contact points: expected 1..12 points per face direction, found " + std::to_string(points));
+  if (!(std::isfinite(band) && band >= 0.0)) {
+    std::ostringstream os;
+    os << "contact band: expected a length >= 0 (mm; 0 = default), found " << band;
+    throw InputError(os.str());
+  }
   if (!(std::isfinite(search_distance) && search_distance >= 0.0)) {
     std::ostringstream os;
     os << "contact search_distance: expected a length >= 0 (mm; 0 = default), found " << search_distance;
@@ -118,7 +123,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
   }
   const bool friction = options_.friction.active() && rates;
   const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
-  const double band = kBand * slave_.thickness();
+  const double band = options_.band > 0.0 ? options_.band : kBand * slave_.thickness();
   const double engage = engage_gap();
   std::vector<PairBlock> blocks;
   for (Index f = 0; f < slave_.n_faces(); ++f) {

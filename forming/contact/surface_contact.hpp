@@ -57,6 +57,12 @@ struct ContactOptions {
   FrictionLaw friction;
   int points = 6;                // contact points per face direction (Gauss), 1..12
   double search_distance = 0.0;  // mm; 0: the default (the plies' thicknesses summed)
+  // Width of the normal law's rounded kink (contact_law.hpp), mm; 0: the default,
+  // 1e-3 x the slave ply's thickness. Wider converges faster where many points sit at the
+  // kink (stacked plies): the laminate punch sample's first step takes 15 Newton
+  // iterations with 1e-2 x the thickness against 187 (3 cut-backs) with the default,
+  // at the price of a pressure S_n band / 8 between plies that merely touch.
+  double band = 0.0;
   // Half pass (body contact): the point's traction acts on the slave side only; two half
   // passes, each side once the slave, make the two-half-pass scheme (see header).
   bool half_pass = false;

@@ -113,10 +113,19 @@ void add_contacts(const FormingCase& spec, Model& model) {
     o.normal = c.law.normal;
     o.friction = c.law.friction;
     o.points = c.law.points;
+    o.band = c.law.band;
     ContactSurface slave = ContactSurface::whole_face(model, c.ply, c.top);
     if (c.tool >= 0) {
       model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),
                                                           spec.tools.at(static_cast<std::size_t>(c.tool)).tool, o));
+    } else if (c.law.two_pass) {
+      // Two half-passes: each side's points against the other, forces on its own side.
+      o.half_pass = true;
+      model.add_interaction(std::make_shared<BodyContact>(c.label, model, std::move(slave),
+                                                          ContactSurface::whole_face(model, c.with, c.with_top), o));
+      model.add_interaction(std::make_shared<BodyContact>(c.label + " (second pass)", model,
+                                                          ContactSurface::whole_face(model, c.with, c.with_top),
+                                                          ContactSurface::whole_face(model, c.ply, c.top), o));
     } else {
       model.add_interaction(std::make_shared<BodyContact>(c.label, model, std::move(slave),
                                                           ContactSurface::whole_face(model, c.with, c.with_top), o));

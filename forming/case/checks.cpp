@@ -1,6 +1,8 @@
 #include "forming/case/checks.hpp"
 
+#include <algorithm>
 #include <string>
+#include <tuple>
 
 namespace sf::forming {
 
@@ -48,6 +50,46 @@ std::vector<EdgeCondition> edge_conditions(const FormingCase& spec, int ply) {
   return out;
 }
 
+// Plane strain across the width (y) of a ply: at every node of both layers, every
+// parameter of y held at its reference value (u_y = 0: y = Y, dy/ds1 = 0, dy/ds2 = 1,
+// cross 0) and the width derivatives of x and z (d/ds2 and d2/ds1ds2) held at 0. The
+// values of x and z on the two width edges stay separate unknowns: with loads, contact
+// and conditions uniform in y the problem is mirror-symmetric about the mid-width, so
+// they move together (Newton keeps the symmetry to round-off), and any difference would
+// cost shear strain across the width. A condition that moves y is a conflict.
+namespace {
+void add_plane_strain(const CasePly& ply, PlyConditions& c, std::vector<CaseProblem>& problems) {
+  const PlyGrid grid{ply.n1, ply.n2};
+  const Index n_nodes = 2 * grid.n_surface_nodes();
+  std::vector<PrescribedParameter> added;
+  const auto find = [&](Index node, int d, int coord) {
+    return std::find_if(c.parameters.begin(), c.parameters.end(),
+                        [&](const PrescribedParameter& p) { return p.node == node && p.d == d && p.coord == coord; });
+  };
+  bool reported = false;
+  for (Index node = 0; node < n_nodes; ++node)
+    for (int d = 0; d < 4; ++d)
+      for (int coord = 0; coord < 3; ++coord) {
+        if (coord != 1 && d < 2) continue;
+        const auto it = find(node, d, coord);
+        if (it == c.parameters.end()) {
+          added.push_back({node, d, coord, 0.0, Ramp::kLinear, -1});
+        } else if (it->displacement != 0.0 && !reported) {
+          problems.push_back(
+              {ProblemKind::kConflict,
+               ply.place,
+               "ply '" + ply.name + "' is plane strain (u_y = 0 across its width), but a boundary condition moves y",
+               {}});
+          reported = true;
+        }
+      }
+  c.parameters.insert(c.parameters.end(), added.begin(), added.end());
+  std::sort(c.parameters.begin(), c.parameters.end(), [](const PrescribedParameter& a, const PrescribedParameter& b) {
+    return std::tie(a.node, a.d, a.coord) < std::tie(b.node, b.d, b.coord);
+  });
+}
+}  // namespace
+
 std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spec, std::vector<CaseProblem>& problems) {
   std::vector<PlyConditions> out;
   for (std::size_t p = 0; p < spec.plies.size(); ++p) {
@@ -67,6 +109,7 @@ std::vector<PlyConditions> discretise_boundary_conditions(const FormingCase& spe
                               ") differently",
                           {}});
     }
+    if (ply.plane_strain) add_plane_strain(ply, out.back(), problems);
   }
   return out;
 }

@@ -41,8 +41,8 @@ int find_material(const FormingCase& spec, const std::string& name) {
   return -1;
 }
 
-const std::vector<std::string> kLawKeys = {"stiffness",      "tolerance",  "viscous", "coulomb",
-                                           "stick_velocity", "engage_gap", "points"};
+const std::vector<std::string> kLawKeys = {"stiffness",  "tolerance", "viscous",  "coulomb", "stick_velocity",
+                                           "engage_gap", "points",    "two_pass", "band"};
 
 // The contact law keys of mapping n (those present in kLawKeys); false on a problem.
 bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
@@ -94,6 +94,18 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
   if (n["points"].IsDefined()) {
     if (const auto v = r.integer(n["points"], what + " points (per face direction)", 1, 12))
       law.points = *v;
+    else
+      ok = false;
+  }
+  if (n["band"].IsDefined()) {
+    if (const auto v = r.positive(n["band"], what + " band", "mm"))
+      law.band = *v;
+    else
+      ok = false;
+  }
+  if (n["two_pass"].IsDefined()) {
+    if (const auto v = r.boolean(n["two_pass"], what + " two_pass"))
+      law.two_pass = *v;
     else
       ok = false;
   }
@@ -156,7 +168,9 @@ bool read_layup_list(Reader& r, const YAML::Node& l, const std::string& what, do
 
 void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   std::string what = "laminate " + std::to_string(index + 1);
-  if (!r.mapping(n, what, {"name", "origin", "size", "elements", "layup", "ply_thickness", "material", "interface"}))
+  if (!r.mapping(
+          n, what,
+          {"name", "origin", "size", "elements", "layup", "ply_thickness", "material", "interface", "plane_strain"}))
     return;
   CaseLaminate lam;
   lam.place = place_of(n);
@@ -193,6 +207,12 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
       ok = false;
   } else
     ok = false;
+  if (const YAML::Node ps = n["plane_strain"]; ps.IsDefined()) {
+    if (const auto v = r.boolean(ps, what + " plane_strain"))
+      base.plane_strain = *v;
+    else
+      ok = false;
+  }
   double thickness = 0.0;
   if (const YAML::Node t = n["ply_thickness"]; t.IsDefined()) {
     if (const auto h = r.positive(t, what + " ply_thickness", "mm"))
@@ -280,6 +300,7 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     p.length_y = base.length_y;
     p.n1 = base.n1;
     p.n2 = base.n2;
+    p.plane_strain = base.plane_strain;
     z += p.thickness;
     lam.angles.push_back(p.angle_deg);
     spec.plies.push_back(p);
@@ -545,6 +566,11 @@ void read_contact(Reader& r, const YAML::Node& n, int index, FormingCase& spec) 
       ok = false;
     if (n["with_face"].IsDefined()) {
       r.problem(ProblemKind::kUnsupported, n["with_face"], what + " with_face: only used with 'with' (a ply)");
+      ok = false;
+    }
+    if (n["two_pass"].IsDefined()) {
+      r.problem(ProblemKind::kUnsupported, n["two_pass"],
+                what + " two_pass: only for contact between plies (a rigid tool is checked in one pass)");
       ok = false;
     }
   } else {

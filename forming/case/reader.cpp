@@ -162,7 +162,8 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
 
 void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   std::string what = "ply " + std::to_string(index + 1);
-  if (!r.mapping(n, what, {"name", "origin", "size", "thickness", "elements", "angle", "material"})) return;
+  if (!r.mapping(n, what, {"name", "origin", "size", "thickness", "elements", "angle", "material", "plane_strain"}))
+    return;
   CasePly ply;
   ply.place = place_of(n);
   bool ok = true;
@@ -226,6 +227,12 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   if (const YAML::Node a = n["angle"]; a.IsDefined()) {
     if (const auto v = r.number(a, what + " angle (degrees)"))
       ply.angle_deg = *v;
+    else
+      ok = false;
+  }
+  if (const YAML::Node ps = n["plane_strain"]; ps.IsDefined()) {
+    if (const auto v = r.boolean(ps, what + " plane_strain"))
+      ply.plane_strain = *v;
     else
       ok = false;
   }

@@ -86,6 +86,10 @@ struct CasePly {
   double thickness = 0.0;      // mm
   int n1 = 0, n2 = 0;          // elements along x and y
   double angle_deg = 0.0;      // layup angle from x towards y, degrees
+  // Plane strain across the width (y): u_y = 0 and d/ds2, d2/ds1ds2 of x and z held at
+  // 0 at every node, so with loads and conditions uniform in y the ply is a 2-D strip
+  // (forming/case/checks.cpp; use elements [n, 1]).
+  bool plane_strain = false;
   std::string material;
   int material_index = -1;
   SourcePlace place;
@@ -170,9 +174,11 @@ struct CaseLaminate {
 
 // The laws of one contact pair (forming/contact/contact_law.hpp).
 struct CaseContactLaw {
-  NormalLaw normal;      // stiffness S_n (N/mm^3), augmented + tolerance (mm)
-  FrictionLaw friction;  // viscous c_f (N s/mm^3), coulomb mu, stick_velocity (mm/s), engage_gap (mm)
-  int points = 6;        // contact points per face direction
+  NormalLaw normal;       // stiffness S_n (N/mm^3), augmented + tolerance (mm)
+  FrictionLaw friction;   // viscous c_f (N s/mm^3), coulomb mu, stick_velocity (mm/s), engage_gap (mm)
+  int points = 6;         // contact points per face direction
+  bool two_pass = false;  // ply-ply: two half-passes (forming/contact/surface_contact.hpp)
+  double band = 0.0;      // mm, rounded kink of the normal law; 0: default (1e-3 ply thicknesses)
 };
 
 struct CaseTool {

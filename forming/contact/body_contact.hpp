@@ -30,7 +30,7 @@ class BodyContact final : public SurfaceContact {
   BodyContact(std::string name, const Model& model, ContactSurface slave, ContactSurface master,
               ContactOptions options);
 
-  bool symmetric() const override { return !options().friction.active(); }
+  bool symmetric() const override { return !options().friction.active() && !options().half_pass; }
   std::string describe() const override;
   const ContactSurface& master() const { return master_; }
 

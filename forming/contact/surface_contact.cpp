@@ -23,7 +23,7 @@ struct PairBlock {
   LocalContribution local;
 };
 
-void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, const LocalContribution& c,
+void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, const LocalContribution& c, bool half_pass,
              InteractionSums& sums) {
   std::vector<Index> dofs;
   std::vector<double> coefs;
@@ -38,13 +38,20 @@ void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, cons
   append(slave, 0);
   if (master) append(*master, slave_size);
   const int m = static_cast<int>(dofs.size());
-  for (int a = 0; a < m; ++a) sums.force(dofs[a]) += coefs[a] * c.force(local[a]);
+  // Half pass: rows of the slave side only (its entries come first).
+  const int rows = half_pass ? static_cast<int>(slave.dofs.size()) : m;
+  for (int a = 0; a < rows; ++a) sums.force(dofs[a]) += coefs[a] * c.force(local[a]);
   const auto add = [&](const MatX& k, linalg::TripletAssembler* target) {
     if (!target || k.size() == 0) return;
-    MatX block(m, m);
+    MatX block(rows, m);
     for (int cc = 0; cc < m; ++cc)
-      for (int a = 0; a < m; ++a) block(a, cc) = coefs[a] * coefs[cc] * k(local[a], local[cc]);
-    target->add_block(dofs, dofs, block);
+      for (int a = 0; a < rows; ++a) block(a, cc) = coefs[a] * coefs[cc] * k(local[a], local[cc]);
+    if (rows == m) {
+      target->add_block(dofs, dofs, block);
+    } else {
+      const std::vector<Index> row_dofs(dofs.begin(), dofs.begin() + rows);
+      target->add_block(row_dofs, dofs, block);
+    }
   };
   add(c.stiffness, sums.stiffness);
   add(c.damping, sums.damping);
@@ -57,6 +64,11 @@ void ContactOptions::validate() const {
   friction.validate();
   if (points < 1 || points > 12)
     throw InputError("contact points: expected 1..12 points per face direction, found " + std::to_string(points));
+  if (!(std::isfinite(band) && band >= 0.0)) {
+    std::ostringstream os;
+    os << "contact band: expected a length >= 0 (mm; 0 = default), found " << band;
+    throw InputError(os.str());
+  }
   if (!(std::isfinite(search_distance) && search_distance >= 0.0)) {
     std::ostringstream os;
     os << "contact search_distance: expected a length >= 0 (mm; 0 = default), found " << search_distance;
@@ -111,7 +123,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
   }
   const bool friction = options_.friction.active() && rates;
   const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
-  const double band = kBand * slave_.thickness();
+  const double band = options_.band > 0.0 ? options_.band : kBand * slave_.thickness();
   const double engage = engage_gap();
   std::vector<PairBlock> blocks;
   for (Index f = 0; f < slave_.n_faces(); ++f) {
@@ -139,7 +151,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       rec.face = f;
       rec.st = rule_.points[static_cast<std::size_t>(q)];
       rec.position = xs;
-      rec.slip = slip_[id];
+      rec.slip = Vec3::Zero();  // the step's increment (below); sample() puts the accumulated slip
       rec.weight = weight_[id];
       Partner partner;
       if (!find_partner(*prepared, xs, k, partner)) {
@@ -203,8 +215,8 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
     }
     if (sums)
       for (const PairBlock& b : blocks) {
-        sums->energy += b.local.energy;
-        scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, *sums);
+        sums->energy += options_.half_pass ? 0.5 * b.local.energy : b.local.energy;
+        scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, options_.half_pass, *sums);
       }
   }
 }
@@ -230,11 +242,29 @@ void SurfaceContact::commit(const Eigen::Ref<const VecX>& x, const InteractionCo
   std::vector<ContactPointRecord> rec;
   rec.reserve(static_cast<std::size_t>(n_points()));
   evaluate(x, context, nullptr, &rec);
+  const bool dynamic = context.velocity != nullptr;
+  if (dynamic && !shear_known_) {
+    // The traction at the interval's start: a run from rest at t = 0 has it with the
+    // bodies at rest (tools may already move); otherwise (a restart) the end's is used.
+    shear_.assign(rec.size(), Vec3::Zero());
+    if (context.previous_time == 0.0) {
+      const VecX rest = VecX::Zero(x.size());
+      std::vector<ContactPointRecord> start;
+      start.reserve(rec.size());
+      evaluate(*context.previous, InteractionContext{0.0, &rest, nullptr, 0.0}, nullptr, &start);
+      for (std::size_t i = 0; i < start.size(); ++i) shear_[i] = start[i].shear;
+    } else {
+      for (std::size_t i = 0; i < rec.size(); ++i) shear_[i] = rec[i].shear;
+    }
+  }
   for (std::size_t i = 0; i < rec.size(); ++i) {
+    const Vec3 traction = dynamic ? Vec3(0.5 * (shear_[i] + rec[i].shear)) : rec[i].shear;
+    if (dynamic) shear_[i] = rec[i].shear;
     if (!rec[i].partner) continue;
     slip_[i] += rec[i].slip;  // the increment over the step
-    dissipated_ += rec[i].weight * (-rec[i].shear).dot(rec[i].slip);
+    dissipated_ += (options_.half_pass ? 0.5 : 1.0) * rec[i].weight * (-traction).dot(rec[i].slip);
   }
+  shear_known_ = dynamic;
 }
 
 MultiplierUpdate SurfaceContact::update_multipliers(const Eigen::Ref<const VecX>& x,

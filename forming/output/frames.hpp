@@ -11,8 +11,14 @@
 // also "pressure" (MPa, positive in compression) and "fibre_tension" (MPa), and the
 // stress includes -p I + (T/J) a (x) a.
 //
-// With contact (forming/contact/), each written step also has, as further parts of the
-// same time step in result.pvd:
+// With contact (forming/contact/), the ply frames also carry point data on the faces
+// that are the slave side of a contact pair (bilinear interpolation of the face's n x n
+// contact points, held constant beyond the outermost ones; where a face is in several
+// pairs, the pair with the highest pressure there; elsewhere pressure, slip and rate 0):
+// "contact_pressure" (MPa), "contact_gap" (mm; NaN where there is no partner or off the
+// contact faces), "contact_slip" (accumulated inter-ply / tool slip, mm, vector) and
+// "contact_slip_rate" (mm/s, vector). Each written step also has, as further parts of
+// the same time step in result.pvd:
 //   steps/tool_<name>_NNNN.vtu     each rigid tool's surface (triangles) where it moves
 //                                  then, over the plies' region (part 1, 2, ...);
 //   steps/contact_NNNN.vtu         the contact points of every pair on the slave ply
@@ -32,7 +38,10 @@
 
 namespace sf::forming {
 
-io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane, int samples_thickness);
+// `context`: with contact (SurfaceContact interactions), the point data also gets the
+// contact fields on the slave ply faces (see header); null: none.
+io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane, int samples_thickness,
+                          const InteractionContext* context = nullptr);
 
 // "steps/step_NNNN.vtu" of step k.
 std::string step_file_name(int k);

@@ -12,6 +12,8 @@
 //    the tool and the contact points as parts of every written step.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -243,6 +245,91 @@ solver: {steps: 2}
   bool has_pressure = false;
   for (const io::FieldArray& f : points.point_data) has_pressure = has_pressure || f.name == "pressure";
   EXPECT_TRUE(has_pressure);
+  // The ply frame carries the contact fields on its faces: squeezed homogeneously between
+  // frictionless planes, every face point has the pressure punch_fz / A (A = 100 mm^2,
+  // reference area) and one negative gap (the faces slip outwards as the ply spreads).
+  const io::VolumeMesh ply = io::read_vtu((dir / "steps/step_0002.vtu").string());
+  const auto field = [&](const char* name) -> const io::FieldArray* {
+    for (const io::FieldArray& f : ply.point_data)
+      if (f.name == name) return &f;
+    return nullptr;
+  };
+  const io::FieldArray *pressure = field("contact_pressure"), *gap = field("contact_gap"),
+                       *slip = field("contact_slip"), *rate = field("contact_slip_rate");
+  ASSERT_TRUE(pressure && gap && slip && rate);
+  EXPECT_EQ(slip->n_components, 3);
+  EXPECT_EQ(rate->n_components, 3);
+  const double p = up / 100.0;
+  int on_faces = 0, inside = 0;
+  double gap0 = 0.0;
+  for (Index i = 0; i < ply.points.rows(); ++i) {
+    const double z = ply.points(i, 2);
+    const auto k = static_cast<std::size_t>(i);
+    if (z > 0.2 && z < 0.8) {  // between the faces: no contact fields
+      EXPECT_EQ(pressure->values[k], 0.0);
+      EXPECT_TRUE(std::isnan(gap->values[k]));
+      ++inside;
+      continue;
+    }
+    EXPECT_NEAR(pressure->values[k], p, 1e-8 * p) << "point " << i;
+    if (on_faces == 0) gap0 = gap->values[k];
+    EXPECT_LT(gap->values[k], 0.0);
+    EXPECT_NEAR(gap->values[k], gap0, 1e-6 * std::abs(gap0)) << "point " << i;
+    EXPECT_NEAR(slip->values[3 * k + 2], 0.0, 1e-9);  // tangential
+    ++on_faces;
+  }
+  EXPECT_GT(on_faces, 0);
+  EXPECT_GT(inside, 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ContactOutputs, PlyFramesCarryTheAccumulatedSlipAndItsRate) {
+  // A stiff block, clamped at x0, on a table sliding along +x at 2 mm/s for 0.3 s with
+  // viscous friction: its bottom face slips -0.6 mm (relative to the table) at -2 mm/s.
+  const CaseCheck c = check_case_text(R"(materials:
+  block: {neo_hookean: {E: 10000, nu: 0.3}}
+plies:
+  - {name: b, size: [10, 10], thickness: 1, elements: [2, 2], material: block}
+tools:
+  - name: table
+    plane: {point: [0, 0, 0], normal: [0, 0, 1]}
+    motion: {velocity: [2, 0, 0]}
+contact:
+  - {ply: b, face: bottom, tool: table, stiffness: 1000, viscous: 0.02}
+boundary_conditions:
+  - clamp: {ply: b, edge: x0}
+loads:
+  - pressure: {ply: b, face: top, value: 0.2}
+solver: {steps: 3, process_time: 0.3}
+output: {samples: [2, 2]}
+)",
+                                      "slip.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sf_contact_slip_test";
+  const fixtures::RunOutput out = fixtures::run_into(c.spec, dir);
+  ASSERT_TRUE(out.report.ok()) << out.report.message;
+  const io::VolumeMesh ply = io::read_vtu((dir / "steps/step_0003.vtu").string());
+  const io::FieldArray *slip = nullptr, *rate = nullptr, *pressure = nullptr;
+  for (const io::FieldArray& f : ply.point_data) {
+    if (f.name == "contact_slip") slip = &f;
+    if (f.name == "contact_slip_rate") rate = &f;
+    if (f.name == "contact_pressure") pressure = &f;
+  }
+  ASSERT_TRUE(slip && rate && pressure);
+  int bottom = 0;
+  for (Index i = 0; i < ply.points.rows(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (ply.points(i, 2) > 0.05) {
+      EXPECT_EQ(slip->values[3 * k], 0.0);
+      continue;
+    }
+    EXPECT_NEAR(slip->values[3 * k], -0.6, 1e-3) << "point " << i;
+    EXPECT_NEAR(rate->values[3 * k], -2.0, 3e-3) << "point " << i;
+    EXPECT_NEAR(slip->values[3 * k + 2], 0.0, 1e-6);
+    EXPECT_GT(pressure->values[k], 0.0);
+    ++bottom;
+  }
+  EXPECT_GT(bottom, 0);
   std::filesystem::remove_all(dir);
 }
 

@@ -67,8 +67,9 @@ InteractionContext context_of(const CaseRun& r, std::size_t k) {
   return InteractionContext{r.steps.time[k - 1], nullptr, prev, t_prev};
 }
 
-// Largest relative deviation of the interface pressure from p, upper block meshed n x n.
-double patch_error(int n, int points) {
+// Largest relative deviation of the interface pressure from p, upper block meshed n x n,
+// over the contact points of every pass.
+double patch_error(int n, int points, bool two_pass = false) {
   const double p = 0.05;  // MPa
   CaseRun r;
   run(R"(
@@ -80,7 +81,7 @@ plies:
           std::to_string(n) + ", " + std::to_string(n) + R"(], material: soft}
 contact:
   - {ply: lower, face: top, with: upper, with_face: bottom, stiffness: 1000, points: )" +
-          std::to_string(points) + R"(}
+          std::to_string(points) + (two_pass ? ", two_pass: true" : "") + R"(}
 boundary_conditions:
   - symmetry: {ply: lower, plane: bottom}
   - symmetry: {ply: lower, plane: x0}
@@ -92,15 +93,17 @@ loads:
 solver: {steps: 1, tolerance: 1.0e-10}
 )",
       r);
-  const auto& c = dynamic_cast<const SurfaceContact&>(r.problem.model.interaction(0));
   double worst = 0.0;
   int count = 0;
-  for (const ContactPointRecord& rec : c.sample(r.steps.x.back(), context_of(r, 1))) {
-    EXPECT_TRUE(rec.partner);
-    worst = std::max(worst, std::abs(rec.pressure - p) / p);
-    ++count;
+  for (int i = 0; i < r.problem.model.n_interactions(); ++i) {
+    const auto& c = dynamic_cast<const SurfaceContact&>(r.problem.model.interaction(i));
+    for (const ContactPointRecord& rec : c.sample(r.steps.x.back(), context_of(r, 1))) {
+      EXPECT_TRUE(rec.partner);
+      worst = std::max(worst, std::abs(rec.pressure - p) / p);
+      ++count;
+    }
   }
-  EXPECT_EQ(count, 4 * points * points);
+  EXPECT_EQ(count, (two_pass ? 4 + n * n : 4) * points * points);
   return worst;
 }
 
@@ -111,6 +114,20 @@ TEST(ContactPatch, UniformPressureCrossesTheInterface) {
   EXPECT_LT(non_matching, 0.07);
   std::printf("patch test: largest relative pressure error %.2e (matching 2 x 2 meshes), %.2e (2 x 2 against 3 x 3)\n",
               matching, non_matching);
+  for (const int points : {8, 12}) {
+    const double e = patch_error(3, points);
+    std::printf("patch test, one pass, %d x %d points a face: %.2e (2 x 2 against 3 x 3)\n", points, points, e);
+  }
+}
+
+TEST(ContactPatch, TwoHalfPassesTransmitTheUniformPressureAcrossNonMatchingMeshes) {
+  const double matching = patch_error(2, 6, true);
+  const double non_matching = patch_error(3, 6, true);
+  std::printf(
+      "patch test, two half-passes: largest relative pressure error %.2e (matching), %.2e (2 x 2 against 3 x 3)\n",
+      matching, non_matching);
+  EXPECT_LT(matching, 1e-6);
+  EXPECT_LT(non_matching, 1e-6);
 }
 
 // A 10 x 10 x 1 block on a plane tool sliding at v = 2 mm/s along x under the block,

@@ -8,8 +8,10 @@
 
 #include <cmath>
 #include <functional>
+#include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -24,6 +26,7 @@
 #include "gsa/mark_strains.hpp"
 #include "gsa/output.hpp"
 #include "gsa/results_folder.hpp"
+#include "gsa/surfaces_file.hpp"
 
 namespace py = pybind11;
 
@@ -87,6 +90,9 @@ AnalyseFlags flags_from(const py::dict& options) {
   auto number = [](double AnalyseFlags::*m, AnalyseFlags& flags) -> Setter {
     return [&flags, m](const py::handle& v, const std::string& k) { flags.*m = as_number(v, k); };
   };
+  auto optional_number = [](std::optional<double> AnalyseFlags::*m, AnalyseFlags& flags) -> Setter {
+    return [&flags, m](const py::handle& v, const std::string& k) { flags.*m = as_number(v, k); };
+  };
   auto integer = [](int AnalyseFlags::*m, AnalyseFlags& flags) -> Setter {
     return [&flags, m](const py::handle& v, const std::string& k) {
       const double x = as_number(v, k);
@@ -113,10 +119,10 @@ AnalyseFlags flags_from(const py::dict& options) {
       {"header_line", integer(&AnalyseFlags::header_line, f)},
       {"pitch", number(&AnalyseFlags::pitch, f)},
       {"pixel_size", number(&AnalyseFlags::pixel_size, f)},
-      {"alpha", number(&AnalyseFlags::alpha, f)},
-      {"beta", number(&AnalyseFlags::beta, f)},
-      {"gamma", number(&AnalyseFlags::gamma, f)},
-      {"delta", number(&AnalyseFlags::delta, f)},
+      {"alpha", optional_number(&AnalyseFlags::alpha, f)},
+      {"beta", optional_number(&AnalyseFlags::beta, f)},
+      {"gamma", optional_number(&AnalyseFlags::gamma, f)},
+      {"delta", optional_number(&AnalyseFlags::delta, f)},
       {"outlier_sigma", number(&AnalyseFlags::outlier_sigma, f)},
       {"smoothing_scale", number(&AnalyseFlags::smoothing_scale, f)},
       {"no_local_smoothing", [&f](const py::handle& v, const std::string&) { f.no_local_smoothing = v.cast<bool>(); }},
@@ -425,6 +431,22 @@ py::dict read_results(const std::string& dir) {
   out["columns"] = columns;
   out["summary_json"] = folder.summary.is_null() ? std::string("null") : folder.summary.dump();
   out["has_surfaces"] = folder.has_surfaces;
+  // surfaces.json (surface method): the fitted surfaces, evaluable anywhere as after analyse().
+  out["surface"] = py::none();
+  const std::string surfaces = (std::filesystem::path(dir) / "surfaces.json").string();
+  if (std::filesystem::exists(surfaces)) {
+    sf::gsa::FittedSurfaces f = sf::gsa::read_surfaces_file(surfaces);
+    auto r = std::make_shared<sf::gsa::AnalysisResult>();
+    r->method = sf::gsa::Method::kSurface;
+    r->mesh = std::move(f.mesh);
+    r->undeformed_parameters = std::move(f.undeformed);
+    r->deformed_parameters = std::move(f.deformed);
+    const auto& params = folder.summary.is_object() && folder.summary.contains("parameters")
+                             ? folder.summary["parameters"]
+                             : nlohmann::json::object();
+    if (params.contains("fibre_angles_deg")) r->fibre_angles = params["fibre_angles_deg"].get<std::vector<double>>();
+    out["surface"] = py::cast(Surface{r});
+  }
   return out;
 }
 

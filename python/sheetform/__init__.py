@@ -102,8 +102,8 @@ def analyse(undeformed, deformed=None, ids=None, ij=None, as_frame=True, **optio
 
 def read_results(dir, as_frame=True):
     """A results folder written by `gsa analyse` (or `gsa batch`): strains.csv as points,
-    summary.json as summary. The fitted surfaces are not stored there as Hermite
-    parameters, so surface is None (their tessellation is in undeformed.vtp and
-    deformed.vtp, for ParaView)."""
+    summary.json as summary, and the fitted surfaces from surfaces.json (written by the
+    surface method), evaluable anywhere as after analyse(); surface is None for the
+    triangles method or a folder written before surfaces.json existed."""
     raw = _core.read_results(os.fspath(dir))
-    return Result(_table(raw["columns"], as_frame), json.loads(raw["summary_json"]))
+    return Result(_table(raw["columns"], as_frame), json.loads(raw["summary_json"]), raw["surface"])

@@ -123,6 +123,21 @@ class SameAsCommandLine(unittest.TestCase):
 
 
 class Surfaces(unittest.TestCase):
+    def test_read_results_surfaces_equal_the_folders_strains(self):
+        out = os.path.join(WORK, "dome_surfaces")
+        shutil.rmtree(out, ignore_errors=True)
+        p = run_cli("--quiet", "analyse", grid_path("dome"), "--out", out, "--no-plots")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        r = sheetform.read_results(out, as_frame=False)
+        self.assertIsNotNone(r.surface)
+        ok = np.array([s == "ok" for s in r.points["status"]])
+        element = r.points["element"][ok].astype(int)
+        xi = np.column_stack([r.points["xi1"][ok], r.points["xi2"][ok]])
+        v = r.surface.evaluate(element, xi)
+        for c in ("E1", "E2", "thickness_change_pct"):
+            # strains.csv keeps xi to round-trip precision: the surfaces give the marks' strains.
+            self.assertLess(np.max(np.abs(v[c] - r.points[c][ok])), 1e-10, c)
+
     def test_evaluate_at_marks_equals_point_strains(self):
         r = sheetform.analyse(grid_path("dome"), as_frame=False)
         ok = np.array([s == "ok" for s in r.points["status"]])

@@ -78,7 +78,7 @@ TEST(Restart, MissingOrForeignRestartFileIsAnInputError) {
     run_case(spec, o);
     ADD_FAILURE() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("different model"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("written for a different case"), std::string::npos) << e.what();
   }
   fs::remove_all(tmp);
 }

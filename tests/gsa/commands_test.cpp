@@ -458,7 +458,8 @@ TEST_F(GsaCli, BadInputExitsOneNamingFileLineColumnAndLeavesNoOutput) {
   EXPECT_THAT(r.err, HasSubstr(bad + ":3:4:"));
   EXPECT_THAT(r.err, Not(HasSubstr("internal error")));
   EXPECT_FALSE(fs::exists(dir_.file("out")));
-  EXPECT_EQ(entries(dir_.path()), (std::set<std::string>{"bad.csv"}));  // no out.tmp-* either
+  // No out/ and no out.tmp-* either; only the hidden lock file (.out.lock) of the run that failed.
+  EXPECT_EQ(entries(dir_.path()), (std::set<std::string>{"bad.csv", ".out.lock"}));
 }
 
 TEST_F(GsaCli, FailedRunKeepsPreviousResults) {

@@ -212,7 +212,7 @@ TEST(GsaStages, OptionErrorsNameTheFieldAndOnTheCommandLineTheFlag) {
     analyse_options(flags);
     ADD_FAILURE() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_THAT(std::string(e.what()), StartsWith("--smoothing-scale: must be > 0"));
+    EXPECT_THAT(std::string(e.what()), StartsWith("--smoothing-scale: must be a finite number > 0"));
   }
   flags = AnalyseFlags{};
   flags.sample = -1;

@@ -11,25 +11,13 @@
 #include <vector>
 
 #include "common/core/error.hpp"
+#include "forming/case/yaml_reader.hpp"
 
 namespace sf::forming::stability {
 namespace {
 
-std::string describe(const YAML::Node& n) {
-  if (!n.IsDefined()) return "nothing";
-  switch (n.Type()) {
-    case YAML::NodeType::Null:
-      return "null";
-    case YAML::NodeType::Scalar:
-      return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    default:
-      return "nothing";
-  }
-}
+// What a node holds, for messages: the case reader's one wording.
+using case_yaml::describe;
 
 class Reader {
  public:

@@ -28,7 +28,9 @@
 #include "gsa/gross_blunders.hpp"
 #include "gsa/flc.hpp"
 #include "gsa/output.hpp"
+#include "gsa/option_error.hpp"
 #include "gsa/plots.hpp"
+#include "gsa/view3d.hpp"
 #include "gsa/results_folder.hpp"
 #include "gsa/series_output.hpp"
 #include "gsa/synthetic.hpp"
@@ -247,6 +249,30 @@ int run_plot(const PlotArgs& a, bool quiet) {
   return cli::kExitOk;
 }
 
+struct ViewArgs {
+  std::string dir, measure = "true", out;
+  View3dOptions options;
+};
+
+int run_view(const ViewArgs& a, bool quiet) {
+  const StrainMeasure measure = parse_measure(a.measure, "--measure");
+  View3dStats st;
+  try {
+    st = write_view_page(a.dir, measure, a.options, a.out);
+  } catch (const OptionError& e) {
+    throw UsageError((e.field() == "max_vertices" ? "--max-vertices: " : "--max-mark-values: ") + e.problem());
+  }
+  std::ostringstream msg;
+  msg << "gsa: wrote " << (a.out.empty() ? (std::filesystem::path(a.dir) / "view.html").string() : a.out) << " ("
+      << st.triangles << " triangles, " << st.quads_per_element_side << "x" << st.quads_per_element_side
+      << " per element, " << st.marks << " marks, " << st.glyph_sites << " arrow sites; "
+      << (st.data_bytes + 999) / 1000 << " kB of data)";
+  if (!st.mark_columns_left_out.empty())
+    msg << "; left out to keep the page small: " << st.mark_columns_left_out.size() << " columns of strains.csv";
+  cli::status(quiet, msg.str());
+  return cli::kExitOk;
+}
+
 struct SynthArgs {
   std::string name, out, exact;
   SyntheticGridOptions grid;
@@ -395,6 +421,26 @@ void add_plot_command(sf::cli::Program& program) {
       [plot, prog] { return run_plot(*plot, prog->common().quiet); });
 }
 
+void add_view_command(sf::cli::Program& program) {
+  const sf::cli::Program* prog = &program;
+  auto view = std::make_shared<ViewArgs>();
+  program.add_command(
+      "view", "Write view.html: the interactive 3-D view of a results folder (opens offline in a browser)",
+      [view](CLI::App& app) {
+        app.add_option("results", view->dir, "Results folder written by gsa analyse (surface method)")->required();
+        app.add_option("-o,--out", view->out, "Page to write (default RESULTS/view.html)");
+        app.add_option("--measure", view->measure,
+                       "Strain measure of the arrows and the first fields: true, engineering or lagrangian")
+            ->default_str("true");
+        app.add_option("--max-vertices", view->options.max_vertices,
+                       "Surface vertices in the page; above, 4x4, 2x2 or 1x1 quads per element (default 60000)");
+        app.add_option("--max-mark-values", view->options.max_mark_values,
+                       "Marks x strains.csv columns in the page; above, the least read columns are left out "
+                       "(default 1500000)");
+      },
+      [view, prog] { return run_view(*view, prog->common().quiet); });
+}
+
 void add_synth_command(sf::cli::Program& program) {
   const sf::cli::Program* prog = &program;
   auto synth = std::make_shared<SynthArgs>();
@@ -420,6 +466,7 @@ void add_synth_command(sf::cli::Program& program) {
 void register_commands(sf::cli::Program& program) {
   add_analyse_command(program);
   add_plot_command(program);
+  add_view_command(program);  // gsa/view3d.hpp (docs/usage.md "3-D view")
   add_synth_command(program);
   add_compare_command(program);          // gsa/compare.hpp
   add_batch_command(program);            // gsa/batch_command.cpp (docs/batch.md)

@@ -21,8 +21,9 @@ namespace sf::gsa {
 
 io::OutputDirOptions analyse_results_folder() {
   io::OutputDirOptions o;
-  o.owned = {"strains.csv", "summary.json",  "undeformed.vtp",     "deformed.vtp",     "samples.csv", "*.png",
-             "report.html", "surfaces.json", "series_strains.csv", "strain_paths.csv", "series.pvd",  "stages"};
+  o.owned = {"strains.csv", "summary.json", "undeformed.vtp", "deformed.vtp",       "samples.csv",
+             "*.png",       "report.html",  "surfaces.json",  "series_strains.csv", "strain_paths.csv",
+             "series.pvd",  "stages",       "view.html"};
   return o;
 }
 

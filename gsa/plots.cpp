@@ -13,6 +13,7 @@
 #include "common/render/chart.hpp"
 #include "common/render/display.hpp"
 #include "gsa/report.hpp"
+#include "gsa/view3d.hpp"
 
 namespace sf::gsa {
 
@@ -621,8 +622,7 @@ namespace {
 // 45 % of the width, which the colour bar and legend need.
 PlotOptions fitted_to_part(const Results& r, PlotOptions o) {
   if (!o.fit_height || r.undeformed.n_points() == 0) return o;
-  const Eigen::RowVector3d lo = r.undeformed.points.colwise().minCoeff(),
-                           hi = r.undeformed.points.colwise().maxCoeff();
+  const Eigen::RowVector3d lo = r.undeformed.points.colwise().minCoeff(), hi = r.undeformed.points.colwise().maxCoeff();
   const Eigen::RowVector3d ext = hi - lo;
   if (!(ext[0] > 0) || !(ext[2] < 0.5 * std::max(ext[0], ext[1]))) return o;  // not a blank seen from above
   const double w = o.size.width;
@@ -663,6 +663,26 @@ void draw_surface_pictures(const Results& r, const std::function<void(const std:
   draw("fibres.png", fibre_scene(r, s, o));
 }
 
+// The interactive 3-D view of report.html (gsa/view3d.hpp), with the marks of the
+// strains.csv just written (out_path) or else the folder's. A view that cannot be made
+// leaves a note in the page, never a failed run.
+void add_view3d(const PlotData& r, const std::function<std::string(const std::string&)>& out_path, ReportPage& page) {
+  if (!r.has_surfaces) return;
+  if (!view3d_available()) {
+    page.view3d_note = view3d_library();
+    return;
+  }
+  std::string csv = out_path("strains.csv");
+  if (!std::filesystem::exists(csv)) csv = (std::filesystem::path(r.source) / "strains.csv").string();
+  try {
+    std::optional<io::CsvTable> strains;
+    if (std::filesystem::exists(csv)) strains = io::read_csv(csv);
+    page.view3d_html = make_view3d(r, strains ? &*strains : nullptr).html;
+  } catch (const Error& e) {
+    page.view3d_note = e.what();
+  }
+}
+
 }  // namespace
 
 PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
@@ -693,6 +713,7 @@ PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
   page.measure = r.measure;
   page.pictures = summary.pictures;
   page.flc = r.margins ? &*r.margins : nullptr;
+  add_view3d(r, out_path, page);
   write_report(out_path("report.html"), r.summary, page);
   return summary;
 }

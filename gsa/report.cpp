@@ -238,6 +238,9 @@ void result_tables(std::ostream& h, const nlohmann::json& s, const ReportPage& p
 // Every picture with its caption.
 void figures(std::ostream& h, const ReportPage& page) {
   h << "</aside>\n<main>\n";
+  h << page.view3d_html;
+  if (page.view3d_html.empty() && !page.view3d_note.empty())
+    h << "<p class=\"warn\" style=\"flex:1 1 100%\">No 3-D view: " << io::xml_escape(page.view3d_note) << "</p>\n";
   for (const std::string& name : page.pictures)
     h << "<figure><a href=\"" << io::xml_escape(name) << "\"><img src=\"" << io::xml_escape(name) << "\" alt=\""
       << io::xml_escape(caption_of(name, page.measure)) << "\"></a>\n<figcaption>"

@@ -17,6 +17,8 @@ struct ReportPage {
   StrainMeasure measure = StrainMeasure::kTrue;  // of the pictures
   std::vector<std::string> pictures;             // PNG file names, in page order
   const FlcMargins* flc = nullptr;               // the forming limit, when given
+  std::string view3d_html;                       // the interactive 3-D view (gsa/view3d.hpp), first in <main>
+  std::string view3d_note;                       // or why there is none
 };
 
 void write_report(const std::string& path, const nlohmann::json& summary, const ReportPage& page);

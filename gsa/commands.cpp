@@ -436,7 +436,7 @@ void add_view_command(sf::cli::Program& program) {
                        "Surface vertices in the page; above, 4x4, 2x2 or 1x1 quads per element (default 60000)");
         app.add_option("--max-mark-values", view->options.max_mark_values,
                        "Marks x strains.csv columns in the page; above, the least read columns are left out "
-                       "(default 1500000)");
+                       "(default 1000000)");
       },
       [view, prog] { return run_view(*view, prog->common().quiet); });
 }

@@ -1,7 +1,7 @@
 #pragma once
-// report.html: one self-contained page (inline style, no scripts) with the summary.json
-// content in tables beside every picture, which it references by file name (keep the
-// folder together).
+// report.html: one page (inline style) with the summary.json content in tables beside
+// every picture, which it references by file name (keep the folder together), and first
+// the interactive 3-D view (gsa/view3d.hpp: its script and data inline).
 
 #include <nlohmann/json.hpp>
 #include <string>

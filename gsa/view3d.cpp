@@ -408,8 +408,11 @@ nlohmann::json marks_json(const PlotData& d, const Tessellation& t, const io::Cs
     }
     if (col.values.size() == rows.size() && !col.categories.empty()) cols.push_back(std::move(col));
   }
-  // Keep within the budget of numbers: drop the columns least read first.
+  // Keep within the budget of numbers: drop the columns least read first (never the
+  // page's own measure).
+  const auto own = measure_fields(d.measure);
   for (const std::string& name : drop_order()) {
+    if (name == own[0] || name == own[1]) continue;
     if (cols.size() * rows.size() <= o.max_mark_values) break;
     const auto it = std::find_if(cols.begin(), cols.end(), [&](const Column& c) { return c.name == name; });
     if (it == cols.end()) continue;
@@ -501,7 +504,8 @@ View3d make_view3d(const PlotData& d, const io::CsvTable* strains, const View3dO
   j["surface"] = surface_json(d, t, o, v.stats);
   j["glyphs"] = glyphs_json(d, t, v.stats);
   if (strains) j["marks"] = marks_json(d, t, *strains, o, v.stats);
-  const std::string data = script_safe(j.dump());
+  // Ids and names from the user's files may hold bytes that are not UTF-8: replaced, not fatal.
+  const std::string data = script_safe(j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   v.stats.data_bytes = data.size();
   std::ostringstream h;
   if (o.full_window)

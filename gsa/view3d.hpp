@@ -37,7 +37,7 @@ namespace sf::gsa {
 
 struct View3dOptions {
   Index max_vertices = 60000;               // surface vertices in the page (before decimation: 81 per element)
-  std::size_t max_mark_values = 1'500'000;  // marks x embedded numeric columns
+  std::size_t max_mark_values = 1'000'000;  // marks x embedded numeric columns
   bool full_window = false;                 // view.html: the view fills the window
   // Throws OptionError naming the field for a value out of range.
   void validate() const;

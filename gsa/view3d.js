@@ -37,6 +37,7 @@
     [0.12, 0.47, 0.71], [1.0, 0.5, 0.05], [0.17, 0.63, 0.17], [0.84, 0.15, 0.16], [0.58, 0.4, 0.74],
     [0.55, 0.34, 0.29], [0.89, 0.47, 0.76], [0.5, 0.5, 0.5], [0.74, 0.74, 0.13], [0.09, 0.75, 0.81]];
   var NO_VALUE = [0.78, 0.78, 0.78];
+  var DENSE_MARKS = 3000;  // above: marks hidden at first and drawn smaller (they would cover the part)
 
   function viridis(t) {
     t = Math.min(1, Math.max(0, t)) * (VIRIDIS.length - 1);
@@ -50,6 +51,17 @@
     var a = Math.abs(v);
     if (a !== 0 && (a < 1e-3 || a >= 1e6)) return v.toExponential(3);
     return String(Number(v.toPrecision(4)));
+  }
+
+  // Colour bar labels: enough decimals to tell the ticks apart.
+  function tick(v, lo, hi) {
+    if (v === null || !isFinite(v)) return '\u2013';
+    var step = (hi - lo) / 4, a = Math.max(Math.abs(lo), Math.abs(hi));
+    if (!(step > 0) || a >= 1e6 || a < 1e-4) return fmt(v);
+    var decimals = Math.max(0, Math.min(10, Math.ceil(-Math.log10(step)) + 1));
+    var text = v.toFixed(decimals);
+    return /^-0\.?0*$/.test(text) ? text.slice(1) : text;  // no "-0.0"
+
   }
 
   function hashOptions() {
@@ -159,7 +171,7 @@
     // State and the controls bar.
     var opts = hashOptions();
     var state = {deformed: opts.state !== 'undeformed', field: fields.length ? fields[0] : null,
-                 marks: opts.marks !== '0', arrows: opts.arrows === '1'};
+                 marks: opts.marks ? opts.marks !== '0' : !!M && M.n <= DENSE_MARKS, arrows: opts.arrows === '1'};
     // field=KEY: the surface field KEY, else the strains.csv column KEY; field=marks:KEY: the column.
     if (opts.field) {
       var want = opts.field.replace(/^marks:/, ''), onMarks = opts.field.indexOf('marks:') === 0;
@@ -264,7 +276,8 @@
           m[3 * k] = rgb[0]; m[3 * k + 1] = rgb[1]; m[3 * k + 2] = rgb[2];
         }
         markColour.needsUpdate = true;
-        markPoints.material.size = onMarks ? 9 : 4;
+        var dense = M.n > DENSE_MARKS;
+        markPoints.material.size = onMarks ? (dense ? 4 : 9) : (dense ? 2 : 4);
         markPoints.visible = state.marks || onMarks;
       }
     }
@@ -365,7 +378,7 @@
             : [hi, 0.75 * hi + 0.25 * lo, 0.5 * (lo + hi), 0.25 * hi + 0.75 * lo, lo];
         values.forEach(function (v) {
           var t = document.createElement('div');
-          t.textContent = (values.length === 1 ? 'constant: ' : '') + fmt(v);
+          t.textContent = values.length === 1 ? 'constant: ' + fmt(v) : tick(v, lo, hi);
           ticks.appendChild(t);
         });
         box.appendChild(ticks);

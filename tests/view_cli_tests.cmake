@@ -7,6 +7,10 @@
 if(NOT TARGET gsa OR NOT COMMAND sf_gsa_cli_test)
   return()
 endif()
+if(NOT EXISTS "${SF_THREE_JS_DIR}/three.min.js")
+  message(STATUS "gsa 3-D view tests left out: gsa builds without three.js (libjs-three)")
+  return()
+endif()
 
 set(view_dir ${SF_CLI_DIR}/view)
 sf_gsa_cli_test(view.analyse_dome

@@ -91,7 +91,7 @@ Folder read_folder(const fs::path& dir, StrainMeasure m = StrainMeasure::kTrue) 
   return {plot_data(std::move(f), m), std::move(strains)};
 }
 
-TEST(View3d, MarksSitWhereTheyWereMeasured) {
+TEST(GsaView3d, MarksSitWhereTheyWereMeasured) {
   if (!view3d_available()) GTEST_SKIP() << view3d_library();
   const fs::path dir = test_dir("dome");
   const GridData grid = analyse_case("dome", dir);
@@ -118,7 +118,7 @@ TEST(View3d, MarksSitWhereTheyWereMeasured) {
   std::cout << "dome, 81 marks: placed within " << worst_u << " mm (blank), " << worst_d << " mm (part)\n";
 }
 
-TEST(View3d, SurfaceFieldsAreTheFittedStrain) {
+TEST(GsaView3d, SurfaceFieldsAreTheFittedStrain) {
   if (!view3d_available()) GTEST_SKIP() << view3d_library();
   const fs::path dir = test_dir("stretch");
   analyse_case("stretch", dir);
@@ -141,7 +141,7 @@ TEST(View3d, SurfaceFieldsAreTheFittedStrain) {
   EXPECT_GT(v.stats.glyph_sites, 0);
 }
 
-TEST(View3d, DecimatesUnderTheVertexBudget) {
+TEST(GsaView3d, DecimatesUnderTheVertexBudget) {
   if (!view3d_available()) GTEST_SKIP() << view3d_library();
   const fs::path dir = test_dir("decimate");
   analyse_case("dome", dir);
@@ -162,7 +162,7 @@ TEST(View3d, DecimatesUnderTheVertexBudget) {
   EXPECT_THROW(make_view3d(f.data, &f.strains, o), UsageError);
 }
 
-TEST(View3d, EveryColumnOfStrainsCsvIsOffered) {
+TEST(GsaView3d, EveryColumnOfStrainsCsvIsOffered) {
   if (!view3d_available()) GTEST_SKIP() << view3d_library();
   const fs::path dir = test_dir("columns");
   analyse_case("dome", dir);
@@ -201,7 +201,7 @@ TEST(View3d, EveryColumnOfStrainsCsvIsOffered) {
   EXPECT_NE(std::find(st.mark_columns.begin(), st.mark_columns.end(), "true1"), st.mark_columns.end());
 }
 
-TEST(View3d, OneSelfContainedPage) {
+TEST(GsaView3d, OneSelfContainedPage) {
   if (!view3d_available()) GTEST_SKIP() << view3d_library();
   const fs::path dir = test_dir("page");
   analyse_case("dome", dir);
@@ -223,7 +223,7 @@ TEST(View3d, OneSelfContainedPage) {
   EXPECT_EQ(st.marks, 81);
 }
 
-TEST(View3d, TriangleMethodHasNoSurfaces) {
+TEST(GsaView3d, TriangleMethodHasNoSurfaces) {
   const fs::path dir = test_dir("triangles");
   analyse_case("dome", dir, Method::kTriangles);
   try {

@@ -237,6 +237,7 @@ def main():
                 b.call("Input.dispatchMouseEvent", {"type": kind, "x": cx, "y": cy, "button": "left", "clickCount": 1})
             info = b.evaluate("(function(){var i=document.querySelector('#gsa-view .gv-info');"
                               "return i.style.display + '|' + i.textContent;})()")
+            b.screenshot()  # kept with --shots: the read-out
             print("click read-out: %s" % info[:300])
             if not info.startswith("block") or "Surface at" not in info:
                 failures.append("a click on the part gave no read-out: " + info[:200])
@@ -254,7 +255,8 @@ def main():
             if a.shots:
                 os.makedirs(a.shots, exist_ok=True)
                 stem = os.path.splitext(os.path.basename(a.page))[0]
-                for name, png in (("first", b.raw[0]), ("rotated", b.raw[1]), ("undeformed_last_field", b.raw[2])):
+                names = ("first", "rotated", "clicked", "undeformed_last_field")
+                for name, png in zip(names, b.raw):
                     with open(os.path.join(a.shots, "%s_%s.png" % (stem, name)), "wb") as f:
                         f.write(png)
         time.sleep(0.3)

@@ -118,7 +118,7 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
                     {"solve", run.seconds_solve},
                     {"write", run.seconds_write},
                     {"total", run.seconds_total}};
-  nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json"};
+  nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json", "tool_force.csv", "profiles.csv"};
   for (const auto& f : run.frames) outputs.push_back(f.second);
   j["outputs"] = outputs;
   j["grid_out"] = run.grid_out.empty() ? nlohmann::json() : nlohmann::json(run.grid_out);

@@ -67,6 +67,7 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
                           {"angle", p.angle_deg},
                           {"fibre_direction", {a0.x(), a0.y(), a0.z()}},
                           {"material", p.material}});
+    if (p.plane_strain) j["plies"].back()["plane_strain"] = true;
   }
   for (const CaseBoundary& bc : spec.boundaries) {
     nlohmann::json bj{{"kind", to_string(bc.kind)}, {"ply", bc.ply}, {"side", to_string(bc.side)}};

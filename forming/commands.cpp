@@ -79,8 +79,9 @@ int run_run(RunArgs& a, bool quiet) {
   if (!a.no_plots) {
     // The run's results are complete without pictures: a failure here is a warning.
     try {
-      PlotOptions po;
+      PlotOptions po;  // cheap at the end of a run: 5 frames (simform plot draws 10)
       po.quiet = quiet;
+      po.frames = 5;
       print_plot_report(a.options.out_dir, plot_results(a.options.out_dir, po), quiet);
     } catch (const std::exception& e) {
       std::cerr << "simform: warning: no pictures (" << e.what() << "); the results are complete, draw them later "

@@ -365,10 +365,14 @@ class Plotter {
       }
     if (lo > hi) lo = hi = 0.0;
     if (hi - lo < p.min_span) {
-      const double m = p.symmetric ? 0.0 : 0.5 * (lo + hi);
-      lo = m - 0.5 * p.min_span;
-      hi = m + 0.5 * p.min_span;
-      if (!p.symmetric && lo < 0.0 && m - 0.5 * (hi - lo) >= 0.0) lo = 0.0;
+      if (p.symmetric) {  // about 0, the values included
+        lo = std::min(lo, -0.5 * p.min_span);
+        hi = std::max(hi, 0.5 * p.min_span);
+      } else {
+        const double m = 0.5 * (lo + hi);
+        lo = m - 0.5 * p.min_span;
+        hi = m + 0.5 * p.min_span;
+      }
     }
     render::ScalarColouring c;
     c.title = p.title;
@@ -699,7 +703,7 @@ class Plotter {
       corners.shading = false;
       char name[64];
       std::snprintf(name, sizeof name, "plots/frames/frame_%04zu.png", k);
-      render::write_png(scene, options_.size, (dir_ / name).string());
+      render::write_png(scene, options_.frame_size, (dir_ / name).string());
       files.push_back((dir_ / name).string());
     }
     report.notes.push_back(std::to_string(files.size()) + " frames in plots/frames/");

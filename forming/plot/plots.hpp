@@ -38,6 +38,7 @@ struct PlotOptions {
   std::string ply;  // fibre glyph ply name; empty: the top fibre-reinforced ply
   render::ImageSize size{1200, 900};
   int frames = 10;        // frames in the sequence (0: none); evenly spread, last included
+  render::ImageSize frame_size{800, 600};  // of the frames of the sequence
   bool animation = true;  // forming.avi when possible
   bool quiet = false;
 };

@@ -7,6 +7,7 @@
 #include "common/cli/app.hpp"
 #include "common/cli/progress.hpp"
 #include "forming/case/reader.hpp"
+#include "forming/plot/plots.hpp"
 #include "forming/run/run.hpp"
 #include "forming/stability/command.hpp"
 
@@ -35,7 +36,30 @@ int run_check(const std::string& path, bool quiet) {
 struct RunArgs {
   std::string case_file;
   RunOptions options;
+  bool no_plots = false;
 };
+
+// The pictures and report.html of a results folder (forming/plot/plots.hpp).
+void print_plot_report(const std::string& dir, const PlotReport& r, bool quiet) {
+  sf::cli::status(quiet, "simform: wrote " + std::to_string(r.pictures.size()) + " pictures in " + dir + "/plots and " +
+                             dir + "/report.html" + (r.animation.empty() ? "" : " (animation " + r.animation + ")"));
+  for (const std::string& n : r.notes) sf::cli::status(quiet, "simform: " + n);
+}
+
+struct PlotArgs {
+  std::string dir;
+  std::string size = "1200x900";
+  PlotOptions options;
+  bool no_animation = false;
+};
+
+int run_plot(PlotArgs& a, bool quiet) {
+  a.options.size = render::parse_size(a.size, "--size");
+  a.options.animation = !a.no_animation;
+  a.options.quiet = quiet;
+  print_plot_report(a.dir, plot_results(a.dir, a.options), quiet);
+  return sf::cli::kExitOk;
+}
 
 int run_run(RunArgs& a, bool quiet) {
   a.options.quiet = quiet;
@@ -52,6 +76,18 @@ int run_run(RunArgs& a, bool quiet) {
   }
   sf::cli::status(quiet, "simform: " + r.brief() + "; wrote " + a.options.out_dir +
                              (a.options.grid_out.empty() ? "" : " and " + a.options.grid_out));
+  if (!a.no_plots) {
+    // The run's results are complete without pictures: a failure here is a warning.
+    try {
+      PlotOptions po;  // cheap at the end of a run: 5 frames (simform plot draws 10)
+      po.quiet = quiet;
+      po.frames = 5;
+      print_plot_report(a.options.out_dir, plot_results(a.options.out_dir, po), quiet);
+    } catch (const std::exception& e) {
+      std::cerr << "simform: warning: no pictures (" << e.what() << "); the results are complete, draw them later "
+                << "with 'simform plot " << a.options.out_dir << "'\n";
+    }
+  }
   return sf::cli::kExitOk;
 }
 
@@ -91,8 +127,22 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--stop-after", args->options.stop_after,
                        "Stop cleanly after this many steps (status 'stopped'; continue with --restart)")
             ->check(CLI::NonNegativeNumber);
+        app.add_flag("--no-plots", args->no_plots, "Do not draw the pictures and report.html at the end");
       },
       [args, prog] { return run_run(*args, prog->common().quiet); });
+
+  auto plot = std::make_shared<PlotArgs>();
+  program.add_command(
+      "plot", "Draw the pictures of a results folder (PNG, no display needed) and its report.html",
+      [plot](CLI::App& app) {
+        app.add_option("results", plot->dir, "Results folder of simform run")->required();
+        app.add_option("--ply", plot->options.ply, "Ply whose fibre directions are drawn (default: the top one)");
+        app.add_option("--size", plot->size, "Picture size WxH in pixels (default 1200x900)");
+        app.add_option("--frames", plot->options.frames, "Frames in the forming sequence (default 10; 0: none)")
+            ->check(CLI::Range(0, 1000));
+        app.add_flag("--no-animation", plot->no_animation, "Do not write plots/forming.avi");
+      },
+      [plot, prog] { return run_plot(*plot, prog->common().quiet); });
 
   stability::add_stability_command(program);
 }

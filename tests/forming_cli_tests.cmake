@@ -139,3 +139,32 @@ endif()
 # ---------------------------------------------------------------- simform stability
 
 include(${CMAKE_CURRENT_LIST_DIR}/forming/stability_cli.cmake)
+
+# Forming results and pictures (issue 13 items 3-4; docs/forming.md "Forming results",
+# "Pictures and report"): a 2-D bend run draws its pictures by default, `simform plot`
+# draws them again, --no-plots skips them, bad input is named.
+set(sf_plot_out ${SF_FORMING_CLI_DIR}/plot_bend)
+sf_forming_cli_test(plot.run_bend
+  COMMAND run tests/forming/cases/bend_2d.yaml --out ${sf_plot_out}
+  REMOVE ${sf_plot_out}
+  STDERR "converged: .*wrote [0-9]+ pictures"
+  EXISTS "${sf_plot_out}/report.html|${sf_plot_out}/plots/section.png|${sf_plot_out}/plots/fibres.png|${sf_plot_out}/plots/shear_angle.png|${sf_plot_out}/plots/thickness.png|${sf_plot_out}/plots/force_displacement.png|${sf_plot_out}/plots/frames/frame_0000.png|${sf_plot_out}/tool_force.csv|${sf_plot_out}/profiles.csv"
+  FIXTURES_SETUP sf_plot_bend)
+sf_forming_cli_test(plot.again
+  COMMAND plot ${sf_plot_out} --frames 2 --no-animation --size 800x600
+  STDERR "wrote 8 pictures"
+  EXISTS "${sf_plot_out}/plots/frames/frame_0001.png")
+set_tests_properties(forming.cli.plot.again PROPERTIES FIXTURES_REQUIRED sf_plot_bend)
+sf_forming_cli_test(plot.bad_ply
+  COMMAND plot ${sf_plot_out} --ply nope EXIT 2 STDERR "--ply: no ply 'nope'.*lam\\.1, lam\\.2")
+set_tests_properties(forming.cli.plot.bad_ply PROPERTIES FIXTURES_REQUIRED sf_plot_bend)
+sf_forming_cli_test(plot.not_results
+  COMMAND plot ${SF_FORMING_CLI_DIR}/no_such_results EXIT 1 STDERR "no_such_results: not a folder")
+sf_forming_cli_test(plot.bad_size
+  COMMAND plot ${sf_plot_out} --size 10x10 EXIT 2 STDERR "--size")
+set(sf_noplot_out ${SF_FORMING_CLI_DIR}/plot_none)
+sf_forming_cli_test(plot.run_no_plots
+  COMMAND run data/forming/uniaxial_0.yaml --out ${sf_noplot_out} --no-plots
+  REMOVE ${sf_noplot_out}
+  EXISTS "${sf_noplot_out}/summary.json|${sf_noplot_out}/tool_force.csv"
+  ABSENT "${sf_noplot_out}/report.html|${sf_noplot_out}/plots")

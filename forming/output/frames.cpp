@@ -8,6 +8,7 @@
 #include "forming/contact/surface_contact.hpp"
 #include "forming/contact/tool_contact.hpp"
 #include "forming/material/material.hpp"
+#include "forming/output/forming_fields.hpp"
 #include "forming/output/sampling.hpp"
 
 namespace sf::forming {
@@ -140,8 +141,12 @@ io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane
   io::VolumeMesh mesh;
   std::vector<Vec3> points;
   std::vector<double> disp, stress, fibre, stretch, body_id, pressure, tension;
+  // Forming results per column of cells (mid-thickness; forming_fields.hpp).
+  std::vector<double> angle_change, ply_shear, trellis, thickness, waviness;
+  const FormingFields forming(model, x);
   const bool constrained = model.any_constrained();
   for (int b = 0; b < model.n_bodies(); ++b) {
+    const WrinkleResult wrinkle = forming.wrinkles(b, ns);
     const PlyMesh& ply = model.ply(b);
     const Material& material = model.material(b);
     // Element pressure and fibre tension of a constrained ply (sigma gains -p I + T/J a a).
@@ -178,6 +183,9 @@ io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane
             }
           }
       auto pid = [&](int i, int j, int k) { return first + (static_cast<Index>(k) * (ns + 1) + j) * (ns + 1) + i; };
+      std::vector<PlyPointFields> column;
+      for (int j = 0; j < ns; ++j)
+        for (int i = 0; i < ns; ++i) column.push_back(forming.at(b, e, Vec3((i + 0.5) / ns, (j + 0.5) / ns, 0.5)));
       for (int k = 0; k < nt; ++k)
         for (int j = 0; j < ns; ++j)
           for (int i = 0; i < ns; ++i) {
@@ -207,6 +215,12 @@ io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane
             for (int c = 0; c < 3; ++c) fibre.push_back(lam > 0.0 ? a[c] / lam : 0.0);
             stretch.push_back(lam);
             body_id.push_back(b);
+            const PlyPointFields& f = column[static_cast<std::size_t>(j * ns + i)];
+            angle_change.push_back(f.fibre_angle_change_deg);
+            ply_shear.push_back(f.ply_shear_deg);
+            trellis.push_back(f.trellis_shear_deg);
+            thickness.push_back(f.thickness);
+            waviness.push_back(wrinkle.deviation[static_cast<std::size_t>((e * ns + j) * ns + i)]);
           }
     }
   }
@@ -223,6 +237,11 @@ io::VolumeMesh tessellate(const Model& model, const VecX& x, int samples_inplane
   mesh.cell_data.push_back({"fibre_direction", 3, std::move(fibre)});
   mesh.cell_data.push_back({"fibre_stretch", 1, std::move(stretch)});
   mesh.cell_data.push_back({"ply", 1, std::move(body_id)});
+  mesh.cell_data.push_back({"fibre_angle_change", 1, std::move(angle_change)});
+  mesh.cell_data.push_back({"ply_shear_angle", 1, std::move(ply_shear)});
+  mesh.cell_data.push_back({"trellis_shear_angle", 1, std::move(trellis)});
+  mesh.cell_data.push_back({"thickness", 1, std::move(thickness)});
+  mesh.cell_data.push_back({"waviness", 1, std::move(waviness)});
   if (constrained) {
     mesh.cell_data.push_back({"pressure", 1, std::move(pressure)});
     mesh.cell_data.push_back({"fibre_tension", 1, std::move(tension)});

@@ -67,6 +67,7 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
                           {"angle", p.angle_deg},
                           {"fibre_direction", {a0.x(), a0.y(), a0.z()}},
                           {"material", p.material}});
+    if (p.plane_strain) j["plies"].back()["plane_strain"] = true;
   }
   for (const CaseBoundary& bc : spec.boundaries) {
     nlohmann::json bj{{"kind", to_string(bc.kind)}, {"ply", bc.ply}, {"side", to_string(bc.side)}};
@@ -118,7 +119,7 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
                     {"solve", run.seconds_solve},
                     {"write", run.seconds_write},
                     {"total", run.seconds_total}};
-  nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json"};
+  nlohmann::json outputs = {"result.pvd", "history.csv", "summary.json", "tool_force.csv", "profiles.csv"};
   for (const auto& f : run.frames) outputs.push_back(f.second);
   j["outputs"] = outputs;
   j["grid_out"] = run.grid_out.empty() ? nlohmann::json() : nlohmann::json(run.grid_out);

@@ -8,6 +8,7 @@
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/json.hpp"
+#include "forming/output/forming_results.hpp"
 #include "forming/output/grid_out.hpp"
 #include "forming/output/summary.hpp"
 
@@ -30,7 +31,8 @@ std::string sci(double v) {
 // those of this one; other files in OUT (the user's) are kept.
 io::OutputDirOptions folder_options(const RunOptions& options) {
   io::OutputDirOptions o;
-  o.owned = {"steps", "result.pvd", "history.csv", "summary.json", "restart.json"};
+  o.owned = {"steps",        "result.pvd",     "history.csv", "summary.json", "restart.json",
+             "profiles.csv", "tool_force.csv", "plots",       "report.html"};
   o.work_suffix = ".partial";
   // Continue in the working folder of a killed run when it got as far as a restart file.
   std::filesystem::path dir = std::filesystem::path(options.out_dir).lexically_normal();
@@ -206,6 +208,10 @@ RunReport RunRecorder::finish(const SteppingReport& stepping, double seconds_bui
   const Clock::time_point t_out = Clock::now();
   frames_.write_collection(out_.path("result.pvd"));
   io::write_file_atomic(out_.path("history.csv"), history_.text());
+  // Forming results of the last converged state (forming_results.hpp).
+  const double process_time = spec_.solver.dynamic ? spec_.solver.end_time : spec_.solver.process_time;
+  io::write_file_atomic(out_.path("tool_force.csv"), tool_force_csv(history_.text(), "history.csv", process_time));
+  io::write_file_atomic(out_.path("profiles.csv"), profiles_csv(spec_, problem_.model, last_.x));
   seconds_write_ += seconds_since(t_out);
   report_.seconds = seconds_build + seconds_since(created_);
 
@@ -231,7 +237,9 @@ RunReport RunRecorder::finish(const SteppingReport& stepping, double seconds_bui
   s.seconds_write = seconds_write_;
   s.seconds_total = report_.seconds;
   s.grid_out = write_grid_file ? options_.grid_out : std::string();
-  io::write_json(out_.path("summary.json"), summary_json(spec_, problem_.model, s));
+  nlohmann::json summary = summary_json(spec_, problem_.model, s);
+  summary["forming"] = forming_summary(spec_, problem_.model, last_.x, spec_.output.samples_inplane);
+  io::write_json(out_.path("summary.json"), summary);
   out_.commit();
 
   if (write_grid_file) {

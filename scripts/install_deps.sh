@@ -11,6 +11,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy  # the Python module `sheetform` (python/, docs/python.md)
   dpkg-dev file  # cpack -G DEB: dpkg-shlibdeps finds the runtime packages of the .deb (docs/install.md)
   libopenblas0-serial  # optimised BLAS under CHOLMOD (reference BLAS is ~10x slower; serial: no spinning threads)
+  clang libclang-rt-14-dev  # libFuzzer targets of the readers (scripts/fuzz.sh, run by scripts/extras.sh in CI)
 )
 
 missing=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The reliability extras of issue 20 (docs/reliability.md), run by `scripts/test.sh` when
-# SF_EXTRAS=1 (CI sets it): a short fuzz run of every reader (clang, libFuzzer), then the
-# unit and command-line tests under the address and undefined-behaviour sanitizers.
+# SF_EXTRAS=1 (CI sets it): a short fuzz run of every reader (clang, libFuzzer), then, with
+# SF_EXTRAS_SANITIZE=1, the unit and command-line tests under the address and
+# undefined-behaviour sanitizers.
 #
 #   bash scripts/extras.sh [MINUTES]     # time budget, default SF_EXTRAS_MINUTES or 50
 #
@@ -17,10 +18,10 @@ mkdir -p build
 status=0
 summary=()
 
-# 1. Fuzzing: SF_FUZZ_SECONDS (default 30) per target.
+# 1. Fuzzing: every reader, a fixed seed and execution count (scripts/fuzz.sh ci).
 if command -v clang++ >/dev/null; then
-  echo "extras: fuzz smoke (build-fuzz, ${SF_FUZZ_SECONDS:-30} s per reader), log build/fuzz.log"
-  SF_FUZZ_SECONDS=${SF_FUZZ_SECONDS:-30} timeout --foreground "$(left)" bash scripts/fuzz.sh smoke >build/fuzz.log 2>&1
+  echo "extras: fuzzing every reader (build-fuzz, about 30 s each), log build/fuzz.log"
+  timeout -k 10 "$(left)" bash scripts/fuzz.sh ci >build/fuzz.log 2>&1
   rc=$?
   runs=$(grep -E '^stat::number_of_executed_units' build/fuzz.log | awk '{s += $2} END {print s + 0}')
   if [ $rc -eq 124 ]; then
@@ -35,12 +36,16 @@ else
   summary+=("fuzz: not run (clang++ not installed)")
 fi
 
-# 2. Sanitizers: the build, then the tests, each stopped at the deadline.
-echo "extras: tests under address+undefined sanitizers (build-sanitize), log build/sanitize.log"
-if [ "$(left)" -le 60 ]; then
+# 2. Sanitizers: the build, then the tests, each stopped at the deadline. Only with
+# SF_EXTRAS_SANITIZE=1 until a whole run has been seen clean on a 2-core machine
+# (docs/reliability.md): a first finding must not be what stops CI from landing work.
+if [ "${SF_EXTRAS_SANITIZE:-0}" != 1 ]; then
+  summary+=("sanitize: not run (SF_EXTRAS_SANITIZE=1 runs it; scripts/sanitize.sh alone)")
+elif [ "$(left)" -le 60 ]; then
   summary+=("sanitize: not run (time budget used up)")
 else
-  timeout --foreground "$(left)" bash scripts/sanitize.sh >build/sanitize.log 2>&1
+  echo "extras: tests under address+undefined sanitizers (build-sanitize), log build/sanitize.log"
+  timeout -k 10 "$(left)" bash scripts/sanitize.sh >build/sanitize.log 2>&1
   rc=$?
   passed=$(grep -cE '^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* Passed' build/sanitize.log)
   failed=$(grep -cE '^ *[0-9]+/[0-9]+ Test +#[0-9]+: .*(\*\*\*|Not Run)' build/sanitize.log)

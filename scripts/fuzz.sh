@@ -3,6 +3,7 @@
 # preset (clang, address + undefined sanitizers) and runs each one.
 #
 #   bash scripts/fuzz.sh smoke            # every target for SF_FUZZ_SECONDS (default 60) s
+#   bash scripts/fuzz.sh ci               # every target, fixed seed and execution count (CI)
 #   bash scripts/fuzz.sh long TARGET N    # one target for N executions (e.g. 1000000)
 #
 # Targets: grid csv mesh flc case stl. Corpora: tests/fuzz/corpus/<target> (seeds, read
@@ -27,13 +28,17 @@ run() {  # target, extra libFuzzer options...
   shift
   local seeds=tests/fuzz/corpus/$t
   [ "$t" = csv ] && seeds=tests/fuzz/corpus/grid
-  mkdir -p "build-fuzz/corpus/$t" "build-fuzz/findings/$t"
+  mkdir -p "$corpus/$t" "build-fuzz/findings/$t"
   build-fuzz/bin/fuzz_$t -max_len=65536 -rss_limit_mb=2048 -timeout=20 \
-    -artifact_prefix="build-fuzz/findings/$t/" -print_final_stats=1 "$@" "build-fuzz/corpus/$t" "$seeds" 2>&1 |
+    -artifact_prefix="build-fuzz/findings/$t/" -print_final_stats=1 "$@" "$corpus/$t" "$seeds" 2>&1 |
     grep -E '^(#[0-9]+.*(DONE|INITED)|stat::number_of_executed_units|==[0-9]+==ERROR|SUMMARY|finding:|Done)' || true
   return "${PIPESTATUS[0]}"
 }
 
+# Executions per target in `ci` mode: about 30 s each on 2 quiet cores. With a fixed seed
+# and a fresh corpus the run is reproducible: what CI runs was run clean before landing.
+declare -A ci_runs=([grid]=3000 [csv]=60000 [mesh]=12000 [flc]=30000 [case]=6000 [stl]=150000)
+corpus=build-fuzz/corpus
 status=0
 case "$mode" in
   smoke)
@@ -42,12 +47,20 @@ case "$mode" in
       run "$t" -max_total_time="${SF_FUZZ_SECONDS:-60}" || { echo "fuzz: $t FOUND A PROBLEM (build-fuzz/findings/$t)"; status=1; }
     done
     ;;
+  ci)
+    corpus=build-fuzz/corpus-ci
+    rm -rf "$corpus"
+    for t in "${targets[@]}"; do
+      echo "fuzz: $t for ${ci_runs[$t]} executions (seed 1)"
+      run "$t" -seed=1 -runs="${ci_runs[$t]}" || { echo "fuzz: $t FOUND A PROBLEM (build-fuzz/findings/$t)"; status=1; }
+    done
+    ;;
   long)
     t=${2:?target}
     run "$t" -runs="${3:-1000000}" || { echo "fuzz: $t FOUND A PROBLEM (build-fuzz/findings/$t)"; status=1; }
     ;;
   *)
-    echo "usage: scripts/fuzz.sh smoke | long TARGET [EXECUTIONS]" >&2
+    echo "usage: scripts/fuzz.sh smoke | ci | long TARGET [EXECUTIONS]" >&2
     exit 2
     ;;
 esac

@@ -13,6 +13,7 @@ packages=(
   libopenblas0-serial  # optimised BLAS under CHOLMOD (reference BLAS is ~10x slower; serial: no spinning threads)
   libjs-three  # three.js r111, inlined into gsa's 3-D view (report.html, gsa view; gsa/view3d.hpp)
   chromium  # headless browser for the 3-D view's tests (tests/gsa/view3d_browser.py; skipped without it)
+  clang libclang-rt-14-dev  # libFuzzer targets of the readers (scripts/fuzz.sh, run by scripts/extras.sh in CI)
 )
 
 missing=()

@@ -195,7 +195,8 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   vacuum.ramp = Ramp::kLinear;  // constant: the first step must carry it all (cut-backs cannot reduce it)
   bool has_vacuum = false;
   if (const YAML::Node v = n["vacuum"]; v.IsDefined()) {
-    if (const YAML::Node p = v["pressure"]; case_yaml::is_map(v) && p.IsDefined() && !v["value"].IsDefined()) {
+    if (case_yaml::is_map(v) && v["pressure"].IsDefined()) {
+      const YAML::Node p = v["pressure"];
       // vacuum: {pressure: 0.09, ramp: constant}
       if (r.mapping(v, what + " vacuum", {"pressure", "ramp"})) {
         if (const auto x = r.positive(p, what + " vacuum pressure", "MPa, the atmosphere over the vacuum")) {

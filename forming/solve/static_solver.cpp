@@ -1,6 +1,8 @@
 #include "forming/solve/static_solver.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -271,10 +273,16 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
     rnorm = free_.restrict(st.residual).norm();
     scale = st.scale;
   }
+  // SF_NEWTON_TRACE=1 in the environment: one line per Newton iteration on stderr (the
+  // residual, its tolerance and the line-search step), to see how a step converges.
+  static const bool trace = std::getenv("SF_NEWTON_TRACE") != nullptr;
   for (;;) {
     rec.residual_norms.push_back(rnorm);
     if (first_norm < 0.0) first_norm = rnorm;
     const double tol = std::max(options_.residual_tol_abs, options_.residual_tol_rel * scale);
+    if (trace)
+      std::fprintf(stderr, "newton: lambda %.6g iteration %d |r| %.3e tol %.3e step %.3g\n", lam_new, rec.iterations,
+                   rnorm, tol, rec.step_lengths.empty() ? 1.0 : rec.step_lengths.back());
     if (rnorm <= tol) {
       rec.converged = true;
       force_scale = scale;

@@ -13,7 +13,7 @@
 //   peak resident memory (getrusage high-water mark).
 // A program that prints figures, not a timed test.
 //   build/bin/simform_dome_bench [--quick] [--max-steps N] [--case FILE]
-//   --quick       6 x 6 bricks a ply, 3 of the 36 steps (a smoke test, seconds)
+//   --quick       4 x 4 bricks a ply, 2 of the 36 steps (a smoke test)
 //   --max-steps N stop cleanly after N steps (the full run can take long)
 //   --case FILE   another case (default: the [0,90]s dome)
 #include <sys/resource.h>
@@ -60,22 +60,23 @@ int main(int argc, char** argv) {
     FormingCase spec = load_case(file);
     if (quick) {
       for (CasePly& p : spec.plies) {
-        p.n1 = std::min(p.n1, 6);
-        p.n2 = std::min(p.n2, 6);
+        p.n1 = std::min(p.n1, 4);
+        p.n2 = std::min(p.n2, 4);
       }
-      if (max_steps == 0) max_steps = 3;
+      if (max_steps == 0) max_steps = 2;
     }
     int elements = 0;
     for (const CasePly& p : spec.plies) elements += p.n1 * p.n2;
     std::printf("case %s%s: %zu plies, %d bricks, %zu contact pairs, %d steps requested%s\n", file.c_str(),
-                quick ? " (--quick: at most 6 x 6 bricks a ply)" : "", spec.plies.size(), elements,
+                quick ? " (--quick: at most 4 x 4 bricks a ply)" : "", spec.plies.size(), elements,
                 spec.contacts.size(), spec.solver.steps,
                 max_steps > 0 ? (", stopping after " + std::to_string(max_steps)).c_str() : "");
+    std::fflush(stdout);
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sf_simform_dome_bench";
     std::filesystem::remove_all(dir);
     RunOptions o;
     o.out_dir = dir.string();
-    o.quiet = true;
+    o.quiet = false;  // simform's step lines on stderr: progress on a long run
     o.stop_after = max_steps;
     solve_profile().reset();
     const auto t0 = std::chrono::steady_clock::now();

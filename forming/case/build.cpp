@@ -158,6 +158,7 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.statics.residual_tol_rel = s.tolerance;
   out.statics.line_search = s.line_search;
   out.statics.min_increment = s.min_increment;
+  out.statics.extrapolate = s.extrapolate;
   out.statics.validate();
   out.uzawa.tolerance = s.constraint_tolerance;
   out.process_time = s.process_time;

@@ -539,7 +539,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver",
                  {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
                   "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
-                  "stop_displacement", "process_time"}))
+                  "stop_displacement", "process_time", "predictor"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -631,6 +631,15 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                 "solver tolerance: expected a relative residual in (0, 1), found " + n["tolerance"].Scalar());
     else if (v)
       s.tolerance = *v;
+  }
+  if (const YAML::Node pr = n["predictor"]; pr.IsDefined()) {
+    if (case_yaml::is_scalar(pr) && (pr.Scalar() == "tangent" || pr.Scalar() == "extrapolate"))
+      s.extrapolate = pr.Scalar() == "extrapolate";
+    else
+      r.problem(ProblemKind::kWrongType, pr,
+                "solver predictor: expected tangent (default) or extrapolate (start each step from the last "
+                "step's increment), found " +
+                    describe(pr));
   }
   if (n["line_search"].IsDefined())
     if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;

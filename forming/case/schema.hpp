@@ -159,6 +159,9 @@ struct CaseSolver {
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
   // Load control: the process time of the load factor (t = lambda process_time, s):
   // tools move with it and friction takes its slip rates over it.
+  // predictor: extrapolate (load control): each step's first iterate starts from the
+  // last step's increment (forming/solve/static_solver.hpp StaticOptions::extrapolate).
+  bool extrapolate = false;
   double process_time = 1.0;   // s
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given

@@ -10,6 +10,7 @@
 #include "forming/case/checks.hpp"
 #include "forming/contact/body_contact.hpp"
 #include "forming/contact/tool_contact.hpp"
+#include "forming/material/mooney_rivlin.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
@@ -36,6 +37,10 @@ Model build_model(const FormingCase& spec) {
     if (m.kind == CaseMaterial::Kind::kNeoHookean) {
       law = std::make_shared<NeoHookean>(m.neo_hookean);
       ct.kappa = kConstraintPenalty * (m.neo_hookean.lambda + 2.0 * m.neo_hookean.mu);
+    } else if (m.kind == CaseMaterial::Kind::kMooneyRivlin) {
+      law = std::make_shared<MooneyRivlin>(m.mooney_rivlin);
+      const MooneyRivlinParams& q = m.mooney_rivlin;
+      ct.kappa = kConstraintPenalty * (q.bulk_modulus() + 4.0 * q.shear_modulus() / 3.0);
     } else {
       law = std::make_shared<TransverselyIsotropic>(m.ti, ply.fibre_direction());
       ct.kappa = kConstraintPenalty * (m.ti.lambda + 2.0 * m.ti.mu_T);
@@ -153,6 +158,7 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.statics.residual_tol_rel = s.tolerance;
   out.statics.line_search = s.line_search;
   out.statics.min_increment = s.min_increment;
+  out.statics.extrapolate = s.extrapolate;
   out.statics.validate();
   out.uzawa.tolerance = s.constraint_tolerance;
   out.process_time = s.process_time;

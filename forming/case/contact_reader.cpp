@@ -698,6 +698,12 @@ void read_tools(Reader& r, const YAML::Node& n, const std::string& case_dir, For
   for (std::size_t i = 0; i < n.size(); ++i) read_tool(r, n[i], static_cast<int>(i), case_dir, spec);
 }
 
+const std::vector<std::string>& contact_law_keys() { return kLawKeys; }
+
+bool read_contact_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
+  return read_law(r, n, what, law);
+}
+
 void read_contacts(Reader& r, const YAML::Node& n, FormingCase& spec) {
   if (!case_yaml::is_sequence(n) || n.size() == 0) {
     r.problem(ProblemKind::kWrongType, n, "contact: expected a list (- ply: ...), found " + describe(n));

@@ -37,4 +37,11 @@ void read_laminates(case_yaml::Reader& r, const YAML::Node& n, FormingCase& spec
 void read_tools(case_yaml::Reader& r, const YAML::Node& n, const std::string& case_dir, FormingCase& spec);
 void read_contacts(case_yaml::Reader& r, const YAML::Node& n, FormingCase& spec);
 
+// The contact law keys (stiffness, tolerance, viscous, coulomb, stick_velocity,
+// engage_gap, points, two_pass, band) and their reader, for other sections that set up
+// contact pairs (forming/case/diaphragm_reader.cpp): reads those of mapping n present,
+// stiffness required; false (with problems recorded) on a bad value.
+const std::vector<std::string>& contact_law_keys();
+bool read_contact_law(case_yaml::Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law);
+
 }  // namespace sf::forming

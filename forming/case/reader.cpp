@@ -18,6 +18,7 @@
 #include "common/core/error.hpp"
 #include "forming/case/checks.hpp"
 #include "forming/case/contact_reader.hpp"
+#include "forming/case/diaphragm_reader.hpp"
 #include "forming/case/model_checks.hpp"
 #include "forming/case/yaml_reader.hpp"
 
@@ -33,8 +34,9 @@ using case_yaml::vector3;
 
 namespace {
 
-const std::vector<std::string> kTopKeys = {"units", "materials", "plies", "laminates", "boundary_conditions",
-                                           "loads", "solver",    "tools", "contact",   "output"};
+const std::vector<std::string> kTopKeys = {"units",     "materials", "plies", "laminates", "boundary_conditions",
+                                           "loads",     "solver",    "tools", "contact",   "output",
+                                           "diaphragms"};
 
 // The law of material `what` under key `law` (neo_hookean: {E, nu} or {mu, lambda});
 // false (with a problem) when it cannot be read or the law rejects the constants.
@@ -63,6 +65,40 @@ bool read_neo_hookean(Reader& r, const std::string& what, const YAML::Node& law,
       m.neo_hookean.validate();
       m.given_as = "mu, lambda";
     }
+  } catch (const InputError& e) {
+    r.problem(ProblemKind::kOutOfRange, law, what + ": " + e.what());
+    return false;
+  }
+  return true;
+}
+
+// The Mooney-Rivlin law of material `what` ({c10, c01, nu} or {c10, c01, kappa}), as
+// read_neo_hookean().
+bool read_mooney_rivlin(Reader& r, const std::string& what, const YAML::Node& law, const YAML::Node& p,
+                        CaseMaterial& m) {
+  const std::string lw = what + " mooney_rivlin";
+  m.kind = CaseMaterial::Kind::kMooneyRivlin;
+  if (!r.mapping(p, lw, {"c10", "c01", "nu", "kappa"})) return false;
+  if (p["nu"].IsDefined() == p["kappa"].IsDefined()) {
+    r.problem(ProblemKind::kWrongType, law, lw + ": give {c10, c01} and either nu or kappa (MPa)");
+    return false;
+  }
+  try {
+    const auto c10 = r.number(r.required(p, "c10", lw), lw + " c10");
+    const auto c01 = r.number(r.required(p, "c01", lw), lw + " c01");
+    if (!c10 || !c01) return false;
+    if (p["nu"].IsDefined()) {
+      const auto nu = r.number(p["nu"], lw + " nu");
+      if (!nu) return false;
+      m.mooney_rivlin = MooneyRivlinParams::from_poisson(*c10, *c01, *nu);
+      m.given_as = "c10, c01, nu";
+    } else {
+      const auto kappa = r.number(p["kappa"], lw + " kappa");
+      if (!kappa) return false;
+      m.mooney_rivlin = MooneyRivlinParams::from_bulk(*c10, *c01, *kappa);
+      m.given_as = "c10, c01, kappa";
+    }
+    m.mooney_rivlin.validate();
   } catch (const InputError& e) {
     r.problem(ProblemKind::kOutOfRange, law, what + ": " + e.what());
     return false;
@@ -126,7 +162,9 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   CaseMaterial m;
   m.name = name;
   m.place = place_of(key);
-  if (!r.mapping(body, what, {"neo_hookean", "transversely_isotropic", "density", "incompressible", "inextensible"}))
+  if (!r.mapping(
+          body, what,
+          {"neo_hookean", "mooney_rivlin", "transversely_isotropic", "density", "incompressible", "inextensible"}))
     return;
   std::size_t extras = 0;
   if (body["density"].IsDefined()) {
@@ -142,21 +180,24 @@ void read_material(Reader& r, const std::string& name, const YAML::Node& key, co
   }
   if (body.size() != extras + 1) {
     r.problem(ProblemKind::kWrongType, key,
-              what + ": expected exactly one law (neo_hookean or transversely_isotropic)");
+              what + ": expected exactly one law (neo_hookean, mooney_rivlin or transversely_isotropic)");
     return;
   }
   auto law = body.begin();
-  while (law != body.end() && law->first.Scalar() != "neo_hookean" && law->first.Scalar() != "transversely_isotropic")
-    ++law;
+  const auto is_law = [](const std::string& k) {
+    return k == "neo_hookean" || k == "mooney_rivlin" || k == "transversely_isotropic";
+  };
+  while (law != body.end() && !is_law(law->first.Scalar())) ++law;
   if (law == body.end()) return;
-  if (m.inextensible && law->first.Scalar() == "neo_hookean")
+  if (m.inextensible && law->first.Scalar() != "transversely_isotropic")
     r.problem(ProblemKind::kUnsupported, body["inextensible"],
               what + ": inextensible needs fibres (a transversely_isotropic law)");
   const std::string law_name = law->first.Scalar();
   const YAML::Node p = law->second;
-  if (law_name != "neo_hookean" && law_name != "transversely_isotropic") return;  // reported above
-  const bool ok = law_name == "neo_hookean" ? read_neo_hookean(r, what, law->first, p, m)
-                                            : read_transversely_isotropic(r, what, law->first, p, m);
+  if (!is_law(law_name)) return;  // reported above
+  const bool ok = law_name == "neo_hookean"     ? read_neo_hookean(r, what, law->first, p, m)
+                  : law_name == "mooney_rivlin" ? read_mooney_rivlin(r, what, law->first, p, m)
+                                                : read_transversely_isotropic(r, what, law->first, p, m);
   if (ok) spec.materials.push_back(m);
 }
 
@@ -498,7 +539,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver",
                  {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
                   "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
-                  "stop_displacement", "process_time"}))
+                  "stop_displacement", "process_time", "predictor"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -590,6 +631,15 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                 "solver tolerance: expected a relative residual in (0, 1), found " + n["tolerance"].Scalar());
     else if (v)
       s.tolerance = *v;
+  }
+  if (const YAML::Node pr = n["predictor"]; pr.IsDefined()) {
+    if (case_yaml::is_scalar(pr) && (pr.Scalar() == "tangent" || pr.Scalar() == "extrapolate"))
+      s.extrapolate = pr.Scalar() == "extrapolate";
+    else
+      r.problem(ProblemKind::kWrongType, pr,
+                "solver predictor: expected tangent (default) or extrapolate (start each step from the last "
+                "step's increment), found " +
+                    describe(pr));
   }
   if (n["line_search"].IsDefined())
     if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;
@@ -736,6 +786,11 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
   }
   if (const YAML::Node s = root["solver"]; s.IsDefined()) read_solver(r, s, spec.solver);
   if (const YAML::Node ts = root["tools"]; ts.IsDefined()) read_tools(r, ts, case_dir, spec);
+  if (const YAML::Node ds = root["diaphragms"]; ds.IsDefined()) {
+    const std::size_t before = problems.size();
+    read_diaphragms(r, ds, spec);
+    drop_unknown_names(problems, before, ProblemKind::kUnknownMaterial, material_names);
+  }
   if (const YAML::Node cs = root["contact"]; cs.IsDefined()) {
     const std::size_t before = problems.size();
     read_contacts(r, cs, spec);

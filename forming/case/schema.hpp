@@ -51,6 +51,7 @@
 #include "common/core/types.hpp"
 #include "forming/contact/contact_law.hpp"
 #include "forming/contact/rigid_tool.hpp"
+#include "forming/material/mooney_rivlin.hpp"
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
@@ -66,15 +67,17 @@ struct SourcePlace {
 };
 
 struct CaseMaterial {
-  enum class Kind { kNeoHookean, kTransverselyIsotropic };
+  enum class Kind { kNeoHookean, kTransverselyIsotropic, kMooneyRivlin };
   std::string name;
   Kind kind = Kind::kNeoHookean;
-  NeoHookeanParams neo_hookean;    // kNeoHookean
-  TransverselyIsotropicParams ti;  // kTransverselyIsotropic (compressible)
-  std::string given_as;            // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T"
-  double density = 0.0;            // t/mm^3 (0 = not given; gravity and dynamics need it)
-  bool incompressible = false;     // element-mean J = 1, exact (augmented Lagrangian)
-  bool inextensible = false;       // element-mean I4 = 1 (transversely isotropic only)
+  NeoHookeanParams neo_hookean;      // kNeoHookean
+  MooneyRivlinParams mooney_rivlin;  // kMooneyRivlin
+  TransverselyIsotropicParams ti;    // kTransverselyIsotropic (compressible)
+  std::string given_as;              // "E, nu", "mu, lambda", "mu_T, mu_L, kappa_f, lambda", "E_f, E_T, G_L, G_T",
+                                     // "c10, c01, nu", "c10, c01, kappa"
+  double density = 0.0;              // t/mm^3 (0 = not given; gravity and dynamics need it)
+  bool incompressible = false;       // element-mean J = 1, exact (augmented Lagrangian)
+  bool inextensible = false;         // element-mean I4 = 1 (transversely isotropic only)
   SourcePlace place;
 };
 
@@ -156,6 +159,9 @@ struct CaseSolver {
   double stop_displacement = 0.0;  // mm, arc length only: also end when max |u| reaches this
   // Load control: the process time of the load factor (t = lambda process_time, s):
   // tools move with it and friction takes its slip rates over it.
+  // predictor: extrapolate (load control): each step's first iterate starts from the
+  // last step's increment (forming/solve/static_solver.hpp StaticOptions::extrapolate).
+  bool extrapolate = false;
   double process_time = 1.0;   // s
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given
@@ -201,6 +207,18 @@ struct CaseContact {
   SourcePlace place;
 };
 
+// A double-diaphragm set-up (forming/case/diaphragm_reader.hpp): two isotropic sheets
+// "<name>.lower" and "<name>.upper" in spec.plies around laminate `laminate`, clamped in
+// a frame; their loads, conditions and contact pairs are in spec.loads, spec.boundaries
+// and spec.contacts like any other.
+struct CaseDiaphragms {
+  std::string name;
+  std::string laminate;
+  int lower = -1;  // index into spec.plies
+  int upper = -1;
+  SourcePlace place;
+};
+
 struct CaseOutput {
   int every = 1;              // write a .vtu every N steps (and always the last)
   int samples_inplane = 4;    // hexahedra per element per in-plane direction in the .vtu
@@ -217,6 +235,7 @@ struct FormingCase {
   std::vector<CaseLaminate> laminates;
   std::vector<CaseTool> tools;
   std::vector<CaseContact> contacts;
+  std::vector<CaseDiaphragms> diaphragms;
   CaseSolver solver;
   CaseOutput output;
   // Every value of the case file except `output`, flattened ("materials.carbon.E_T",

@@ -192,7 +192,7 @@ inline bool ply_of(Reader& r, const YAML::Node& b, const std::string& what, cons
   return true;
 }
 
-// The optional key "ramp" (linear or smooth) into `ramp`; false on a bad value.
+// The optional key "ramp" (linear, smooth or constant) into `ramp`; false on a bad value.
 inline bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ramp& ramp) {
   const YAML::Node rp = b["ramp"];
   if (!rp.IsDefined()) return true;
@@ -200,8 +200,10 @@ inline bool ramp_of(Reader& r, const YAML::Node& b, const std::string& what, Ram
     ramp = Ramp::kLinear;
   } else if (is_scalar(rp) && rp.Scalar() == "smooth") {
     ramp = Ramp::kSmooth;
+  } else if (is_scalar(rp) && rp.Scalar() == "constant") {
+    ramp = Ramp::kConstant;
   } else {
-    r.problem(ProblemKind::kWrongType, rp, what + " ramp: expected linear or smooth, found " + describe(rp));
+    r.problem(ProblemKind::kWrongType, rp, what + " ramp: expected linear, smooth or constant, found " + describe(rp));
     return false;
   }
   return true;

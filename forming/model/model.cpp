@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <limits>
 #include <sstream>
 #include <utility>
 
 #include "common/core/error.hpp"
+#include "forming/model/solve_profile.hpp"
 
 namespace sf::forming {
 namespace {
@@ -172,6 +174,7 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
   SF_ASSERT(!direction || direction->size() == n_dofs_, "direction must have n_dofs entries");
   SF_ASSERT(!tangent || (tangent->n_dofs() == n_dofs_ && tangent->n_elements() == static_cast<Index>(bricks_.size())),
             "pattern made for another model");
+  const auto t_start = std::chrono::steady_clock::now();
   Assembly out;
   out.force = VecX::Zero(n_dofs_);
   if (direction) out.tangent_times = VecX::Zero(n_dofs_);
@@ -276,10 +279,15 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
   for (double en : energies) out.energy += en;
   out.strain_energy = out.energy;
   out.element_force_norm = out.force.norm();
+  SolveProfile& profile = solve_profile();
+  const auto t_elements = std::chrono::steady_clock::now();
+  profile.elements_s += std::chrono::duration<double>(t_elements - t_start).count();
+  ++profile.assemblies;
   if (interactions_.empty()) return out;
   linalg::TripletAssembler stiffness(n_dofs_, n_dofs_);
-  if (!add_interactions(x, context, need_k, stiffness, out)) return out;
-  if (need_k) merge_interactions(stiffness, tangent, direction, out);
+  const bool added = add_interactions(x, context, need_k, stiffness, out);
+  if (added && need_k) merge_interactions(stiffness, tangent, direction, out);
+  profile.contact_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_elements).count();
   return out;
 }
 

@@ -3,14 +3,16 @@
 // time t / end_time of a dynamic run).
 //   kLinear  r(t) = t
 //   kSmooth  r(t) = 3 t^2 - 2 t^3   (zero rate at both ends)
+//   kConstant r(t) = 1 for t > 0, r(0) = 0 (full value from the first step on, e.g. the
+//            vacuum that holds a laminate between diaphragms before it is formed)
 // t is clamped to [0, 1]; r(0) = 0, r(1) = 1.
 #include <string>
 
 namespace sf::forming {
 
-enum class Ramp { kLinear, kSmooth };
+enum class Ramp { kLinear, kSmooth, kConstant };
 
-// "linear", "smooth" (the case-file names).
+// "linear", "smooth", "constant" (the case-file names).
 std::string to_string(Ramp ramp);
 double ramp_value(Ramp ramp, double t);
 // dr/dt (0 outside [0, 1]; the linear ramp's rate is 1 on the whole closed interval).

@@ -44,6 +44,13 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
       mj["law"] = "neo_hookean";
       mj["mu"] = m.neo_hookean.mu;
       mj["lambda"] = m.neo_hookean.lambda;
+    } else if (m.kind == CaseMaterial::Kind::kMooneyRivlin) {
+      const MooneyRivlinParams& q = m.mooney_rivlin;
+      mj["law"] = "mooney_rivlin (compressible)";
+      mj["c10"] = q.c10;
+      mj["c01"] = q.c01;
+      mj["lambda"] = q.lambda;
+      mj["small_strain"] = {{"E", q.young_modulus()}, {"nu", q.poisson_ratio()}, {"mu", q.shear_modulus()}};
     } else {
       const TransverselyIsotropicModuli mod = small_strain_moduli(m.ti);
       mj["law"] = "transversely_isotropic (compressible)";

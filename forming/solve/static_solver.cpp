@@ -1,6 +1,8 @@
 #include "forming/solve/static_solver.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -271,10 +273,16 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
     rnorm = free_.restrict(st.residual).norm();
     scale = st.scale;
   }
+  // SF_NEWTON_TRACE=1 in the environment: one line per Newton iteration on stderr (the
+  // residual, its tolerance and the line-search step), to see how a step converges.
+  static const bool trace = std::getenv("SF_NEWTON_TRACE") != nullptr;
   for (;;) {
     rec.residual_norms.push_back(rnorm);
     if (first_norm < 0.0) first_norm = rnorm;
     const double tol = std::max(options_.residual_tol_abs, options_.residual_tol_rel * scale);
+    if (trace)
+      std::fprintf(stderr, "newton: lambda %.6g iteration %d |r| %.3e tol %.3e step %.3g\n", lam_new, rec.iterations,
+                   rnorm, tol, rec.step_lengths.empty() ? 1.0 : rec.step_lengths.back());
     if (rnorm <= tol) {
       rec.converged = true;
       force_scale = scale;
@@ -429,6 +437,12 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   if (options.workspace && options.workspace->next_increment > 0.0)
     increment = std::clamp(options.workspace->next_increment, options.min_increment, increment);
   int attempts = 0;
+  // StaticOptions::extrapolate: the first predictor starts from the previous increment.
+  const double span = options.clock.end - options.clock.start;
+  VecX extrapolated;
+  if (options.extrapolate && options.workspace && options.workspace->last_increment.size() == n &&
+      options.workspace->last_span > 0.0 && span > 0.0)
+    extrapolated = (span / options.workspace->last_span) * options.workspace->last_increment;
   while (lambda < 1.0) {
     if (attempts >= options.max_steps) {
       report.status = SolveStatus::kStepFailed;
@@ -443,7 +457,15 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     rec.increment = lam_new - lambda;
     VecX xt;
     std::string why;
-    const LoadStepping::Predicted predicted = steps.predict(lam_new, x, xt, rec, why);
+    // The first attempt from the extrapolated state when it is admissible.
+    VecX guess;
+    if (attempts == 1 && extrapolated.size() == n) {
+      guess = x + lam_new * extrapolated;
+      if (!model.assemble(guess, false).ok) guess.resize(0);
+    }
+    LoadStepping::Predicted predicted = steps.predict(lam_new, guess.size() == n ? guess : x, xt, rec, why);
+    if (guess.size() == n && predicted == LoadStepping::Predicted::kInadmissible)
+      predicted = steps.predict(lam_new, x, xt, rec, why);
     if (predicted == LoadStepping::Predicted::kInadmissible) return invalid(why);
     if (predicted == LoadStepping::Predicted::kOk) steps.correct(lam_new, xt, rec, report.force_scale);
     if (rec.converged) {
@@ -466,6 +488,10 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     }
   }
   if (options.workspace) options.workspace->next_increment = increment;
+  if (options.workspace && options.extrapolate && lambda >= 1.0) {
+    options.workspace->last_increment = x - x_start;
+    options.workspace->last_span = span;
+  }
   if (lambda >= 1.0) {
     report.status = SolveStatus::kConverged;
     report.message.clear();

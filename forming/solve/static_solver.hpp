@@ -63,12 +63,17 @@ struct ProcessClock {
 };
 
 struct StaticOptions {
-  double initial_increment = 1.0;   // first load-factor increment, (0, 1]
-  double max_increment = 1.0;       // cap after regrowth, (0, 1]
-  double min_increment = 1e-6;      // cut back below this -> kStepFailed
-  double growth = 1.5;              // increment growth after an easy step, >= 1
-  int easy_iterations = 5;          // ... i.e. one converging in at most this many iterations
-  int max_iterations = 25;          // Newton iterations per step (predictor included)
+  double initial_increment = 1.0;  // first load-factor increment, (0, 1]
+  double max_increment = 1.0;      // cap after regrowth, (0, 1]
+  double min_increment = 1e-6;     // cut back below this -> kStepFailed
+  double growth = 1.5;             // increment growth after an easy step, >= 1
+  int easy_iterations = 5;         // ... i.e. one converging in at most this many iterations
+  int max_iterations = 25;         // Newton iterations per step (predictor included)
+  // Start each solve's first predictor from the start state moved by the previous
+  // solve's increment, scaled to this solve's process-time span (kept in the workspace):
+  // a tool that keeps moving then meets plies that already moved with it, instead of
+  // the whole stroke as penetration. Off: the predictor starts at the start state.
+  bool extrapolate = false;
   int max_steps = 1000;             // attempted steps in total (converged + cut back)
   double residual_tol_rel = 1e-10;  // relative to force_scale
   double residual_tol_abs = 0.0;    // N

@@ -4,6 +4,7 @@
 
 #include "common/core/error.hpp"
 #include "forming/model/model.hpp"
+#include "forming/model/solve_profile.hpp"
 
 namespace sf::forming {
 
@@ -25,6 +26,14 @@ TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric) {
 }
 
 const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& k) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SolveProfile& profile = solve_profile();
+  ++profile.factorizations;
+  struct AddTime {
+    std::chrono::steady_clock::time_point t0;
+    double& to;
+    ~AddTime() { to += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
+  } timer{t0, profile.factorize_s};
   if (spd_ && skip_cholesky_ > 0) {
     --skip_cholesky_;
   } else if (spd_) {
@@ -43,7 +52,12 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
 
 Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
   SF_ASSERT(active_ != nullptr, "TangentSolver::solve() needs a successful factorize()");
-  return active_->solve(b);
+  const auto t0 = std::chrono::steady_clock::now();
+  Eigen::MatrixXd x = active_->solve(b);
+  SolveProfile& profile = solve_profile();
+  ++profile.solves;
+  profile.solve_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return x;
 }
 
 FreeDofs::FreeDofs(const std::vector<bool>& free) : is_free(free) {

@@ -78,6 +78,10 @@ class TangentWorkspace {
   // The load-factor increment (fraction of a solve's load) the last static solve would
   // have taken next; the next solve of the run starts with it (0: none yet).
   double next_increment = 0.0;
+  // The increment of positions the last static solve made and its process-time span
+  // (StaticOptions::extrapolate); empty: none yet.
+  VecX last_increment;
+  double last_span = 0.0;
   // How many times prepare() laid the pattern out (1 for a run whose structure stays).
   int layouts() const { return layouts_; }
   // Seconds spent laying patterns out, in total.

@@ -1,0 +1,391 @@
+#include "forming/case/diaphragm_reader.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "forming/case/contact_reader.hpp"
+
+namespace sf::forming {
+
+using case_yaml::describe;
+using case_yaml::pair_of;
+using case_yaml::place_of;
+using case_yaml::Reader;
+
+namespace {
+
+// Slack (mm, relative to the frame size) when checking that the frame holds the laminate.
+constexpr double kFrameSlack = 1e-9;
+
+std::optional<PlySide> side_of(const std::string& s) {
+  if (s == "x0") return PlySide::kX0;
+  if (s == "x1") return PlySide::kX1;
+  if (s == "y0") return PlySide::kY0;
+  if (s == "y1") return PlySide::kY1;
+  return std::nullopt;
+}
+
+// The pressure mapping {value, face?, ramp?} of `key`; false on a problem.
+bool read_pressure_entry(Reader& r, const YAML::Node& p, const std::string& what, bool with_face, CaseLoad& load) {
+  std::vector<std::string> keys = {"value", "ramp"};
+  if (with_face) keys.push_back("face");
+  if (!r.mapping(p, what, keys)) return false;
+  bool ok = true;
+  if (const YAML::Node v = r.required(p, "value", what); v.IsDefined()) {
+    if (const auto x = r.positive(v, what + " value", "MPa"))
+      load.value = *x;
+    else
+      ok = false;
+  } else
+    ok = false;
+  if (with_face && p["face"].IsDefined()) {
+    const YAML::Node f = p["face"];
+    if (case_yaml::is_scalar(f) && (f.Scalar() == "top" || f.Scalar() == "bottom"))
+      load.top = f.Scalar() == "top";
+    else {
+      r.problem(ProblemKind::kWrongType, f,
+                what +
+                    " face: expected top (on the upper diaphragm, pushing down) or bottom (on the lower "
+                    "diaphragm, pushing up), found " +
+                    describe(f));
+      ok = false;
+    }
+  }
+  if (!case_yaml::ramp_of(r, p, what, load.ramp)) ok = false;
+  load.kind = CaseLoad::Kind::kPressure;
+  load.follower = true;
+  load.place = place_of(p);
+  return ok;
+}
+
+}  // namespace
+
+void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
+  std::string what = "diaphragms";
+  if (!r.mapping(n, what,
+                 {"name", "laminate", "frame", "elements", "thickness", "material", "symmetry", "pressure", "vacuum",
+                  "contact", "tools"}))
+    return;
+  bool ok = true;
+  CaseDiaphragms d;
+  d.place = place_of(n);
+  if (const auto name = r.text(r.required(n, "name", what), what + " name")) {
+    d.name = *name;
+    what = "diaphragms '" + d.name + "'";
+  } else
+    ok = false;
+  // The laminate.
+  const CaseLaminate* lam = nullptr;
+  if (const YAML::Node l = r.required(n, "laminate", what); l.IsDefined()) {
+    if (const auto t = r.text(l, what + " laminate")) {
+      const auto it = std::find_if(spec.laminates.begin(), spec.laminates.end(),
+                                   [&](const CaseLaminate& c) { return c.name == *t; });
+      if (it == spec.laminates.end()) {
+        r.problem(ProblemKind::kUnknownPly, l,
+                  what + " laminate: unknown laminate '" + *t + "' (not defined under laminates)");
+        ok = false;
+      } else
+        lam = &*it;
+    } else
+      ok = false;
+  } else
+    ok = false;
+  // Geometry of the sheets.
+  CasePly sheet;
+  if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined() && pair_of(r, e, what + " elements")) {
+    const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
+    const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
+    if (a && b) {
+      sheet.n1 = *a;
+      sheet.n2 = *b;
+    } else
+      ok = false;
+  } else
+    ok = false;
+  if (const YAML::Node t = r.required(n, "thickness", what); t.IsDefined()) {
+    if (const auto h = r.positive(t, what + " thickness", "mm"))
+      sheet.thickness = *h;
+    else
+      ok = false;
+  } else
+    ok = false;
+  if (const YAML::Node m = r.required(n, "material", what); m.IsDefined()) {
+    if (const auto t = r.text(m, what + " material")) {
+      sheet.material = *t;
+      const int index = [&] {
+        for (std::size_t i = 0; i < spec.materials.size(); ++i)
+          if (spec.materials[i].name == *t) return static_cast<int>(i);
+        return -1;
+      }();
+      sheet.material_index = index;
+      if (index < 0) {
+        r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + *t + "'", *t);
+        ok = false;
+      } else if (spec.materials[static_cast<std::size_t>(index)].kind == CaseMaterial::Kind::kTransverselyIsotropic) {
+        r.problem(ProblemKind::kOutOfRange, m,
+                  what +
+                      " material: a diaphragm is an isotropic rubber sheet; expected a neo_hookean or "
+                      "mooney_rivlin material, found '" +
+                      *t + "' (transversely_isotropic)");
+        ok = false;
+      }
+    } else
+      ok = false;
+  } else
+    ok = false;
+  // Frame.
+  double fx0 = 0.0, fy0 = 0.0, flx = 0.0, fly = 0.0;
+  bool origin_given = false;
+  const YAML::Node frame = r.required(n, "frame", what);
+  if (frame.IsDefined() && r.mapping(frame, what + " frame", {"origin", "size"})) {
+    if (const YAML::Node s = r.required(frame, "size", what + " frame");
+        s.IsDefined() && pair_of(r, s, what + " frame size")) {
+      const auto a = r.positive(s[0], what + " frame size Lx", "mm");
+      const auto b = r.positive(s[1], what + " frame size Ly", "mm");
+      if (a && b) {
+        flx = *a;
+        fly = *b;
+      } else
+        ok = false;
+    } else
+      ok = false;
+    if (const YAML::Node o = frame["origin"]; o.IsDefined()) {
+      if (pair_of(r, o, what + " frame origin")) {
+        const auto a = r.number(o[0], what + " frame origin x");
+        const auto b = r.number(o[1], what + " frame origin y");
+        if (a && b) {
+          fx0 = *a;
+          fy0 = *b;
+          origin_given = true;
+        } else
+          ok = false;
+      } else
+        ok = false;
+    }
+  } else
+    ok = false;
+  // Symmetry edges.
+  std::vector<PlySide> symmetric;
+  if (const YAML::Node s = n["symmetry"]; s.IsDefined()) {
+    if (!case_yaml::is_sequence(s)) {
+      r.problem(
+          ProblemKind::kWrongType, s,
+          what + " symmetry: expected a list of frame edges on symmetry planes, e.g. [x0, y0], found " + describe(s));
+      ok = false;
+    } else {
+      for (const YAML::Node& e : s) {
+        const auto side = case_yaml::is_scalar(e) ? side_of(e.Scalar()) : std::nullopt;
+        if (!side) {
+          r.problem(ProblemKind::kWrongType, e, what + " symmetry: expected x0, x1, y0 or y1, found " + describe(e));
+          ok = false;
+        } else
+          symmetric.push_back(*side);
+      }
+    }
+  }
+  // Loads.
+  CaseLoad forming;
+  bool has_forming = false;
+  if (const YAML::Node p = n["pressure"]; p.IsDefined()) {
+    has_forming = read_pressure_entry(r, p, what + " pressure", true, forming);
+    ok = has_forming && ok;
+  }
+  CaseLoad vacuum;
+  vacuum.ramp = Ramp::kLinear;  // constant: the first step must carry it all (cut-backs cannot reduce it)
+  bool has_vacuum = false;
+  if (const YAML::Node v = n["vacuum"]; v.IsDefined()) {
+    if (case_yaml::is_map(v) && v["pressure"].IsDefined()) {
+      const YAML::Node p = v["pressure"];
+      // vacuum: {pressure: 0.09, ramp: constant}
+      if (r.mapping(v, what + " vacuum", {"pressure", "ramp"})) {
+        if (const auto x = r.positive(p, what + " vacuum pressure", "MPa, the atmosphere over the vacuum")) {
+          vacuum.value = *x;
+          has_vacuum = case_yaml::ramp_of(r, v, what + " vacuum", vacuum.ramp);
+        }
+      }
+      vacuum.kind = CaseLoad::Kind::kPressure;
+      vacuum.follower = true;
+      vacuum.place = place_of(v);
+    } else {
+      r.problem(
+          ProblemKind::kWrongType, v,
+          what + " vacuum: expected {pressure: MPa (e.g. 0.09), ramp: constant|linear|smooth}, found " + describe(v));
+    }
+    ok = has_vacuum && ok;
+  }
+  if (!has_forming && !n["pressure"].IsDefined() && !n["tools"].IsDefined()) {
+    r.problem(ProblemKind::kMissing, n, what + ": nothing forms the diaphragms: give pressure or tools");
+    ok = false;
+  }
+  // Contact laws.
+  CaseContactLaw grip;
+  if (const YAML::Node c = r.required(n, "contact", what); c.IsDefined()) {
+    if (r.mapping(c, what + " contact", contact_law_keys()))
+      ok = read_contact_law(r, c, what + " contact", grip) && ok;
+    else
+      ok = false;
+  } else
+    ok = false;
+  struct ToolPair {
+    int tool = -1;
+    bool top = false;
+    CaseContactLaw law;
+    std::string name;
+    SourcePlace place;
+  };
+  std::vector<ToolPair> tool_pairs;
+  if (const YAML::Node ts = n["tools"]; ts.IsDefined()) {
+    if (!case_yaml::is_sequence(ts) || ts.size() == 0) {
+      r.problem(
+          ProblemKind::kWrongType, ts,
+          what + " tools: expected a list ({tool: NAME, stiffness: N/mm^3, face: bottom|top}), found " + describe(ts));
+      ok = false;
+    } else {
+      for (std::size_t i = 0; i < ts.size(); ++i) {
+        const std::string tw = what + " tools " + std::to_string(i + 1);
+        std::vector<std::string> keys = {"tool", "face"};
+        for (const std::string& k : contact_law_keys())
+          if (k != "two_pass") keys.push_back(k);
+        if (!r.mapping(ts[i], tw, keys)) {
+          ok = false;
+          continue;
+        }
+        ToolPair tp;
+        tp.place = place_of(ts[i]);
+        if (const auto t = r.text(r.required(ts[i], "tool", tw), tw + " tool")) {
+          tp.name = *t;
+          for (std::size_t k = 0; k < spec.tools.size(); ++k)
+            if (spec.tools[k].name == *t) tp.tool = static_cast<int>(k);
+          if (tp.tool < 0) {
+            r.problem(ProblemKind::kUnknownTool, ts[i]["tool"],
+                      tw + ": unknown tool '" + *t + "' (not defined under tools)", *t);
+            ok = false;
+          }
+        } else
+          ok = false;
+        if (const YAML::Node f = ts[i]["face"]; f.IsDefined()) {
+          if (case_yaml::is_scalar(f) && (f.Scalar() == "top" || f.Scalar() == "bottom"))
+            tp.top = f.Scalar() == "top";
+          else {
+            r.problem(ProblemKind::kWrongType, f,
+                      tw + " face: expected bottom (the lower diaphragm) or top (the upper one), found " + describe(f));
+            ok = false;
+          }
+        }
+        ok = read_contact_law(r, ts[i], tw, tp.law) && ok;
+        tool_pairs.push_back(tp);
+      }
+    }
+  }
+  if (!ok || lam == nullptr) return;
+
+  // The laminate's plies and extent.
+  const std::size_t first = static_cast<std::size_t>(lam->first_ply);
+  const std::size_t last = first + lam->angles.size() - 1;
+  const CasePly& bottom = spec.plies[first];
+  const CasePly& top = spec.plies[last];
+  const double lam_top = top.origin.z() + top.thickness;
+  if (!origin_given) {
+    fx0 = bottom.origin.x() + 0.5 * (bottom.length_x - flx);
+    fy0 = bottom.origin.y() + 0.5 * (bottom.length_y - fly);
+  }
+  const double slack = kFrameSlack * std::max(flx, fly);
+  if (bottom.origin.x() < fx0 - slack || bottom.origin.y() < fy0 - slack ||
+      bottom.origin.x() + bottom.length_x > fx0 + flx + slack ||
+      bottom.origin.y() + bottom.length_y > fy0 + fly + slack) {
+    r.problem(ProblemKind::kOutOfRange, frame,
+              what + " frame: the laminate '" + lam->name + "' must lie inside the frame (x " + std::to_string(fx0) +
+                  " .. " + std::to_string(fx0 + flx) + ", y " + std::to_string(fy0) + " .. " +
+                  std::to_string(fy0 + fly) + " mm)");
+    return;
+  }
+  sheet.plane_strain = bottom.plane_strain;
+  if (sheet.plane_strain && sheet.n2 != 1) {
+    r.problem(ProblemKind::kOutOfRange, n["elements"],
+              what + " elements: the laminate is plane strain; mesh the width with one element ([n, 1])");
+    return;
+  }
+  for (const std::string& suffix : {std::string("lower"), std::string("upper")}) {
+    if (spec.find_ply(d.name + "." + suffix) >= 0) {
+      r.problem(ProblemKind::kDuplicate, n["name"],
+                what + ": ply name '" + d.name + "." + suffix + "' used by an earlier ply");
+      return;
+    }
+  }
+  sheet.length_x = flx;
+  sheet.length_y = fly;
+  sheet.angle_deg = 0.0;
+  sheet.place = d.place;
+  CasePly lower = sheet, upper = sheet;
+  lower.name = d.name + ".lower";
+  lower.origin = Vec3(fx0, fy0, bottom.origin.z() - sheet.thickness);
+  upper.name = d.name + ".upper";
+  upper.origin = Vec3(fx0, fy0, lam_top);
+  d.lower = static_cast<int>(spec.plies.size());
+  spec.plies.push_back(lower);
+  d.upper = static_cast<int>(spec.plies.size());
+  spec.plies.push_back(upper);
+  d.laminate = lam->name;
+
+  // The frame: clamps, or symmetry on the listed edges.
+  std::vector<PlySide> sides = {PlySide::kX0, PlySide::kX1};
+  if (!sheet.plane_strain) sides.insert(sides.end(), {PlySide::kY0, PlySide::kY1});
+  for (const int ply : {d.lower, d.upper}) {
+    for (const PlySide side : sides) {
+      CaseBoundary bc;
+      bc.kind = std::find(symmetric.begin(), symmetric.end(), side) != symmetric.end() ? CaseBoundary::Kind::kSymmetry
+                                                                                       : CaseBoundary::Kind::kClamp;
+      bc.ply = spec.plies[static_cast<std::size_t>(ply)].name;
+      bc.ply_index = ply;
+      bc.side = side;
+      bc.place = frame.IsDefined() ? place_of(frame) : d.place;
+      spec.boundaries.push_back(bc);
+    }
+  }
+  // Loads: forming pressure on one outer face, vacuum on both.
+  if (has_forming) {
+    forming.ply_index = forming.top ? d.upper : d.lower;
+    forming.ply = spec.plies[static_cast<std::size_t>(forming.ply_index)].name;
+    spec.loads.push_back(forming);
+  }
+  if (has_vacuum) {
+    for (const bool on_top : {true, false}) {
+      CaseLoad v = vacuum;
+      v.top = on_top;
+      v.ply_index = on_top ? d.upper : d.lower;
+      v.ply = spec.plies[static_cast<std::size_t>(v.ply_index)].name;
+      spec.loads.push_back(v);
+    }
+  }
+  // Contact: the laminate's outer plies (slave) on the diaphragms, the upper diaphragm on
+  // the lower one outside the laminate, and the diaphragms on the tools.
+  const auto add = [&](int ply, bool ply_top, int with, bool with_top, const CaseContactLaw& law, SourcePlace at) {
+    CaseContact c;
+    c.ply = ply;
+    c.top = ply_top;
+    c.with = with;
+    c.with_top = with_top;
+    c.law = law;
+    c.label = spec.plies[static_cast<std::size_t>(ply)].name + "/" + spec.plies[static_cast<std::size_t>(with)].name;
+    c.place = at;
+    spec.contacts.push_back(c);
+  };
+  const SourcePlace grip_at = place_of(n["contact"]);
+  add(static_cast<int>(first), false, d.lower, true, grip, grip_at);
+  add(static_cast<int>(last), true, d.upper, false, grip, grip_at);
+  add(d.upper, false, d.lower, true, grip, grip_at);
+  for (const ToolPair& tp : tool_pairs) {
+    CaseContact c;
+    c.ply = tp.top ? d.upper : d.lower;
+    c.top = tp.top;
+    c.tool = tp.tool;
+    c.law = tp.law;
+    c.label = spec.plies[static_cast<std::size_t>(c.ply)].name + "/" + tp.name;
+    c.place = tp.place;
+    spec.contacts.push_back(c);
+  }
+  spec.diaphragms.push_back(d);
+}
+
+}  // namespace sf::forming

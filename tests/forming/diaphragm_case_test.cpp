@@ -1,0 +1,184 @@
+// Double-diaphragm set-ups in case files (forming/case/diaphragm_reader.hpp) and the
+// Mooney-Rivlin law in a case:
+//  * `diaphragms:` becomes two isotropic plies around the laminate (the lower one's top
+//    face at the laminate's bottom, the upper one's bottom face at its top), clamps (or
+//    symmetry) on the frame edges, the forming pressure on one outer face and the vacuum
+//    on both, and contact pairs laminate/diaphragm, upper/lower diaphragm and
+//    diaphragm/tool;
+//  * bad diaphragm input is reported with its line and column (unknown key, unknown
+//    laminate, tool or material, an anisotropic diaphragm, a frame that does not hold the
+//    laminate, a bad symmetry edge or face, a vacuum without its pressure);
+//  * a coarse plane-strain double-diaphragm bend runs: the pack sinks into the die slot
+//    under the forming pressure, the diaphragms stay clamped at the frame and the plies
+//    do not pass through one another or through the diaphragms.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "common/io/vtk_xml.hpp"
+#include "forming/case/build.hpp"
+#include "forming/case/reader.hpp"
+#include "tests/forming/fixtures.hpp"
+
+namespace sf::forming {
+namespace {
+
+// Largest penetration accepted in the run below, mm: the penalty's own p / S_n with
+// p up to ~0.5 MPa and S_n = 50 N/mm^3 is 0.01 mm; twice that.
+constexpr double kPenetrationTol = 0.02;
+
+const char* kBend = R"(units: "mm, N, MPa, s"
+materials:
+  ply_law: {neo_hookean: {E: 200, nu: 0.3}}
+  rubber: {mooney_rivlin: {c10: 0.3, c01: 0.05, nu: 0.45}}
+laminates:
+  - name: lam
+    origin: [0, 0, 1]
+    size: [20, 5]
+    elements: [6, 1]
+    layup: "[0_2]"
+    ply_thickness: 0.5
+    material: ply_law
+    plane_strain: true
+    interface: {stiffness: 50, viscous: 0.02, band: 0.01}
+tools:
+  - name: die
+    die: {centre: [0, 0, 0], normal: [0, 0, 1], slot_half_width: 10, along: [0, 1, 0], edge_radius: 3}
+    motion: {fixed: true}
+diaphragms:
+  name: dd
+  laminate: lam
+  frame: {origin: [0, 0], size: [30, 5]}
+  elements: [10, 1]
+  thickness: 1
+  material: rubber
+  symmetry: [x0]
+  pressure: {value: 0.02, face: top, ramp: linear}
+  vacuum: {pressure: 0.02, ramp: linear}
+  contact: {stiffness: 50, viscous: 0.05, band: 0.01}
+  tools: [{tool: die, stiffness: 50, band: 0.01}]
+boundary_conditions:
+  - symmetry: {ply: lam.1, plane: x0}
+  - symmetry: {ply: lam.2, plane: x0}
+solver: {steps: 3, process_time: 0.1, max_iterations: 40, tolerance: 1.0e-6}
+)";
+
+TEST(DiaphragmCase, BuildsTwoSheetsTheirFrameLoadsAndContacts) {
+  const CaseCheck c = check_case_text(kBend, "bend.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  ASSERT_EQ(c.spec.plies.size(), 4u);
+  const CasePly& lower = c.spec.plies[2];
+  const CasePly& upper = c.spec.plies[3];
+  EXPECT_EQ(lower.name, "dd.lower");
+  EXPECT_EQ(upper.name, "dd.upper");
+  EXPECT_DOUBLE_EQ(lower.origin.z(), 0.0);  // top face at the laminate's bottom (z = 1)
+  EXPECT_DOUBLE_EQ(upper.origin.z(), 2.0);  // bottom face at the laminate's top
+  EXPECT_DOUBLE_EQ(lower.length_x, 30.0);
+  EXPECT_TRUE(lower.plane_strain);
+  EXPECT_EQ(c.spec.materials[1].kind, CaseMaterial::Kind::kMooneyRivlin);
+  // Frame: x0 on the symmetry plane, x1 clamped (plane strain: no y edges), both sheets.
+  int clamps = 0, symmetries = 0;
+  for (const CaseBoundary& b : c.spec.boundaries) {
+    if (b.ply_index < 2) continue;
+    (b.kind == CaseBoundary::Kind::kClamp ? clamps : symmetries) += 1;
+    EXPECT_EQ(b.side, b.kind == CaseBoundary::Kind::kClamp ? PlySide::kX1 : PlySide::kX0);
+  }
+  EXPECT_EQ(clamps, 2);
+  EXPECT_EQ(symmetries, 2);
+  // Loads: forming pressure on the upper top, vacuum on both outer faces.
+  ASSERT_EQ(c.spec.loads.size(), 3u);
+  EXPECT_EQ(c.spec.loads[0].ply, "dd.upper");
+  EXPECT_TRUE(c.spec.loads[0].top);
+  EXPECT_DOUBLE_EQ(c.spec.loads[0].value, 0.02);
+  EXPECT_EQ(c.spec.loads[1].ramp, Ramp::kLinear);
+  EXPECT_EQ(c.spec.loads[2].ply, "dd.lower");
+  EXPECT_FALSE(c.spec.loads[2].top);
+  // Contacts: the laminate's interface, lam.1/lower, lam.2/upper, upper/lower, lower/die.
+  ASSERT_EQ(c.spec.contacts.size(), 5u);
+  EXPECT_EQ(c.spec.contacts[1].label, "lam.1/dd.lower");
+  EXPECT_EQ(c.spec.contacts[2].label, "lam.2/dd.upper");
+  EXPECT_EQ(c.spec.contacts[3].label, "dd.upper/dd.lower");
+  EXPECT_EQ(c.spec.contacts[4].label, "dd.lower/die");
+  EXPECT_DOUBLE_EQ(c.spec.contacts[1].law.friction.viscous, 0.05);
+  const Problem problem = build_problem(c.spec);
+  EXPECT_EQ(problem.model.n_bodies(), 4);
+  EXPECT_EQ(problem.model.n_interactions(), 5);
+}
+
+// The one problem of kBend with `from` replaced by `to`.
+CaseProblem only_problem(const std::string& from, const std::string& to) {
+  std::string text = kBend;
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  const CaseCheck c = check_case_text(text, "bad.yaml");
+  EXPECT_EQ(c.problems.size(), 1u) << (c.problems.empty() ? "no problem" : c.located(0) + " ...");
+  return c.problems.empty() ? CaseProblem{} : c.problems[0];
+}
+
+TEST(DiaphragmCase, BadInputIsReportedWithItsPlace) {
+  struct Bad {
+    const char* from;
+    const char* to;
+    int line;
+    const char* words;
+  };
+  const Bad bad[] = {
+      {"  symmetry: [x0]\n", "  symetry: [x0]\n", 26, "symetry"},
+      {"  laminate: lam\n", "  laminate: lum\n", 21, "unknown laminate 'lum'"},
+      {"material: rubber", "material: ply_law2", 25, "unknown material 'ply_law2'"},
+      {"{tool: die, stiffness", "{tool: dye, stiffness", 30, "unknown tool 'dye'"},
+      {"size: [30, 5]}", "size: [15, 5]}", 22, "inside the frame"},
+      {"symmetry: [x0]", "symmetry: [z0]", 26, "expected x0, x1, y0 or y1"},
+      {"face: top, ramp", "face: side, ramp", 27, "expected top"},
+      {"vacuum: {pressure: 0.02, ramp: linear}", "vacuum: 0.02", 28, "vacuum"},
+      {"contact: {stiffness: 50, viscous", "contact: {stiffness: -5, viscous", 29, "stiffness"},
+      {"rubber: {mooney_rivlin: {c10: 0.3, c01: 0.05, nu: 0.45}}",
+       "rubber: {mooney_rivlin: {c10: 0.3, c01: -1, nu: 0.45}}", 4, "c01"},
+      {"rubber: {mooney_rivlin: {c10: 0.3, c01: 0.05, nu: 0.45}}", "rubber: {mooney_rivlin: {c10: 0.3, c01: 0.05}}", 4,
+       "either nu or kappa"},
+  };
+  for (const Bad& b : bad) {
+    const CaseProblem p = only_problem(b.from, b.to);
+    EXPECT_EQ(p.place.line, b.line) << b.to << ": " << p.message;
+    EXPECT_GT(p.place.column, 0) << b.to;
+    EXPECT_NE(p.message.find(b.words), std::string::npos) << b.to << ": " << p.message;
+  }
+  // An anisotropic diaphragm.
+  std::string text = kBend;
+  text.replace(text.find("material: rubber"), 16, "material: fibre");
+  text.replace(text.find("  rubber:"), 9,
+               "  fibre: {transversely_isotropic: {E_f: 100, E_T: 1, G_L: 0.5, G_T: 0.4}}\n  rubber:");
+  const CaseCheck c = check_case_text(text, "aniso.yaml");
+  ASSERT_EQ(c.problems.size(), 1u) << c.located(0);
+  EXPECT_NE(c.problems[0].message.find("isotropic"), std::string::npos) << c.problems[0].message;
+}
+
+TEST(DiaphragmCase, CoarseBendSinksIntoTheDieWithoutPenetration) {
+  const CaseCheck c = check_case_text(kBend, "bend.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sf_diaphragm_case_test";
+  const fixtures::RunOutput out = fixtures::run_into(c.spec, dir);
+  ASSERT_TRUE(out.report.ok()) << out.report.message;
+  // The pack sinks into the slot (x < 10): the largest displacement is downwards.
+  EXPECT_LT(out.report.max_displacement.z(), -0.5);
+  // Ply frame of the last step: every point of the laminate plies above the lower
+  // diaphragm's points at about the same x (no ply went through the sheet below it).
+  const io::VolumeMesh contact = io::read_vtu((dir / "steps/contact_0003.vtu").string());
+  const io::FieldArray* gap = nullptr;
+  for (const io::FieldArray& f : contact.point_data)
+    if (f.name == "gap") gap = &f;
+  ASSERT_NE(gap, nullptr);
+  double min_gap = 1e30;
+  for (double g : gap->values)
+    if (std::isfinite(g)) min_gap = std::min(min_gap, g);
+  std::printf("[ measured ] largest penetration of the coarse diaphragm bend: %.3e mm\n", -min_gap);
+  EXPECT_GT(min_gap, -kPenetrationTol);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sf::forming

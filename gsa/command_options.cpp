@@ -74,6 +74,12 @@ void validate_for_the_command_line(const Options& options) {
   }
 }
 
+std::string number_text(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
 }  // namespace
 
 void check_units_text(const std::string& units) {
@@ -100,6 +106,9 @@ std::string flag_of_field(const std::string& field) {
       {"fibre_angles", "--fibres"},
       {"sample", "--sample"},
       {"units", "--units"},
+      {"necking_margin", "--necking-margin"},
+      {"thinning_limit_pct", "--thinning-limit"},
+      {"min_stretch", "--min-stretch"},
   };
   const auto it = flags.find(field);
   return it == flags.end() ? field : it->second;
@@ -132,7 +141,47 @@ OutputOptions output_options(const AnalyseFlags& a) {
   o.units = a.units;
   o.sample = a.sample;
   o.measure = parse_measure(a.measure, "--measure");
+  if (a.thickness) {
+    if (!std::isfinite(*a.thickness) || !(*a.thickness > 0))
+      throw UsageError("--thickness: expected the initial sheet thickness in " + a.units + " (> 0), found " +
+                       number_text(*a.thickness));
+    o.mid.thickness = *a.thickness;
+  }
+  o.mid.face = parse_grid_face(a.grid_face, "--grid-face");
+  const int curves = (a.flc.empty() ? 0 : 1) + (a.flc_n ? 1 : 0) + (a.flc0 ? 1 : 0);
+  if (curves > 1) throw UsageError("--flc, --flc-n and --flc0 each give a forming limit curve: give one of them");
   if (!a.flc.empty()) o.flc = read_flc(a.flc);
+  if (a.flc_n) {
+    if (!a.thickness)
+      throw UsageError("--flc-n: the Keeler-Brazier curve needs the sheet thickness: add --thickness T (mm)");
+    const double flc0 = keeler_brazier_flc0(*a.thickness, *a.flc_n, "--flc-n", "--thickness");
+    o.flc_description = "Keeler-Brazier, t = " + number_text(*a.thickness) + " mm, n = " + number_text(*a.flc_n) +
+                        ": FLC0 = " + number_text(flc0) + " (engineering), standard shape";
+    o.flc = standard_shape_flc(flc0, o.measure, o.flc_description);
+  }
+  if (a.flc0) {
+    if (!std::isfinite(*a.flc0) || !(*a.flc0 > 0))
+      throw UsageError(
+          "--flc0: expected the plane-strain forming limit, a major strain > 0 in the --measure strain, "
+          "found " +
+          number_text(*a.flc0));
+    // Given in the measure of the analysis; the shape is tabulated in engineering strain.
+    const double eng = (o.measure == StrainMeasure::kTrue          ? std::exp(*a.flc0)
+                        : o.measure == StrainMeasure::kEngineering ? 1.0 + *a.flc0
+                                                                   : std::sqrt(1.0 + 2.0 * *a.flc0)) -
+                       1.0;
+    o.flc_description = "FLC0 = " + number_text(*a.flc0) + " (" + measure_word(o.measure) + "), standard shape";
+    o.flc = standard_shape_flc(eng, o.measure, o.flc_description);
+  }
+  o.zones.necking_margin = a.necking_margin;
+  o.zones.thinning_limit_pct = a.thinning_limit;
+  o.zones.min_stretch = a.min_stretch;
+  validate_for_the_command_line(o.zones);
+  for (std::size_t k = 0; k < a.sections.size(); ++k)
+    o.sections.push_back(parse_section(a.sections[k], "--section " + std::to_string(k + 1)));
+  o.neck = a.neck;
+  if (a.neck && a.sections.empty())
+    throw UsageError("--neck: evaluates a neck along a section: give one or more --section");
   validate_for_the_command_line(o);
   return o;
 }

@@ -39,6 +39,15 @@ struct AnalyseFlags {
   std::vector<std::string> stages;
   std::string stage_column, reference_stage, path_ids, stage_smoothing = "once";
   int strain_paths = 5;
+  // Press-shop outputs (docs/usage.md): mid-surface strains, forming-limit assessment,
+  // sections. Empty optionals: not given.
+  std::optional<double> thickness;  // --thickness, initial sheet thickness (length unit, mm)
+  std::string grid_face = "top";    // --grid-face
+  std::optional<double> flc_n;      // --flc-n: Keeler-Brazier curve (with --thickness)
+  std::optional<double> flc0;       // --flc0: plane-strain limit, standard shape
+  double necking_margin = 0.10, thinning_limit = 30.0, min_stretch = 0.02;
+  std::vector<std::string> sections;  // --section (repeatable)
+  bool neck = false;                  // --neck
 };
 
 // --method, --penalty, --mesh/--elements, --alpha.. --delta, --smoothing-scale,

@@ -50,6 +50,34 @@ void add_plot_options(CLI::App& app, std::string& measure, std::string& size, st
                  "principal strain plot; strains.csv gets flc_margin");
 }
 
+// The press-shop options of `gsa analyse` (docs/usage.md "Mid-surface strains",
+// "Forming-limit assessment", "Sections").
+void add_press_options(CLI::App& app, AnalyseFlags& a) {
+  app.add_option("--thickness", a.thickness,
+                 "Initial sheet thickness in the length unit (mm): mid-surface strains and the current thickness "
+                 "(strains.csv mid_major, mid_minor, thickness_mm); the forming limit is then assessed on them");
+  app.add_option("--grid-face", a.grid_face,
+                 "Face the grid is on: top (default; the side the fitted surface's normal points to) or bottom");
+  app.add_option("--flc-n", a.flc_n,
+                 "Forming limit curve from Keeler-Brazier (low-carbon steels) with this strain-hardening exponent n "
+                 "(0.05..0.35) and --thickness");
+  app.add_option("--flc0", a.flc0,
+                 "Forming limit curve from its plane-strain limit FLC0 (in the --measure strain) and the standard "
+                 "shape");
+  app.add_option("--necking-margin", a.necking_margin,
+                 "Necking risk zone: within this strain below the forming limit curve (default 0.10)");
+  app.add_option("--thinning-limit", a.thinning_limit,
+                 "Excess thinning zone: thinning beyond this many percent (default 30)");
+  app.add_option("--min-stretch", a.min_stretch, "Insufficient stretch zone: major strain below this (default 0.02)");
+  app.add_option("--section", a.sections,
+                 "Section line (repeatable): plane:X,Y,Z,NX,NY,NZ (point and normal, cutting the formed part) or "
+                 "curve:X,Y;X,Y;... (points on the undeformed blank); writes section_N.csv and section_N.png")
+      ->allow_extra_args(false);
+  app.add_flag("--neck", a.neck,
+               "Evaluate the neck along each section (ISO 12004-2 style inverse parabola; summary.json, "
+               "section_N.csv)");
+}
+
 // The grid, from one file or two, with the status lines of reading.
 struct Input {
   GridData grid;
@@ -105,7 +133,8 @@ ProgressCallback stage_status_lines(bool quiet) {
 
 // "gsa: 441 of 441 points analysed; results in DIR (mesh 7x7, ...)".
 std::string closing_line(const AnalysisResult& result, Index n_points, const std::string& out, const std::string& units,
-                         const std::optional<FlcMargins>& margins) {
+                         const std::optional<FlcMargins>& margins,
+                         const std::optional<FlcAssessment>& assessment = std::nullopt) {
   Index ok = 0;
   for (const auto& p : result.points) ok += p.strain ? 1 : 0;
   std::ostringstream msg;
@@ -125,6 +154,13 @@ std::string closing_line(const AnalysisResult& result, Index n_points, const std
         << " flagged as outliers, strains kept (see summary.json)";
   if (margins)
     msg << "; " << margins->n_beyond << " of " << margins->n_marks << " marks beyond the forming limit curve";
+  if (assessment) {
+    msg << " (zones:";
+    bool first = true;
+    for (const auto& [zone, n] : assessment->counts)
+      if (n > 0) msg << (first ? " " : ", ") << n << " " << zone, first = false;
+    msg << ")";
+  }
   return msg.str();
 }
 
@@ -178,7 +214,13 @@ void warn_uncovered_marks(AnalysisResult& result, const std::string& mesh_file, 
 
 int run_analyse(const AnalyseFlags& a, bool quiet) {
   if (a.out.empty()) throw UsageError("--out: empty; give the folder to write the results into (e.g. --out results)");
-  if (!a.stages.empty() || !a.stage_column.empty()) return run_analyse_series(a, quiet);  // gsa/series_output.cpp
+  if (!a.stages.empty() || !a.stage_column.empty()) {
+    if (a.thickness || a.flc_n || a.flc0 || !a.sections.empty())
+      throw UsageError(
+          "--thickness, --flc-n, --flc0 and --section are not available with a stage series yet: "
+          "analyse the stage of interest on its own");
+    return run_analyse_series(a, quiet);  // gsa/series_output.cpp
+  }
   const AnalyseOptions options = analyse_options(a);
   OutputOptions output = output_options(a);  // reads the forming limit curve, with or without pictures
   output.keep_surfaces = !a.no_plots;
@@ -217,11 +259,22 @@ int run_analyse(const AnalyseFlags& a, bool quiet) {
                               a.out, output.measure);
     data.flc = output.flc;
     data.margins = written.margins;
+    data.assessment = written.press.assessment;
+    // The principal strain plot shows the strains the zones were assessed on.
+    if (!written.press.mid.empty()) data.marks = assessed_strains(result, written.press.mid, output.measure);
+    data.sections = written.sections;
+    data.section_options.measure = output.measure;
+    data.section_options.mid = output.mid;
     write_pictures(
         data, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
   }
   out.commit();
-  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, written.margins));
+  const std::optional<FlcAssessment> assessment = written.press.assessment;
+  const std::size_t n_sections = written.sections.size();
+  cli::status(quiet, closing_line(result, in.grid.n_points(), a.out, output.units, written.margins, assessment) +
+                         (n_sections > 0 ? "; " + std::to_string(n_sections) + " section" +
+                                               (n_sections == 1 ? "" : "s") + " (section_N.csv)"
+                                         : ""));
   return cli::kExitOk;
 }
 
@@ -405,6 +458,7 @@ void add_analyse_command(sf::cli::Program& program) {
         app.add_option("--sample", args->sample, "Also write samples.csv with fields on N x N points per element");
         app.add_flag("--no-plots", args->no_plots, "Do not draw pictures (PNG) nor report.html");
         add_plot_options(app, args->measure, args->size, args->view, args->flc);
+        add_press_options(app, *args);  // mid-surface, forming-limit assessment, sections (issue 17)
       },
       [args, prog] { return run_analyse(*args, prog->common().quiet); });
 }

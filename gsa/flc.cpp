@@ -27,6 +27,20 @@ FormingLimitCurve read_flc(const std::string& path) {
   if (pts.size() < 2)
     throw InputError(path + ": a forming limit curve needs at least 2 rows (minor, major), found " +
                      std::to_string(pts.size()));
+  // One major strain per minor strain: the rows must run monotonically in minor strain (either
+  // way); a row that turns back is named with its line.
+  if (pts.size() >= 2) {
+    const bool rising = pts[1].first > pts[0].first;
+    for (std::size_t r = 1; r < pts.size(); ++r) {
+      const double prev = pts[r - 1].first, cur = pts[r].first;
+      if (rising ? cur > prev : cur < prev) continue;
+      throw InputError(path + ":" + std::to_string(t.line(r)) + ":" + std::to_string(t.char_column(r, cm)) +
+                       ": minor strain " + std::string(t.cell(r, cm)) + " after " + std::string(t.cell(r - 1, cm)) +
+                       " on line " + std::to_string(t.line(r - 1)) +
+                       ": a forming limit curve must be monotone in minor strain (every row's minor strain " +
+                       (rising ? "greater" : "smaller") + " than the previous row's, one major strain per minor)");
+    }
+  }
   std::stable_sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   FormingLimitCurve c;
   c.source = path;

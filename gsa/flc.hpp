@@ -3,8 +3,9 @@
 // margin of every mark against it.
 //
 // File: CSV with columns `minor` and `major` (any order, '#' comments), at least 2 rows,
-// strains in the measure of the analysis' pictures (--measure). The rows are sorted by
-// minor strain when read and interpolated linearly between.
+// strains in the measure of the analysis' pictures (--measure). The rows must be monotone in
+// minor strain (ascending or descending; a row that turns back or repeats a minor strain is an
+// error naming its line); they are stored ascending and interpolated linearly between.
 //
 // Margin of a mark: the curve's major strain at the mark's minor strain minus the mark's
 // major strain; positive = safe, negative = beyond the limit; NaN for marks without a

@@ -23,7 +23,7 @@ io::OutputDirOptions analyse_results_folder() {
   io::OutputDirOptions o;
   o.owned = {"strains.csv", "summary.json", "undeformed.vtp", "deformed.vtp",       "samples.csv",
              "*.png",       "report.html",  "surfaces.json",  "series_strains.csv", "strain_paths.csv",
-             "series.pvd",  "stages",       "view.html"};
+             "series.pvd",  "stages",       "view.html",      "section_*.csv"};
   return o;
 }
 
@@ -116,7 +116,9 @@ std::vector<std::string> strain_columns(const AnalysisResult& result) {
 }
 
 void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
-                       const OutputOptions& options, const FlcMargins* margins) {
+                       const OutputOptions& options, const FlcMargins* margins, const PressColumns* press) {
+  const bool mid = press && !press->mid.empty();
+  const FlcAssessment* assessment = press && press->assessment ? &*press->assessment : nullptr;
   std::ofstream out(path);
   if (!out) throw Error(path + ": cannot write");
   out << "# gsa strains; lengths in " << options.units << "; strains dimensionless (E = Green-Lagrange, "
@@ -126,9 +128,27 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
       << "); flag_* = why a point was flagged (its deviation from its neighbours' local fit, the threshold "
       << "it exceeded, the noise level; " << options.units << "), flagged points keep the fitted surfaces' strain"
       << "; thickness by incompressibility; method " << method_name(result.method) << "\n";
+  if (mid)
+    out << "# mid_major, mid_minor: principal " << measure_word(options.measure)
+        << " strains of the sheet's mid-surface (grid on the "
+        << (options.mid.face == GridFace::kTop ? "top" : "bottom") << " face, initial thickness "
+        << options.mid.thickness << " " << options.units << "); thickness_mm: current thickness in " << options.units
+        << " (incompressible mid-surface)\n";
   if (margins) out << flc_margin_comment(*margins) << "\n";
+  if (assessment)
+    out << "# flc_radial_margin: distance along the mark's proportional strain path from the origin to the curve "
+           "minus its distance (strain); zone: failure, necking_risk (within "
+        << assessment->options.necking_margin << "), excess_thinning (beyond " << assessment->options.thinning_limit_pct
+        << " %), compression (below the pure-shear line), "
+        << "insufficient_stretch (major below " << assessment->options.min_stretch
+        << "), safe, outside_curve; assessed on the " << assessment->strains << " strains\n";
   std::vector<std::string> columns = strain_columns(result);
+  if (mid)
+    for (const std::string& c : {std::string("mid_major"), std::string("mid_minor"), "thickness_" + options.units})
+      columns.push_back(c);
   if (margins) columns.push_back("flc_margin");
+  if (assessment)
+    for (const char* c : {"flc_radial_margin", "zone"}) columns.push_back(c);
   std::unique_ptr<fe::SurfaceField> fu;
   if (result.method == Method::kSurface)
     fu = std::make_unique<fe::SurfaceField>(result.mesh, result.undeformed_parameters);
@@ -168,7 +188,18 @@ void write_strains_csv(const std::string& path, const GridData& grid, const Anal
         }
         w.add(pr.strain ? pr.shear_angle_deg : kNaN);
       }
-      if (margins) w.add(margins->margin[static_cast<std::size_t>(p)]);
+      const std::size_t q = static_cast<std::size_t>(p);
+      if (mid) {
+        const auto& m = press->mid[q];
+        if (m && pr.strain)
+          w.add(principal_strain(m->strain, 0, options.measure))
+              .add(principal_strain(m->strain, 1, options.measure))
+              .add(m->thickness);
+        else
+          w.add(kNaN).add(kNaN).add(kNaN);
+      }
+      if (margins) w.add(margins->margin[q]);
+      if (assessment) w.add(assessment->radial_margin[q]).add(std::string(zone_code(assessment->zone[q])));
       w.end_row();
     }
     return text.str();
@@ -324,7 +355,32 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
   return j;
 }
 
-io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv) {
+std::vector<std::optional<MidSurfaceStrain>> mark_mid_strains(const AnalysisResult& r, const MidSurfaceOptions& o) {
+  std::vector<std::optional<MidSurfaceStrain>> out(r.points.size());
+  if (!o.enabled() || r.method != Method::kSurface) return out;
+  const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
+  const unsigned all = basis::kValues | basis::kFirst | basis::kSecond;
+  for (std::size_t p = 0; p < r.points.size(); ++p) {
+    const PointResult& pr = r.points[p];
+    if (!pr.strain || pr.element < 0) continue;
+    out[p] = mid_surface_strain(fu.evaluate3(pr.element, pr.xi, all), fd.evaluate3(pr.element, pr.xi, all), o);
+  }
+  return out;
+}
+
+MarkStrains assessed_strains(const AnalysisResult& r, const std::vector<std::optional<MidSurfaceStrain>>& mid,
+                             StrainMeasure measure) {
+  MarkStrains m = mark_strains(r, measure);
+  if (mid.empty()) return m;
+  for (std::size_t p = 0; p < m.major.size() && p < mid.size(); ++p) {
+    if (!std::isfinite(m.major[p])) continue;
+    m.major[p] = mid[p] ? principal_strain(mid[p]->strain, 0, measure) : kNaN;
+    m.minor[p] = mid[p] ? principal_strain(mid[p]->strain, 1, measure) : kNaN;
+  }
+  return m;
+}
+
+io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv, const MidSurfaceOptions& mid) {
   io::PolyMesh pm;
   const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
   const Index ne = r.mesh.n_elements();
@@ -337,6 +393,8 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   io::FieldArray dir1{"dir1", 3, {}}, dir2{"dir2", 3, {}}, disp{"displacement", 3, {}}, shear{"shear_angle_deg", 1, {}};
   io::FieldArray f1{"fibre1", 3, {}}, f2{"fibre2", 3, {}}, s1{"fibre1_stretch", 1, {}}, s2{"fibre2_stretch", 1, {}};
   const bool fibres = r.fibre_angles.size() == 2;
+  io::FieldArray ml1{"mid_lambda1", 1, {}}, ml2{"mid_lambda2", 1, {}}, mth{"thickness", 1, {}};
+  const unsigned updates = basis::kValues | basis::kFirst | (mid.enabled() ? basis::kSecond : 0u);
   // Only the cells where the marks are (gsa/measured_region.hpp); every point is kept, so
   // element e's points stay at e (subdiv + 1)^2 onwards.
   const std::vector<bool> measured = measured_cells(r, subdiv);
@@ -346,9 +404,15 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
     for (int j = 0; j < np; ++j)
       for (int i = 0; i < np; ++i, ++pt) {
         const Vec2 xi(static_cast<double>(i) / subdiv, static_cast<double>(j) / subdiv);
-        const auto b = basis::BicubicHermite::evaluate(xi, basis::kValues | basis::kFirst);
+        const auto b = basis::BicubicHermite::evaluate(xi, updates);
         const fe::SurfacePoint pu = fu.evaluate3(e, b), pd = fd.evaluate3(e, b);
         pm.points.row(pt) = (deformed ? pd.x : pu.x).transpose();
+        if (mid.enabled()) {
+          const auto m = mid_surface_strain(pu, pd, mid);
+          ml1.values.push_back(m ? m->strain.lambda1 : kNaN);
+          ml2.values.push_back(m ? m->strain.lambda2 : kNaN);
+          mth.values.push_back(m ? m->thickness : kNaN);
+        }
         const auto s = surface_strain(pu.dx, pd.dx);
         const Fields f = fields_of(s);
         const double vals[] = {f.e1, f.e2, f.eng1, f.eng2, f.true1, f.true2, f.thick, f.lambda1, f.lambda2};
@@ -396,6 +460,8 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   if (fibres) {
     for (auto* f : {&f1, &f2, &s1, &s2, &shear}) pm.point_data.push_back(std::move(*f));
   }
+  if (mid.enabled())
+    for (auto* f : {&ml1, &ml2, &mth}) pm.point_data.push_back(std::move(*f));
   pm.cell_data.push_back(io::FieldArray{"element", 1, std::move(kept_element)});
   return pm;
 }
@@ -423,24 +489,133 @@ void write_samples_csv(const std::string& path, const AnalysisResult& r, const O
       }
 }
 
+namespace {
+// summary.json: "mid_surface", "forming_limit" and "sections" (docs/usage.md).
+void add_press_summary(nlohmann::json& j, const AnalysisResult& r, const OutputOptions& o, const WrittenResults& w) {
+  if (!w.press.mid.empty()) {
+    std::vector<double> mj, mn, th;
+    Index n = 0;
+    Vec3 normal = Vec3::Zero();
+    for (std::size_t p = 0; p < w.press.mid.size(); ++p) {
+      const auto& m = w.press.mid[p];
+      if (!m) continue;
+      ++n;
+      mj.push_back(principal_strain(m->strain, 0, o.measure));
+      mn.push_back(principal_strain(m->strain, 1, o.measure));
+      th.push_back(m->thickness);
+      normal += m->strain.normal_undeformed;
+    }
+    j["mid_surface"] = {
+        {"initial_thickness", o.mid.thickness},
+        {"grid_face", o.mid.face == GridFace::kTop ? "top" : "bottom"},
+        {"mean_undeformed_normal",
+         n > 0 ? nlohmann::json{normal.normalized()[0], normal.normalized()[1], normal.normalized()[2]}
+               : nlohmann::json(nullptr)},
+        {"measure", measure_word(o.measure)},
+        {"marks", n},
+        {"mid_major", range_of(mj)},
+        {"mid_minor", range_of(mn)},
+        {"thickness", range_of(th)},
+        {"formula",
+         "mid-surface r - s h/2 n (s = +1 top, -1 bottom face), tangents from the fits' second derivatives; h = "
+         "t0 / (lambda1 lambda2) of the mid-surface (docs/theory/strain.md)"}};
+    j["units"]["thickness"] = o.units;
+  }
+  if (w.press.assessment && w.margins) {
+    const FlcAssessment& a = *w.press.assessment;
+    double min_radial = kNaN;
+    for (double x : a.radial_margin)
+      if (std::isfinite(x) && !(min_radial <= x)) min_radial = x;
+    j["forming_limit"] = {{"curve", a.curve},
+                          {"measure", measure_word(o.measure)},
+                          {"strains", a.strains},
+                          {"necking_margin", a.options.necking_margin},
+                          {"thinning_limit_pct", a.options.thinning_limit_pct},
+                          {"min_stretch", a.options.min_stretch},
+                          {"marks_assessed", w.margins->n_marks},
+                          {"marks_beyond", w.margins->n_beyond},
+                          {"min_margin", json_number(w.margins->min_margin)},
+                          {"min_radial_margin", json_number(min_radial)},
+                          {"zones", a.counts},
+                          {"curve_points", {{"minor", o.flc->minor}, {"major", o.flc->major}}}};
+  }
+  if (!w.sections.empty()) {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const Section& s : w.sections) {
+      double len_u = 0, len_d = 0;
+      for (const SectionPoint& p : s.points)
+        if (p.branch == 0) len_u = p.s_undeformed, len_d = p.s_deformed;
+      nlohmann::json e = {{"name", s.name},
+                          {"file", s.name + ".csv"},
+                          {"definition", s.spec.text},
+                          {"points", s.points.size()},
+                          {"branches", s.n_branches},
+                          {"length_undeformed", len_u},
+                          {"length_deformed", len_d}};
+      if (s.neck) {
+        const NeckResult& n = *s.neck;
+        e["neck"] = n.ok ? nlohmann::json{{"limit_major", n.limit_major},     {"limit_minor", n.limit_minor},
+                                          {"apex_position", n.apex_position}, {"peak_major", n.peak_major},
+                                          {"peak_position", n.peak_position}, {"window_width", n.window_width},
+                                          {"fit_points", n.fit_points},       {"fit_rms", n.fit_rms}}
+                         : nlohmann::json{{"error", n.message}};
+      }
+      arr.push_back(std::move(e));
+    }
+    j["sections"] = arr;
+  }
+  (void)r;
+}
+}  // namespace
+
 WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, AnalysisResult& result,
                              const OutputOptions& options, const RunInfo& info) {
   const auto t0 = std::chrono::steady_clock::now();
   WrittenResults written;
-  if (options.flc) written.margins = flc_margins(*options.flc, mark_strains(result, options.measure), options.measure);
+  const bool mid = options.mid.enabled() && result.method == Method::kSurface;
+  if (mid) written.press.mid = mark_mid_strains(result, options.mid);
+  if (options.flc) {
+    const MarkStrains assessed = assessed_strains(result, written.press.mid, options.measure);
+    written.margins = flc_margins(*options.flc, assessed, options.measure);
+    std::vector<double> thick(result.points.size(), kNaN);
+    for (std::size_t p = 0; p < result.points.size(); ++p) {
+      if (!result.points[p].strain) continue;
+      if (!mid)
+        thick[p] = result.points[p].strain->thickness_change_pct();
+      else if (written.press.mid[p])
+        thick[p] = 100.0 * (written.press.mid[p]->thickness / options.mid.thickness - 1.0);
+    }
+    written.press.assessment = assess_marks(*options.flc, assessed, thick, options.measure, options.zones);
+    written.press.assessment->curve =
+        options.flc_description.empty() ? "table " + options.flc->source : options.flc_description;
+    written.press.assessment->strains = mid ? "mid-surface" : "surface (marked face)";
+  }
+  // Sections before any file: a plane that misses the part fails the run here.
+  SectionOptions so;
+  so.measure = options.measure;
+  if (mid) so.mid = options.mid;
+  so.neck = options.neck;
+  for (std::size_t k = 0; k < options.sections.size(); ++k) {
+    Section sec = cut_section(result, options.sections[k], so, "--section " + std::to_string(k + 1));
+    sec.name = "section_" + std::to_string(k + 1);
+    written.sections.push_back(std::move(sec));
+  }
   const FlcMargins* margins = written.margins ? &*written.margins : nullptr;
+  const PressColumns* press = &written.press;
   // The mark table on a second thread while the surfaces are written (independent
   // files and read-only inputs); its exception, if any, is rethrown by get().
   auto csv = std::async(std::launch::async,
-                        [&] { write_strains_csv(out.path("strains.csv"), grid, result, options, margins); });
+                        [&] { write_strains_csv(out.path("strains.csv"), grid, result, options, margins, press); });
   try {
     if (result.method == Method::kSurface) {
       for (const bool deformed : {false, true}) {
-        io::PolyMesh surface = surface_polymesh(result, deformed);
+        io::PolyMesh surface = surface_polymesh(result, deformed, 8, mid ? options.mid : MidSurfaceOptions{});
         io::write_vtp(out.path(deformed ? "deformed.vtp" : "undeformed.vtp"), surface);
         if (options.keep_surfaces) (deformed ? written.deformed : written.undeformed) = std::move(surface);
       }
       if (options.sample > 0) write_samples_csv(out.path("samples.csv"), result, options);
+      for (const Section& sec : written.sections)
+        write_section_csv(out.path(sec.name + ".csv"), sec, so, options.units);
       // The fitted surfaces themselves, for `gsa compare` (gsa/surfaces_file.hpp).
       write_surfaces_file(out.path("surfaces.json"), result.mesh, result.undeformed_parameters,
                           result.deformed_parameters, options.units);
@@ -452,6 +627,7 @@ WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, Ana
   csv.get();
   result.times.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   written.summary = make_summary(grid, result, options, info);
+  add_press_summary(written.summary, result, options, written);
   io::write_json(out.path("summary.json"), written.summary);
   return written;
 }

@@ -11,7 +11,10 @@
 #include "common/io/vtk_xml.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/flc.hpp"
+#include "gsa/flc_assessment.hpp"
 #include "gsa/grid.hpp"
+#include "gsa/midsurface.hpp"
+#include "gsa/sections.hpp"
 #include "gsa/strain_measure.hpp"
 
 namespace sf::io {
@@ -33,6 +36,15 @@ struct OutputOptions {
   std::optional<FormingLimitCurve> flc;
   StrainMeasure measure = StrainMeasure::kTrue;
   bool keep_surfaces = false;  // return the tessellated surfaces (to draw pictures from them)
+  // Press-shop outputs (issue 17; docs/usage.md "Mid-surface strains", "Forming-limit
+  // assessment", "Sections"). With mid.enabled() (--thickness): mid-surface strains and the
+  // thickness per mark (strains.csv mid_major, mid_minor, thickness_mm) and on the surfaces;
+  // the forming limit is then assessed on the mid-surface strains.
+  MidSurfaceOptions mid;
+  std::string flc_description;        // how the curve was made (table, Keeler-Brazier, FLC0)
+  ZoneOptions zones;                  // with a curve: the zones (strains.csv flc_radial_margin, zone)
+  std::vector<SectionSpec> sections;  // --section, in order: section_N.csv
+  bool neck = false;                  // --neck: evaluate a neck on each section
   // Throws OptionError naming the field for a value out of range.
   void validate() const;
 };
@@ -45,14 +57,31 @@ struct RunInfo {
 // Column names of strains.csv, in order.
 std::vector<std::string> strain_columns(const AnalysisResult& result);
 
-// With margins, a comment line and a last column flc_margin.
+// Per-mark press-shop results written beside the strains (nothing when not asked for).
+struct PressColumns {
+  std::vector<std::optional<MidSurfaceStrain>> mid;  // per mark, with OutputOptions::mid
+  std::optional<FlcAssessment> assessment;           // with a curve
+};
+
+// With margins, a comment line and a last column flc_margin; with `press`, the columns
+// mid_major, mid_minor, thickness_mm (before flc_margin) and flc_radial_margin, zone (after).
 void write_strains_csv(const std::string& path, const GridData& grid, const AnalysisResult& result,
-                       const OutputOptions& options, const FlcMargins* margins = nullptr);
+                       const OutputOptions& options, const FlcMargins* margins = nullptr,
+                       const PressColumns* press = nullptr);
+// Mid-surface strain of every mark (nothing where a mark has no strain or the surfaces
+// are missing: triangle method).
+std::vector<std::optional<MidSurfaceStrain>> mark_mid_strains(const AnalysisResult& result,
+                                                              const MidSurfaceOptions& options);
+// The strains the forming limit is assessed on: mid-surface where given, else the face's.
+MarkStrains assessed_strains(const AnalysisResult& result, const std::vector<std::optional<MidSurfaceStrain>>& mid,
+                             StrainMeasure measure);
 nlohmann::json make_summary(const GridData& grid, const AnalysisResult& result, const OutputOptions& options,
                             const RunInfo& info);
 // A fitted surface tessellated (subdiv x subdiv quads per element) with the strain fields
 // as point data, as undeformed.vtp and deformed.vtp hold it; `deformed` selects the surface.
-io::PolyMesh surface_polymesh(const AnalysisResult& result, bool deformed, int subdiv = 8);
+// With `mid` enabled also mid_lambda1, mid_lambda2 and thickness (current, length unit).
+io::PolyMesh surface_polymesh(const AnalysisResult& result, bool deformed, int subdiv = 8,
+                              const MidSurfaceOptions& mid = {});
 void write_samples_csv(const std::string& path, const AnalysisResult& result, const OutputOptions& options);
 
 // What write_results() computed on the way.
@@ -60,6 +89,8 @@ struct WrittenResults {
   nlohmann::json summary;             // summary.json's content
   std::optional<FlcMargins> margins;  // with OutputOptions::flc
   io::PolyMesh undeformed, deformed;  // with OutputOptions::keep_surfaces (surface method)
+  PressColumns press;                 // mid-surface strains and the assessment, when asked for
+  std::vector<Section> sections;      // one per OutputOptions::sections (section_N.csv written)
 };
 
 // Writes everything into `out` (not committed here): strains.csv once (with the forming

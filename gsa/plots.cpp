@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "common/core/error.hpp"
@@ -503,6 +504,148 @@ void add_strain_paths(const std::vector<StrainPath>& paths, render::Chart& chart
                       " stages (strain_paths.csv), a dot at the last.";
 }
 
+render::Colour zone_colour(Zone z) {
+  switch (z) {
+    case Zone::kFailure:
+      return {0.84, 0.09, 0.09};
+    case Zone::kNeckingRisk:
+      return {1.00, 0.62, 0.00};
+    case Zone::kExcessThinning:
+      return {0.58, 0.20, 0.72};
+    case Zone::kCompression:
+      return {0.15, 0.42, 0.90};
+    case Zone::kInsufficientStretch:
+      return {0.62, 0.62, 0.62};
+    case Zone::kSafe:
+      return {0.18, 0.66, 0.28};
+    case Zone::kOutside:
+      return {0.90, 0.90, 0.80};
+    case Zone::kNone:
+      break;
+  }
+  return {0.97, 0.97, 0.97};
+}
+
+// The zones on the formed part: every quad of the tessellated surface classified from its
+// corners' mean stretches (the mid-surface's when the surfaces carry them), drawn as one
+// plain surface per zone with its outline.
+render::Scene zone_scene(const Results& r, const PlotOptions& o) {
+  const FlcAssessment& a = *r.assessment;
+  const bool mid = find_field(r.deformed, "mid_lambda1", 1) && find_field(r.deformed, "mid_lambda2", 1);
+  const std::string file = r.source + "/deformed.vtp";
+  const io::FieldArray& l1 = require_field(r.deformed, mid ? "mid_lambda1" : "lambda1", 1, file);
+  const io::FieldArray& l2 = require_field(r.deformed, mid ? "mid_lambda2" : "lambda2", 1, file);
+  std::map<Zone, std::vector<std::vector<Index>>> by_zone;
+  for (const auto& poly : r.deformed.polygons) {
+    double s1 = 0, s2 = 0;
+    int n = 0;
+    for (Index v : poly) {
+      const double a1 = l1.values[static_cast<std::size_t>(v)], a2 = l2.values[static_cast<std::size_t>(v)];
+      if (!std::isfinite(a1) || !std::isfinite(a2)) continue;
+      s1 += a1, s2 += a2, ++n;
+    }
+    Zone z = Zone::kNone;
+    if (n > 0) {
+      const double lam1 = s1 / n, lam2 = s2 / n;
+      const double major = strain_of_stretch(lam1, r.measure), minor = strain_of_stretch(lam2, r.measure);
+      z = classify_zone(major, minor, 100.0 * (1.0 / (lam1 * lam2) - 1.0), r.flc->major_at(minor), r.measure,
+                        a.options);
+    }
+    by_zone[z].push_back(poly);
+  }
+  render::Scene scene;
+  scene.title = "Forming-limit zones";
+  scene.view = o.view;
+  scene.subtitle =
+      r.case_name + "  \xC2\xB7  " + a.strains + " strains  \xC2\xB7  " + measure_name(r.measure) + " strain";
+  scene.footnote =
+      "Formed part. Zones of the fitted surface (corners' mean strains); marks counted in "
+      "summary.json, per mark in strains.csv (zone). Curve: " +
+      a.curve + ".";
+  scene.legend_title = "Zone (marks)";
+  for (const auto& [z, polys] : by_zone) {
+    render::Surface surf;
+    surf.points = r.deformed.points;
+    surf.polygons = polys;
+    surf.colour = zone_colour(z);
+    scene.surfaces.push_back(std::move(surf));
+  }
+  for (Zone z : kZones) {
+    if (!by_zone.count(z) && a.counts.at(zone_code(z)) == 0) continue;
+    render::LegendEntry e;
+    e.kind = render::LegendEntry::Kind::kSwatch;
+    e.colour = zone_colour(z);
+    e.label = zone_label(z) + " (" + std::to_string(a.counts.at(zone_code(z))) + ")";
+    scene.legend.push_back(e);
+  }
+  return scene;
+}
+
+// Major, minor and thickness strain along a section (branch 0) against the arc length on
+// the formed part; the mid-surface strains solid and the face's dashed when both exist.
+render::Chart section_chart(const Results& r, const Section& sec) {
+  const bool mid = r.section_options.mid.enabled();
+  const std::string w = measure_word(r.measure);
+  render::Chart c;
+  c.title = "Section " + sec.name.substr(sec.name.find('_') + 1) + ": " + sec.spec.text;
+  c.subtitle = r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain along the cut";
+  c.x_label = "arc length on the formed part (" + r.units + ")";
+  c.y_label = w + " strain";
+  c.legend_title = "Key";
+  render::ChartSeries e1, e2, m1, m2, th;
+  for (auto* x : {&e1, &e2, &m1, &m2, &th}) x->style = render::ChartSeries::Style::kLine;
+  e1.colour = m1.colour = {0.80, 0.10, 0.10};
+  e2.colour = m2.colour = {0.10, 0.30, 0.75};
+  th.colour = {0.15, 0.55, 0.20};
+  e1.size_px = e2.size_px = mid ? 1.6 : 2.6;
+  m1.size_px = m2.size_px = th.size_px = 2.6;
+  if (mid) e1.dash_px = e2.dash_px = 6;
+  std::vector<double> su, sd;
+  for (const SectionPoint& p : sec.points) {
+    if (p.branch != 0) continue;
+    for (auto* x : {&e1, &e2, &m1, &m2, &th}) x->x.push_back(p.s_deformed);
+    e1.y.push_back(p.major);
+    e2.y.push_back(p.minor);
+    m1.y.push_back(p.mid_major);
+    m2.y.push_back(p.mid_minor);
+    th.y.push_back(p.thickness_strain);
+    su.push_back(p.s_undeformed);
+    sd.push_back(p.s_deformed);
+  }
+  e1.label = mid ? "major, marked face" : "major";
+  e2.label = mid ? "minor, marked face" : "minor";
+  m1.label = "major, mid-surface";
+  m2.label = "minor, mid-surface";
+  th.label = "thickness strain (h/h0)";
+  c.series = {e1, e2};
+  if (mid) c.series.insert(c.series.end(), {m1, m2});
+  c.series.push_back(th);
+  c.footnote = "section_" + sec.name.substr(sec.name.find('_') + 1) +
+               ".csv holds every point (both arc lengths, "
+               "positions, all branches).";
+  if (sec.n_branches > 1) c.footnote += " Branch 0 of " + std::to_string(sec.n_branches) + " shown.";
+  if (sec.neck && sec.neck->ok && su.size() >= 2) {
+    const NeckResult& n = *sec.neck;
+    // The apex position (blank arc length) on the formed part's arc length.
+    const auto it = std::lower_bound(su.begin(), su.end(), n.apex_position);
+    const std::size_t k = std::clamp<std::size_t>(static_cast<std::size_t>(it - su.begin()), 1, su.size() - 1);
+    const double t = (n.apex_position - su[k - 1]) / std::max(su[k] - su[k - 1], 1e-300);
+    const double x = sd[k - 1] + t * (sd[k] - sd[k - 1]);
+    render::ChartSeries apex;
+    apex.x = {x, x};
+    apex.y = {n.limit_major, n.limit_minor};
+    apex.colour = {0, 0, 0};
+    apex.size_px = 6;
+    apex.label = "neck limit strains (ISO 12004-2 style): " + render::format_fixed(n.limit_major, 3) + ", " +
+                 render::format_fixed(n.limit_minor, 3);
+    c.series.push_back(apex);
+  } else if (sec.neck && !sec.neck->ok) {
+    c.footnote += " Neck not evaluated: " + sec.neck->message + ".";
+  }
+  c.include_origin = false;
+  return c;
+}
+
 render::Chart principal_chart(const Results& r, PlotSummary& summary) {
   const MarkStrains& ms = r.marks;
   const FormingLimitCurve* flc = r.flc ? &*r.flc : nullptr;
@@ -538,7 +681,8 @@ render::Chart principal_chart(const Results& r, PlotSummary& summary) {
   }
   summary.n_marks = n;
   safe.label = (flc ? "marks within the limit (" : "marks (") + std::to_string(safe.x.size()) + ")";
-  chart.series.push_back(safe);
+  const bool zones = flc && r.assessment && r.assessment->zone.size() == ms.major.size();
+  if (!zones) chart.series.push_back(safe);
   if (flc) {
     render::ChartSeries curve;
     curve.style = render::ChartSeries::Style::kLine;
@@ -559,10 +703,39 @@ render::Chart principal_chart(const Results& r, PlotSummary& summary) {
         if (flc->minor[i] >= lo && flc->minor[i] <= hi) chart.range_points.emplace_back(flc->minor[i], flc->major[i]);
     }
     beyond.label = "marks beyond the limit (" + std::to_string(beyond.x.size()) + ")";
-    chart.series.push_back(beyond);
+    if (!zones) chart.series.push_back(beyond);
+  }
+  if (zones) {
+    // One colour per zone (the marks' zones of strains.csv) and the necking-risk line.
+    const FlcAssessment& a = *r.assessment;
+    render::ChartSeries risk;
+    risk.style = render::ChartSeries::Style::kLine;
+    risk.colour = zone_colour(Zone::kFailure);
+    risk.opacity = 0.7;
+    risk.size_px = 1.6;
+    risk.dash_px = 8;
+    risk.sets_range = false;
+    risk.x = flc->minor;
+    for (double y : flc->major) risk.y.push_back(y - a.options.necking_margin);
+    risk.label = "curve - " + render::format_fixed(a.options.necking_margin, 2) + " (necking risk)";
+    chart.series.push_back(risk);
+    for (Zone z : kZones) {
+      render::ChartSeries d;
+      d.colour = zone_colour(z);
+      d.size_px = 3.2;
+      for (std::size_t i = 0; i < ms.major.size(); ++i)
+        if (a.zone[i] == z) {
+          d.x.push_back(ms.minor[i]);
+          d.y.push_back(ms.major[i]);
+        }
+      if (d.x.empty()) continue;
+      d.label = zone_label(z) + " (" + std::to_string(d.x.size()) + ")";
+      chart.series.push_back(d);
+    }
   }
   chart.subtitle =
       r.case_name + "  \xC2\xB7  " + measure_name(r.measure) + " strain  \xC2\xB7  " + std::to_string(n) + " marks";
+  if (zones) chart.subtitle += "  \xC2\xB7  " + r.assessment->strains + " strains";
   chart.footnote = "One dot per analysed mark (strains.csv). Equal axes." +
                    std::string(flc ? " Forming limit curve from " + fs::path(flc->source).filename().string() +
                                          ", in " + w + " strain."
@@ -690,7 +863,9 @@ PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
                            const PictureProgress& progress) {
   PlotSummary summary;
   const bool fibres = r.has_surfaces && find_field(r.deformed, "shear_angle_deg", 1) != nullptr;
-  const int n_pictures = r.has_surfaces ? (fibres ? 8 : 6) : 1;
+  const bool zones = r.has_surfaces && r.assessment && r.flc;
+  const int n_pictures =
+      (r.has_surfaces ? (fibres ? 8 : 6) : 1) + (zones ? 1 : 0) + static_cast<int>(r.sections.size());
   const auto display = render::acquire_display();  // one display for all pictures
   int done = 0;
   if (progress) progress(done, n_pictures);
@@ -706,6 +881,12 @@ PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
     render::write_chart_png(chart, o.size, out_path("principal_strains.png"));
     // The strain plot reads best first after the arrows; keep report order stable.
     summary.pictures.push_back("principal_strains.png");
+    if (progress) progress(++done, n_pictures);
+  }
+  if (zones) draw("zones.png", zone_scene(r, o));
+  for (const Section& sec : r.sections) {
+    render::write_chart_png(section_chart(r, sec), o.size, out_path(sec.name + ".png"));
+    summary.pictures.push_back(sec.name + ".png");
     if (progress) progress(++done, n_pictures);
   }
   ReportPage page;

@@ -17,6 +17,8 @@
 //                          the forming limit curve when given
 //   shear_angle.png        fibre mode: trellis shear angle contours
 //   fibres.png             fibre mode: both fibre families as short lines on the part
+//   zones.png              with a forming limit assessment: the zones on the formed part
+//   section_N.png          per --section: major, minor and thickness strain along the cut
 //   report.html            summary and all pictures
 //
 // Arrows: at a regular sampling of the surface (element centres, or 2 x 2 ... points per
@@ -36,7 +38,9 @@
 #include "common/render/scene.hpp"
 #include "gsa/analysis.hpp"
 #include "gsa/flc.hpp"
+#include "gsa/flc_assessment.hpp"
 #include "gsa/results_folder.hpp"
+#include "gsa/sections.hpp"
 #include "gsa/strain_measure.hpp"
 
 namespace sf::gsa {
@@ -64,6 +68,11 @@ struct PlotData {
   std::optional<FormingLimitCurve> flc;          // drawn in the principal strain plot (in `measure`)
   std::optional<FlcMargins> margins;             // of the marks against it
   std::vector<StrainPath> strain_paths;          // stage series: paths drawn on the principal strain plot
+  // Press-shop results (gsa analyse with a curve, --thickness, --section): the zones on the
+  // part (zones.png) and on the principal strain plot, one line plot per section.
+  std::optional<FlcAssessment> assessment;  // per-mark zones (with flc)
+  std::vector<Section> sections;            // section_N.png
+  SectionOptions section_options;           // measure and mid-surface options of the sections and zones
 };
 // From a results folder read back.
 PlotData plot_data(ResultsFolder folder, StrainMeasure measure);

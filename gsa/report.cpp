@@ -70,12 +70,18 @@ std::string caption_of(const std::string& name, StrainMeasure measure) {
       {"minor_strain.png", "Minor principal strain on the formed part."},
       {"shear_angle.png", "Trellis shear angle between the fibre families on the formed part."},
       {"fibres.png", "Current directions of both fibre families on the formed part."},
+      {"zones.png",
+       "Forming-limit zones on the formed part: failure (above the forming limit curve), necking risk (within the "
+       "margin below it), excess thinning, compression (wrinkling tendency), insufficient stretch, safe."},
       {"principal_strains.png",
        "Major against minor strain, one dot per analysed mark, with the reference lines of "
        "equibiaxial, plane-strain, uniaxial-tension and pure-shear deformation."},
   };
   const auto it = captions.find(name);
   std::string c = it == captions.end() ? name : it->second;
+  if (name.rfind("section_", 0) == 0)
+    c = "Major, minor and thickness strain along " + name.substr(0, name.size() - 4) +
+        " against the arc length on the formed part (every point in " + name.substr(0, name.size() - 4) + ".csv).";
   if (name.find("strain") != std::string::npos || name.find("arrows") != std::string::npos)
     c += " Strain measure: " + m + ".";
   return c;
@@ -253,11 +259,58 @@ void figures(std::ostream& h, const ReportPage& page) {
 
 }  // namespace
 
+// Mid-surface strains, the forming-limit assessment and the sections (summary.json
+// "mid_surface", "forming_limit", "sections"; issue 17).
+void press_tables(std::ostream& h, const nlohmann::json& s) {
+  const std::string unit = at(s, {"units", "length"}).is_string() ? " " + text_of(at(s, {"units", "length"})) : "";
+  if (const auto& m = at(s, {"mid_surface"}); m.is_object()) {
+    Table t("Mid-surface strains");
+    t.row("initial thickness", text_of(at(m, {"initial_thickness"})) + unit);
+    t.row("grid on the", text_of(at(m, {"grid_face"})) + " face");
+    t.row("mid-surface major (" + text_of(at(m, {"measure"})) + ")",
+          text_of(at(m, {"mid_major", "min"})) + " .. " + text_of(at(m, {"mid_major", "max"})));
+    t.row("mid-surface minor", text_of(at(m, {"mid_minor", "min"})) + " .. " + text_of(at(m, {"mid_minor", "max"})));
+    t.row("current thickness",
+          text_of(at(m, {"thickness", "min"})) + " .. " + text_of(at(m, {"thickness", "max"})) + unit);
+    h << t.str();
+  }
+  if (const auto& f = at(s, {"forming_limit"}); f.is_object()) {
+    Table t("Forming-limit assessment");
+    t.row("curve", text_of(at(f, {"curve"})));
+    t.row("assessed on", text_of(at(f, {"strains"})) + " strains (" + text_of(at(f, {"measure"})) + ")");
+    t.row("smallest major margin", text_of(at(f, {"min_margin"})));
+    t.row("smallest radial margin", text_of(at(f, {"min_radial_margin"})));
+    const auto& z = at(f, {"zones"});
+    if (z.is_object())
+      for (auto it = z.begin(); it != z.end(); ++it) t.row("zone " + it.key(), text_of(it.value()) + " marks");
+    t.row("per mark",
+          "columns <code>flc_margin</code>, <code>flc_radial_margin</code>, <code>zone</code> of "
+          "strains.csv");
+    h << t.str();
+  }
+  if (const auto& secs = at(s, {"sections"}); secs.is_array() && !secs.empty()) {
+    Table t("Sections");
+    for (const auto& x : secs) {
+      std::string v = "<a href=\"" + text_of(at(x, {"file"})) + "\">" + text_of(at(x, {"file"})) +
+                      "</a>: " + text_of(at(x, {"definition"})) + ", " + text_of(at(x, {"length_deformed"})) + unit +
+                      " on the part";
+      if (at(x, {"neck", "limit_major"}).is_number())
+        v += "; neck limit strains " + text_of(at(x, {"neck", "limit_major"})) + " / " +
+             text_of(at(x, {"neck", "limit_minor"}));
+      else if (at(x, {"neck", "error"}).is_string())
+        v += "; neck: " + text_of(at(x, {"neck", "error"}));
+      t.row(text_of(at(x, {"name"})), v);
+    }
+    h << t.str();
+  }
+}
+
 void write_report(const std::string& path, const nlohmann::json& summary, const ReportPage& page) {
   std::ostringstream h;
   page_head(h, summary, page);
   parameter_tables(h, summary);
   result_tables(h, summary, page);
+  press_tables(h, summary);
   figures(h, page);
   io::write_file_atomic(path, h.str());
 }

@@ -95,14 +95,15 @@ void write_strains_with_margin(const ResultsFolder& folder, const std::string& o
     while (std::getline(in, line)) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
       if (line.rfind('#', 0) != 0) break;
-      if (line.rfind("# flc_margin", 0) == 0) continue;
+      if (line.rfind("# flc_margin", 0) == 0 || line.rfind("# flc_radial_margin", 0) == 0) continue;
       comments.push_back(line);
     }
   }
   std::vector<std::string> header;
   std::vector<std::size_t> keep;
   for (std::size_t c = 0; c < t.n_columns(); ++c)
-    if (t.names()[c] != "flc_margin") {
+    // The assessment of an earlier curve goes with it (gsa analyse writes it anew).
+    if (t.names()[c] != "flc_margin" && t.names()[c] != "flc_radial_margin" && t.names()[c] != "zone") {
       header.push_back(t.names()[c]);
       keep.push_back(c);
     }

@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "common/core/memory.hpp"
 #include "common/io/atomic_file.hpp"
 #include "common/io/grid_file.hpp"
 #include "gsa/accuracy.hpp"
@@ -33,6 +34,7 @@ static double peak_mb() {
 }
 
 int main(int argc, char** argv) {
+  keep_freed_memory();  // as gsa does (common/core/memory.hpp)
   const double max_marks = argc > 1 ? std::atof(argv[1]) : 1e5;
   const int elements = argc > 2 ? std::atoi(argv[2]) : 0;
   const std::string name = argc > 3 ? argv[3] : "dome";

@@ -133,6 +133,10 @@ struct AnalysisResult {
   std::vector<double> element_multiplier;  // local smoothing: penalty multiplier per element (1: global weight)
   Index relaxed_elements = 0;              // elements with a multiplier below 1
   double local_gauge_length = 0.0;         // gauge length in the relaxed elements (units; 0: none)
+  // Automatic mesh refined at a localised feature narrower than an element (a neck):
+  // rounds of refinement (0: none) and the smallest element then (units).
+  int refinement_rounds = 0;
+  double smallest_element = 0.0;
   double noise_outliers_undeformed = 0.0, noise_outliers_deformed = 0.0;  // noise levels of the outlier checks (units)
   SigmaWeights weights_undeformed, weights_deformed;  // fit weights from the sigmas (used = false: all 1)
 };

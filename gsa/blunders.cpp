@@ -100,18 +100,31 @@ void BlunderOptions::validate() const {
 Index BlunderCheck::n_flagged() const { return static_cast<Index>(std::count(flagged.begin(), flagged.end(), true)); }
 
 BlunderCheck find_blunders(const Points3& positions, const Points3& values, const std::vector<bool>& usable,
-                           bool normal_only, const BlunderOptions& o) {
+                           bool normal_only, const BlunderOptions& o, std::shared_ptr<const BlunderNeighbours> reuse) {
   o.validate();
   const Index n = positions.rows();
   BlunderCheck out;
   out.deviation.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
   out.flagged.assign(static_cast<std::size_t>(n), false);
   Points3 X = positions;
-  for (Index p = 0; p < n; ++p)
-    if (!usable[static_cast<std::size_t>(p)] || !values.row(p).allFinite())
-      X.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
-  // Candidates once; each pass takes the nearest ones not flagged.
-  const std::vector<std::vector<Index>> candidates = mesh::nearest_neighbours(X, o.neighbours + 16);
+  std::vector<bool> among(static_cast<std::size_t>(n));
+  for (Index p = 0; p < n; ++p) {
+    among[static_cast<std::size_t>(p)] = usable[static_cast<std::size_t>(p)] && values.row(p).allFinite();
+    if (!among[static_cast<std::size_t>(p)]) X.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+  // Candidates once (or those of an earlier check among the same points); each pass
+  // takes the nearest ones not flagged.
+  const int count = o.neighbours + 16;
+  if (reuse && reuse->count == count && reuse->among == among && reuse->candidates.size() == among.size()) {
+    out.neighbours = std::move(reuse);
+  } else {
+    auto searched = std::make_shared<BlunderNeighbours>();
+    searched->among = std::move(among);
+    searched->count = count;
+    searched->candidates = mesh::nearest_neighbours(X, count);
+    out.neighbours = std::move(searched);
+  }
+  const std::vector<std::vector<Index>>& candidates = out.neighbours->candidates;
   const int comps = normal_only ? 1 : 3;
   for (int pass = 0; pass < o.passes; ++pass) {
     std::vector<std::vector<Index>> nb(static_cast<std::size_t>(n));

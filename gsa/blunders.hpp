@@ -28,6 +28,7 @@
 // Deformed state: values = the deformed positions against the undeformed
 // in-plane coordinates, all three components count.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,19 +46,32 @@ struct BlunderOptions {
   void validate() const;
 };
 
+// The candidate neighbours of each point (nearest first) among the points a check
+// used: kept so a second check of the same positions among the same points (the
+// deformed state after the undeformed one) does not search them again.
+struct BlunderNeighbours {
+  std::vector<bool> among;  // the points searched
+  int count = 0;            // candidates per point
+  std::vector<std::vector<Index>> candidates;
+};
+
 struct BlunderCheck {
   std::vector<double> deviation;  // per point, mm (NaN where not checked)
   double noise = 0.0;             // robust noise level per component, mm
   double threshold = 0.0;         // deviation above which a point can be flagged, mm
   std::vector<bool> flagged;      // per point
   Index n_flagged() const;
+  std::shared_ptr<const BlunderNeighbours> neighbours;  // the candidates searched (or reused)
 };
 
 // positions: n x 3 undeformed positions (where the points are); values: n x 3 the
 // state to check (the positions themselves for the undeformed state); usable: the
 // points taking part (others are neither checked nor used). normal_only: test the
 // deviation along the local normal of the positions only.
+// `reuse`: the neighbours of an earlier check of the same positions, taken when they
+// were searched among the same points (else searched again).
 BlunderCheck find_blunders(const Points3& positions, const Points3& values, const std::vector<bool>& usable,
-                           bool normal_only, const BlunderOptions& options = {});
+                           bool normal_only, const BlunderOptions& options = {},
+                           std::shared_ptr<const BlunderNeighbours> reuse = nullptr);
 
 }  // namespace sf::gsa

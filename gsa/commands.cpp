@@ -435,8 +435,9 @@ void add_analyse_command(sf::cli::Program& program) {
                        "How the automatic smoothing is chosen: noise-model (default; Cp with the estimated noise, "
                        "spatial correlation included) or gcv (cross-validation, assumes independent errors)");
         app.add_flag("--no-local-smoothing", args->no_local_smoothing,
-                     "Keep one smoothing weight everywhere (by default it is relaxed where the fit cannot follow a "
-                     "localised feature such as a neck)");
+                     "Keep one smoothing weight and the uniform automatic mesh everywhere (by default the smoothing "
+                     "is relaxed, and the mesh refined, where the fit cannot follow a localised feature such as a "
+                     "neck)");
         app.add_flag("--no-sigma-weights", args->no_sigma_weights,
                      "Fit every point with weight 1 (by default a point with an uncertainty column, e.g. sigma, "
                      "is weighted 1/sigma^2, normalised to the median sigma)");

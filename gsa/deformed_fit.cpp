@@ -120,6 +120,12 @@ MatX DeformedProblem::smooth(const MatX& values, const Penalty& penalty, int pas
   return f.fitted;
 }
 
+MatX DeformedProblem::smoothing_residual(const MatX& values, const Penalty& penalty, int passes) {
+  std::optional<MatX> out = system().smoothing_residual(values, penalty, passes);
+  if (!out) throw InputError(marks_.source + ": surface fit: the smoothed least-squares system is singular");
+  return std::move(*out);
+}
+
 void DeformedProblem::set_probes(MatX probes) {
   probes_ = std::move(probes);
   if (system_) system_->set_probes(probes_);

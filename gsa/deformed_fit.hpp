@@ -73,6 +73,8 @@ class DeformedProblem {
   // with the same weights, e.g. noise probes): their fit with a zero reference, at the
   // marks. The problem's own data stay as they are.
   MatX smooth(const MatX& values, const Penalty& penalty, int passes);
+  // values - smooth(values, penalty, passes), without the copies (FitSystem::smoothing_residual).
+  MatX smoothing_residual(const MatX& values, const Penalty& penalty, int passes);
   // Probes for the trace estimates of later fit_pair() calls (FitSystem::set_probes),
   // kept when the system is rebuilt; their column count is the trace_probes to pass.
   void set_probes(MatX probes);

@@ -298,6 +298,13 @@ struct FitSystem::Impl {
     return *work[i];
   }
   void draw_probes(int count);
+  // Phi^T W z over the points with weight > 0 (the others may be NaN).
+  MatX weighted_rhs(const Eigen::Ref<const MatX>& values) const;
+  // K (data weights + penalty) factorised in `ws` (reused when unchanged) and the dof
+  // parameters of the fit of the data whose Phi^T W z is `rhs_data`; `pinned` gets the
+  // dofs pinned to the reference. Empty with `message` set when K is singular.
+  MatX parameters(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
+                  const MatX& rhs_data, int passes, std::vector<Index>& pinned, std::string& message) const;
   FitResult solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes,
                   int passes) const;
 };
@@ -336,24 +343,41 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penal
 
 FitSystem::~FitSystem() = default;
 
-void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
-  Impl& s = *impl_;
-  s.values = values;
-  // Phi^T W z over the points with weight > 0 (the others may be NaN). A column at a
-  // time (contiguous in z), the columns on all cores; each entry sums over the points
-  // in their order whatever the threads.
-  s.data_rhs = MatX::Zero(s.phi.cols(), values.cols());
+MatX FitSystem::Impl::weighted_rhs(const Eigen::Ref<const MatX>& values) const {
+  // A column at a time (contiguous in z), the columns on all cores; each entry sums over
+  // the points in their order whatever the threads.
+  MatX out = MatX::Zero(phi.cols(), values.cols());
   parallel_for(
       values.cols(),
       [&](Index c) {
         const double* z = values.col(c).data();
-        double* out = s.data_rhs.col(c).data();
-        for (Index d = 0; d < s.phi.rows(); ++d) {
-          if (!(s.w[d] > 0.0)) continue;
-          for (decltype(s.phi)::InnerIterator it(s.phi, d); it; ++it) out[it.col()] += (s.w[d] * it.value()) * z[d];
+        double* o = out.col(c).data();
+        for (Index d = 0; d < phi.rows(); ++d) {
+          if (!(w[d] > 0.0)) continue;
+          for (RowMatrix::InnerIterator it(phi, d); it; ++it) o[it.col()] += (w[d] * it.value()) * z[d];
         }
       },
       1);
+  return out;
+}
+
+void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
+  Impl& s = *impl_;
+  s.values = values;
+  s.data_rhs = s.weighted_rhs(values);
+}
+
+std::optional<MatX> FitSystem::smoothing_residual(const Eigen::Ref<const MatX>& values, const Penalty& penalty,
+                                                  int passes) {
+  const Impl& s = *impl_;
+  std::vector<Index> pinned;
+  std::string message;
+  const MatX zero = MatX::Zero(s.mesh->n_dofs(), values.cols());
+  const MatX params = s.parameters(impl_->workspace(0), penalty, zero, s.weighted_rhs(values), passes, pinned, message);
+  if (params.size() == 0) return std::nullopt;
+  MatX out = values;
+  out.noalias() -= s.phi * params;
+  return out;
 }
 
 void FitSystem::set_probes(const MatX& p) {
@@ -380,9 +404,9 @@ void FitSystem::Impl::draw_probes(int count) {
   probes_weighted = phi.transpose() * (w.asDiagonal() * probes);
 }
 
-FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
-                                 int trace_probes, int passes) const {
-  FitResult out;
+MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
+                                 const MatX& rhs_data, int passes, std::vector<Index>& pinned,
+                                 std::string& message) const {
   const Index n = mesh->n_dofs();
   const std::array<VecX, 5>& order = penalties->order;
   Eigen::Map<VecX> pen_values(ws.pen.valuePtr(), ws.pen.nonZeros());
@@ -390,9 +414,9 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
   if (penalty.boundary > 0.0) pen_values += penalty.boundary * order[4];
   Eigen::Map<VecX> k_values(ws.k.valuePtr(), ws.k.nonZeros());
   k_values = normal_values + pen_values;
-  MatX rhs = data_rhs + ws.pen * reference;
+  MatX rhs = rhs_data + ws.pen * reference;
   // Pin dofs nothing determines (unused by every element, or with an empty row).
-  std::vector<Index> pinned;
+  pinned.clear();
   for (Index i = 0; i < n; ++i)
     if (!used[i]) pinned.push_back(i);
   for (Index i : linalg::empty_rows(ws.k))
@@ -406,18 +430,27 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
     ws.factored = k_values;
     if (!rep.ok()) {
       ws.factored.resize(0);
-      out.message = "surface fit: the smoothed least-squares system is singular (" + rep.brief() +
-                    "); too few points for the mesh (try fewer elements), or all points on a line";
-      return out;
+      message = "surface fit: the smoothed least-squares system is singular (" + rep.brief() +
+                "); too few points for the mesh (try fewer elements), or all points on a line";
+      return MatX();
     }
   }
-  out.parameters = ws.solver.solve(rhs);
+  MatX parameters = ws.solver.solve(rhs);
   // Further passes penalise the deviation from the previous pass (same matrix).
   for (int pass = 1; pass < passes; ++pass) {
-    MatX r = data_rhs + ws.pen * out.parameters;
+    MatX r = rhs_data + ws.pen * parameters;
     for (Index i : pinned) r.row(i) = reference.row(i);
-    out.parameters = ws.solver.solve(r);
+    parameters = ws.solver.solve(r);
   }
+  return parameters;
+}
+
+FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
+                                 int trace_probes, int passes) const {
+  FitResult out;
+  std::vector<Index> pinned;
+  out.parameters = parameters(ws, penalty, reference, data_rhs, passes, pinned, out.message);
+  if (out.parameters.size() == 0) return out;
   if (trace_probes > 0) {
     // z^T Phi H Phi^T W z = (Phi^T z)^T H (Phi^T W z) with H the (iterated)
     // smoother in dof space: all in dof space.

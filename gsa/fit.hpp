@@ -37,6 +37,7 @@
 #include <array>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,6 +127,12 @@ class FitSystem {
   // degrees of freedom are those of the iterated smoother.
   FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0,
                   int passes = 1);
+  // values - H values: the residuals of fitting other data at the same points with the
+  // same weights (e.g. noise probes, n_points x k) with `penalty` and a zero reference.
+  // The system's own data stay as they are; no copy of `values` is kept and no fitted
+  // values or residual norms are stored (with 1e5 points and 42 probe columns each such
+  // temporary is 34 MB). Nothing when the system is singular.
+  std::optional<MatX> smoothing_residual(const Eigen::Ref<const MatX>& values, const Penalty& penalty, int passes = 1);
   // Probes of the trace estimate given by the caller (n_points x count) instead of
   // Rademacher ones: with probes drawn from the noise N(0, Sigma) the estimate is
   // tr(H Sigma) (gsa/noise_model.hpp). Later solves with trace_probes = count use them.

@@ -60,7 +60,16 @@ struct AutoMesh {
   std::vector<MeshLocation> loc;
   int n1 = 0, n2 = 0;
   std::string layout;
+  std::vector<double> breaks1, breaks2;
+  Eigen::Vector2d low = Eigen::Vector2d::Zero(), length = Eigen::Vector2d::Zero();
 };
+
+// The cell of fraction f among ascending breaks 0 = b_0 < ... < b_n = 1.
+int cell_of(const std::vector<double>& b, double f) {
+  const int n = static_cast<int>(b.size()) - 1;
+  const int i = static_cast<int>(std::upper_bound(b.begin(), b.end(), f) - b.begin()) - 1;
+  return std::clamp(i, 0, n - 1);
+}
 
 // Keeps the elements of `full` that hold a mark, renumbering the locations.
 AutoMesh drop_empty_elements(const mesh::SurfaceMesh& full, std::vector<MeshLocation> loc) {
@@ -76,24 +85,50 @@ AutoMesh drop_empty_elements(const mesh::SurfaceMesh& full, std::vector<MeshLoca
 
 // Structured rectangle over the marks' bounding box in the plane (st: in-plane
 // coordinates of the marks), n1 x n2 elements (0: from the number of marks).
-AutoMesh rectangle_layout(const Eigen::MatrixX2d& st, const PlaneFrame& frame, int n1, int n2) {
+AutoMesh rectangle_layout(const Eigen::MatrixX2d& st, const PlaneFrame& frame, const MeshOptions& options) {
+  int n1 = options.elements1, n2 = options.elements2;
   const Eigen::Vector2d lo = st.colwise().minCoeff(), hi = st.colwise().maxCoeff();
   const double margin = 1e-6 * (hi - lo).maxCoeff();
   const Eigen::Vector2d lo_m = lo.array() - margin, len = (hi - lo).array() + 2 * margin;
-  if (n1 == 0 || n2 == 0) choose_element_counts(st.rows(), len[0], len[1], n1, n2);
+  const bool graded = !options.breaks1.empty() && !options.breaks2.empty();
+  if (graded) {
+    n1 = static_cast<int>(options.breaks1.size()) - 1;
+    n2 = static_cast<int>(options.breaks2.size()) - 1;
+  } else if (n1 == 0 || n2 == 0) {
+    choose_element_counts(st.rows(), len[0], len[1], n1, n2);
+  }
+  std::vector<double> b1(static_cast<std::size_t>(n1) + 1), b2(static_cast<std::size_t>(n2) + 1);
+  for (int i = 0; i <= n1; ++i) b1[static_cast<std::size_t>(i)] = graded ? options.breaks1[i] : double(i) / n1;
+  for (int j = 0; j <= n2; ++j) b2[static_cast<std::size_t>(j)] = graded ? options.breaks2[j] : double(j) / n2;
   const Vec3 origin = frame.centroid + lo_m[0] * frame.a1 + lo_m[1] * frame.a2;
-  const mesh::SurfaceMesh full = mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2);
+  std::vector<double> s1, s2;  // the breaks in length units, for a graded mesh
+  if (graded) {
+    for (double b : b1) s1.push_back(b * len[0]);
+    for (double b : b2) s2.push_back(b * len[1]);
+  }
+  const mesh::SurfaceMesh full = mesh::make_rectangle_mesh(origin, frame.a1, frame.a2, len[0], len[1], n1, n2, s1, s2);
   std::vector<MeshLocation> loc(static_cast<std::size_t>(st.rows()));
   for (Index k = 0; k < st.rows(); ++k) {
-    const double u = (st(k, 0) - lo_m[0]) / len[0] * n1, v = (st(k, 1) - lo_m[1]) / len[1] * n2;
-    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
-    const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
-    loc[k] = {static_cast<Index>(j) * n1 + i, Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0))};
+    const double f1 = (st(k, 0) - lo_m[0]) / len[0], f2 = (st(k, 1) - lo_m[1]) / len[1];
+    if (!graded) {  // as before: the same floating-point steps on a uniform mesh
+      const double u = f1 * n1, v = f2 * n2;
+      const int i = std::clamp(static_cast<int>(std::floor(u)), 0, n1 - 1);
+      const int j = std::clamp(static_cast<int>(std::floor(v)), 0, n2 - 1);
+      loc[k] = {static_cast<Index>(j) * n1 + i, Vec2(std::clamp(u - i, 0.0, 1.0), std::clamp(v - j, 0.0, 1.0))};
+      continue;
+    }
+    const int i = cell_of(b1, f1), j = cell_of(b2, f2);
+    const double u = (f1 - b1[i]) / (b1[i + 1] - b1[i]), v = (f2 - b2[j]) / (b2[j + 1] - b2[j]);
+    loc[k] = {static_cast<Index>(j) * n1 + i, Vec2(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0))};
   }
   AutoMesh out = drop_empty_elements(full, std::move(loc));
   out.n1 = n1;
   out.n2 = n2;
-  out.layout = std::to_string(n1) + "x" + std::to_string(n2);
+  out.layout = std::to_string(n1) + "x" + std::to_string(n2) + (graded ? " (refined at a localised feature)" : "");
+  out.breaks1 = std::move(b1);
+  out.breaks2 = std::move(b2);
+  out.low = lo_m;
+  out.length = len;
   return out;
 }
 
@@ -143,7 +178,12 @@ FrameAndMesh build_frame_and_mesh(const GridData& grid, const FitMarks& marks, c
       st(k, 0) = d.dot(frame.a1);
       st(k, 1) = d.dot(frame.a2);
     }
-    AutoMesh am = rectangle_layout(st, frame, options.elements1, options.elements2);
+    AutoMesh am = rectangle_layout(st, frame, options);
+    out.breaks1 = std::move(am.breaks1);
+    out.breaks2 = std::move(am.breaks2);
+    out.plane = std::move(st);
+    out.plane_low = am.low;
+    out.plane_length = am.length;
     out.mesh = std::move(am.mesh);
     out.start = std::move(am.loc);
     out.elements1 = am.n1;

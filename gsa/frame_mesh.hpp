@@ -35,16 +35,23 @@ FitMarks fit_marks(const GridData& grid);
 struct MeshOptions {
   int elements1 = 0, elements2 = 0;  // automatic mesh of n1 x n2 elements; 0 = from the number of marks
   std::string file;                  // the user's own mesh instead (JSON, gsa/mesh_file.hpp)
+  // Automatic mesh only: element boundaries as fractions of the marks' extent along each
+  // axis (n + 1 ascending values from 0 to 1), e.g. finer where a neck is
+  // (gsa/analysis.cpp, "refinement"); empty: uniform.
+  std::vector<double> breaks1, breaks2;
 };
 
 struct FrameAndMesh {
-  PlaneFrame frame;                  // best-fit plane of the undeformed marks
-  mesh::SurfaceMesh mesh;            // the fitting mesh, in the grid's units
-  std::vector<MeshLocation> start;   // m: each mark's starting location on it
-  int elements1 = 0, elements2 = 0;  // automatic mesh: its size before empty elements were dropped
-  std::string layout;                // "7x7", or "from FILE"
-  double mark_spacing = 0.0;         // d = sqrt(mesh area / marks), units
-  PenaltyMatrices penalties;         // the smoothing penalties of `mesh`, assembled once
+  PlaneFrame frame;                      // best-fit plane of the undeformed marks
+  mesh::SurfaceMesh mesh;                // the fitting mesh, in the grid's units
+  std::vector<MeshLocation> start;       // m: each mark's starting location on it
+  int elements1 = 0, elements2 = 0;      // automatic mesh: its size before empty elements were dropped
+  std::vector<double> breaks1, breaks2;  // automatic mesh: its element boundaries (fractions, n + 1 each)
+  Eigen::MatrixX2d plane;                // automatic mesh: each mark's in-plane coordinates (frame axes)
+  Eigen::Vector2d plane_low = Eigen::Vector2d::Zero(), plane_length = Eigen::Vector2d::Zero();  // the meshed box
+  std::string layout;                                                                           // "7x7", or "from FILE"
+  double mark_spacing = 0.0;  // d = sqrt(mesh area / marks), units
+  PenaltyMatrices penalties;  // the smoothing penalties of `mesh`, assembled once
 };
 // Throws sf::InputError naming the file when the marks lie on a line, and naming the mark
 // (file:line) when it cannot be located on a user mesh. Fit systems built on the result

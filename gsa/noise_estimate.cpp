@@ -90,17 +90,15 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
   const VariogramPairs pairs(marks.undeformed, usable, d, vo);
   MatX residual(m, 1);
   const ProbeBank bank = make_probe_bank(marks.undeformed, d);
+  system.set_values(marks.undeformed);
   return pilot_ladder(8, 1, vo.max_lag, d, true, [&](int k) -> std::optional<NoiseEstimate> {
     const Penalty pilot = jumps_penalty(k, d);
-    system.set_values(marks.undeformed);
     const FitResult f = system.solve(pilot, mesh.geometry(), 0, 1);
     if (!f.ok) return std::nullopt;
     for (Index i = 0; i < m; ++i) residual(i, 0) = (marks.undeformed.row(i) - f.fitted.row(i)).dot(normal.row(i));
-    auto shrink = [&](const MatX& probes) {
-      system.set_values(probes);
-      const FitResult g = system.solve(pilot, MatX::Zero(mesh.n_dofs(), probes.cols()), 0, 1);
-      return MatX(probes - g.fitted);
-    };
+    // The probes' residuals without copies of them (the same factorisation as the data's).
+    // (The data's fit with the same matrix succeeded: so does theirs.)
+    auto shrink = [&](const MatX& probes) { return *system.smoothing_residual(probes, pilot, 1); };
     return fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink);
   });
 }
@@ -148,7 +146,7 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
       pairs.emplace(marks.undeformed, usable, d, vo);
       paired = usable;
     }
-    auto shrink = [&](const MatX& probes) { return MatX(probes - problem.smooth(probes, pilot, 1)); };
+    auto shrink = [&](const MatX& probes) { return problem.smoothing_residual(probes, pilot, 1); };
     NoiseEstimate e = fit_noise_model(*pairs, pairs->gamma(residual, 3), bank, shrink);
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;

@@ -140,6 +140,32 @@ Vec3 CorrelatedField::at(const Vec3& p) const {
   return out;
 }
 
+void CorrelatedField::at_rows(const Points3& positions, Index first, int count,
+                              Eigen::Matrix<double, kBlock, 3>& out) const {
+  out.setZero();
+  if (amplitude_ == 0.0) return;
+  alignas(16) double x[kBlock] = {}, y[kBlock] = {}, z[kBlock] = {};
+  for (int i = 0; i < count; ++i) {
+    x[i] = positions(first + i, 0);
+    y[i] = positions(first + i, 1);
+    z[i] = positions(first + i, 2);
+  }
+  for (int c = 0; c < 3; ++c) {
+    const Index modes = k_[c].rows();
+    const double* k0 = k_[c].col(0).data();
+    const double* k1 = k_[c].col(1).data();
+    const double* k2 = k_[c].col(2).data();
+    const double* phase = phase_[c].data();
+    alignas(16) double sum[kBlock] = {};
+    // Each point's modes in order, as in at(): the same sums to the last bit.
+    for (Index m = 0; m < modes; ++m) {
+      const double a = k0[m], b = k1[m], e = k2[m], ph = phase[m];
+      for (int i = 0; i < kBlock; ++i) sum[i] += probe_cos(a * x[i] + b * y[i] + e * z[i] + ph);
+    }
+    for (int i = 0; i < count; ++i) out(i, c) = amplitude_ * sum[i];
+  }
+}
+
 VariogramPairs::VariogramPairs(const Points3& positions, const std::vector<bool>& usable, double spacing,
                                const VariogramOptions& o)
     : spacing_(spacing) {
@@ -215,12 +241,19 @@ ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed
   std::vector<CorrelatedField> fields;
   for (int l = 0; l < nl; ++l)
     fields.emplace_back(1.0, bank.lengths[static_cast<std::size_t>(l)], 500u + static_cast<unsigned>(l), 48);
-  // The cosines are most of the cost of the noise estimate: on all cores, by point.
-  parallel_for(n, [&](Index p) {
-    const Vec3 x = positions.row(p).transpose();
-    for (int l = 0; l < nl; ++l)
-      bank.probes.block<1, 3>(p, 3 * l) = fields[static_cast<std::size_t>(l)].at(x).transpose();
-  });
+  // The cosines are most of the cost of the noise estimate: on all cores, by blocks of points.
+  constexpr int kb = CorrelatedField::kBlock;
+  parallel_for((n + kb - 1) / kb,
+               [&](Index b) {
+                 const Index first = b * kb;
+                 const int count = static_cast<int>(std::min<Index>(kb, n - first));
+                 Eigen::Matrix<double, kb, 3> v;
+                 for (int l = 0; l < nl; ++l) {
+                   fields[static_cast<std::size_t>(l)].at_rows(positions, first, count, v);
+                   bank.probes.block(first, 3 * l, count, 3) = v.topRows(count);
+                 }
+               },
+               32);
   std::mt19937_64 rng(777);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (Index p = 0; p < n; ++p)
@@ -290,10 +323,17 @@ MatX noise_probes(const NoiseEstimate& noise, const Points3& positions, int coun
     if (noise.sigma_correlated > 0 && noise.correlation_length > 0) {
       const CorrelatedField field(noise.sigma_correlated, noise.correlation_length,
                                   seed + 1000u + static_cast<unsigned>(f), 64);
-      parallel_for(n, [&](Index k) {
-        const Vec3 v = field.at(positions.row(k).transpose());
-        for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) = v[c];
-      });
+      constexpr int kb = CorrelatedField::kBlock;
+      parallel_for((n + kb - 1) / kb,
+                   [&](Index b) {
+                     const Index first = b * kb;
+                     const int rows = static_cast<int>(std::min<Index>(kb, n - first));
+                     Eigen::Matrix<double, kb, 3> v;
+                     field.at_rows(positions, first, rows, v);
+                     for (int i = 0; i < rows; ++i)
+                       for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(first + i, 3 * f + c) = v(i, c);
+                   },
+                   32);
     }
     for (Index k = 0; k < n; ++k)
       for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) += noise.sigma_white * normal(rng);

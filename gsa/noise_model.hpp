@@ -59,6 +59,12 @@ class CorrelatedField {
   CorrelatedField(double sigma, double correlation_length, unsigned seed, int modes = 512);
   // Three independent components at position p (mm).
   Vec3 at(const Vec3& p) const;
+  // The same at the rows [first, first + count) of `positions` (count <= kBlock) into
+  // out(i, c): bit for bit what at() gives, but the modes' cosines of kBlock points are
+  // taken together, which the compiler vectorises (at() sums one point's modes in order,
+  // a reduction it may not reorder).
+  static constexpr int kBlock = 8;
+  void at_rows(const Points3& positions, Index first, int count, Eigen::Matrix<double, kBlock, 3>& out) const;
 
  private:
   double amplitude_ = 0.0;

@@ -49,6 +49,7 @@ MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing
   const BlunderCheck u =
       find_blunders(marks.undeformed, marks.undeformed, all, true, blunder_options(mark_spacing, options));
   out.noise_undeformed = u.noise;
+  out.neighbours = u.neighbours;
   for (Index k = 0; k < m; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     if (u.flagged[kk])
@@ -64,7 +65,7 @@ void find_deformed_outliers(const FitMarks& marks, const Points3& deformed, doub
   for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = deformed.row(k).allFinite();
   for (const OutlierFlag& f : out.undeformed) usable[static_cast<std::size_t>(f.mark)] = false;
   const BlunderCheck d =
-      find_blunders(marks.undeformed, deformed, usable, false, blunder_options(mark_spacing, options));
+      find_blunders(marks.undeformed, deformed, usable, false, blunder_options(mark_spacing, options), out.neighbours);
   out.noise_deformed = d.noise;
   out.deformed.clear();
   for (Index k = 0; k < m; ++k) {

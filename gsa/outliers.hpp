@@ -17,10 +17,12 @@
 // surfaces at its material point, and is readmitted when the final surface passes
 // within its threshold. Every flag carries its numbers (deviation, threshold, noise).
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "gsa/blunders.hpp"
 #include "gsa/frame_mesh.hpp"
 
 namespace sf::gsa {
@@ -54,6 +56,9 @@ std::string describe(const OutlierFlag& flag, double sigma, const std::string& u
 struct MarkOutliers {
   std::vector<OutlierFlag> undeformed, deformed;
   double noise_undeformed = 0.0, noise_deformed = 0.0;  // robust noise levels of the deviations (units)
+  // The undeformed check's neighbour candidates, reused by the deformed check when it
+  // uses the same marks (gsa/blunders.hpp).
+  std::shared_ptr<const BlunderNeighbours> neighbours;
 };
 // deformed: m x 3 deformed positions of the marks (NaN where not digitised).
 MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,

@@ -245,6 +245,8 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
                       {"element_type", "bicubic Hermite, arc-length scale factors"},
                       {"plane_origin", {r.centroid[0], r.centroid[1], r.centroid[2]}},
                       {"plane_axis1", {r.axis1[0], r.axis1[1], r.axis1[2]}},
+                      {"refinement_rounds", r.refinement_rounds},
+                      {"smallest_element", r.refinement_rounds > 0 ? nlohmann::json(r.smallest_element) : nullptr},
                       {"plane_axis2", {r.axis2[0], r.axis2[1], r.axis2[2]}}};
     params["penalty"] = r.penalty_kind == PenaltyKind::kThirdOrder ? "third-order (gamma) with edge jumps"
                         : r.penalty_kind == PenaltyKind::kJumps    ? "fourth-order edge jumps (delta)"

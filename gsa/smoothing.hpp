@@ -34,7 +34,8 @@ enum class SmoothingRule {
 struct SmoothingOptions {
   PenaltyKind penalty = PenaltyKind::kJumps;
   SmoothingRule rule = SmoothingRule::kNoiseModel;
-  bool local = true;  // relax the smoothing where the fit cannot follow a localised feature
+  bool local =
+      true;  // relax the smoothing, and refine the automatic mesh, where the fit cannot follow a localised feature
   // Explicit weights: giving any switches the automatic choice off; these are used for
   // both fits and the unset ones are 0. Units: alpha 1, beta units^2, gamma units^4,
   // delta units^6 (each >= 0).

@@ -1,5 +1,6 @@
 #pragma once
-// Process-wide memory settings for the programs that run Newton solves.
+// Process-wide memory settings for the programs that run Newton solves, and gsa
+// (its noise estimate frees and allocates again probe matrices of tens of MB).
 
 namespace sf {
 

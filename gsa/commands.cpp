@@ -15,6 +15,7 @@
 #include "common/cli/progress.hpp"
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/io/json.hpp"
 #include "common/io/csv.hpp"
 #include "common/io/grid_file.hpp"
 #include "common/render/display.hpp"
@@ -289,7 +290,12 @@ int run_plot(const PlotArgs& a, bool quiet) {
   if (!a.flc.empty()) flc = read_flc(a.flc);  // a bad curve file fails before any work
   if (!std::filesystem::is_directory(a.dir))
     throw InputError(a.dir + ": no such folder; give a results folder written by `gsa analyse`");
-  io::AtomicOutputDir out(a.dir);
+  // Another curve or measure: the zones picture of gsa analyse's curve is not carried over.
+  io::OutputDirOptions keep;
+  const auto summary = std::filesystem::path(a.dir) / "summary.json";
+  if (flc && !(std::filesystem::exists(summary) && zones_belong_to(io::read_json(summary.string()), *flc, measure)))
+    keep.owned = {"zones.png"};
+  io::AtomicOutputDir out(a.dir, keep);
   const Redrawn r = redraw_results_folder(
       a.dir, measure, flc, po, [&out](const std::string& name) { return out.path(name); }, picture_bar(quiet));
   out.commit();

@@ -755,7 +755,7 @@ PlotData plot_data(ResultsFolder folder, StrainMeasure measure) {
   d.units = units_of(folder.summary);
   d.fibre_angles = fibre_angles_of(folder.summary);
   d.measure = measure;
-  d.marks = mark_strains(folder.strains, measure);
+  d.marks = assessed_mark_strains(folder, measure);
   d.summary = std::move(folder.summary);
   d.has_surfaces = folder.has_surfaces;
   d.undeformed = std::move(folder.undeformed);
@@ -899,6 +899,20 @@ PlotSummary write_pictures(const PlotData& r, const PlotOptions& o,
   return summary;
 }
 
+bool zones_belong_to(const nlohmann::json& summary, const FormingLimitCurve& flc, StrainMeasure measure) {
+  if (!summary.is_object() || !summary.contains("forming_limit")) return false;
+  const nlohmann::json& f = summary["forming_limit"];
+  if (!f.is_object() || f.value("measure", std::string()) != measure_word(measure)) return false;
+  const auto points = f.find("curve_points");
+  if (points == f.end() || !points->is_object()) return false;
+  try {
+    return points->at("minor").get<std::vector<double>>() == flc.minor &&
+           points->at("major").get<std::vector<double>>() == flc.major;
+  } catch (const nlohmann::json::exception&) {
+    return false;  // a summary edited by hand: treat as another curve
+  }
+}
+
 Redrawn redraw_results_folder(const std::string& dir, StrainMeasure measure,
                               const std::optional<FormingLimitCurve>& flc, const PlotOptions& options,
                               const std::function<std::string(const std::string&)>& out_path,
@@ -906,8 +920,13 @@ Redrawn redraw_results_folder(const std::string& dir, StrainMeasure measure,
   ResultsFolder folder = read_results_folder(dir);
   Redrawn out;
   if (flc) {
-    out.margins = flc_margins(*flc, mark_strains(folder.strains, measure), measure);
-    write_strains_with_margin(folder, out_path("strains.csv"), *out.margins);
+    out.margins = flc_margins(*flc, assessed_mark_strains(folder, measure), measure);
+    // The zones of gsa analyse belong to its curve: kept with the same curve, not shown
+    // beside another one (the caller drops zones.png; summary.json keeps them, naming
+    // their curve).
+    const bool same = zones_belong_to(folder.summary, *flc, measure);
+    write_strains_with_margin(folder, out_path("strains.csv"), *out.margins, same);
+    if (!same && folder.summary.is_object()) folder.summary.erase("forming_limit");
   }
   PlotData data = plot_data(std::move(folder), measure);
   data.flc = flc;

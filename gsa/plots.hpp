@@ -106,6 +106,11 @@ struct Redrawn {
   PlotSummary pictures;
   std::optional<FlcMargins> margins;  // with a curve
 };
+// Whether the forming-limit assessment that `gsa analyse` put in `summary` (its zones) was
+// made with this curve (the same points) in this measure; a redraw with another curve or
+// measure drops those zones (zones.png, the report's counts) instead of showing them beside it.
+bool zones_belong_to(const nlohmann::json& summary, const FormingLimitCurve& flc, StrainMeasure measure);
+
 Redrawn redraw_results_folder(const std::string& dir, StrainMeasure measure,
                               const std::optional<FormingLimitCurve>& flc, const PlotOptions& options,
                               const std::function<std::string(const std::string&)>& out_path,

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
@@ -85,7 +86,37 @@ MarkStrains mark_strains(const io::CsvTable& t, StrainMeasure m) {
   return out;
 }
 
-void write_strains_with_margin(const ResultsFolder& folder, const std::string& out, const FlcMargins& margins) {
+MarkStrains assessed_mark_strains(const ResultsFolder& folder, StrainMeasure m) {
+  MarkStrains out = mark_strains(folder.strains, m);
+  const io::CsvTable& t = folder.strains;
+  const auto c1 = t.find_column("mid_major"), c2 = t.find_column("mid_minor");
+  const nlohmann::json& s = folder.summary;
+  if (!c1 || !c2 || !s.is_object() || !s.contains("mid_surface") || !s["mid_surface"].is_object()) return out;
+  const std::string written = s["mid_surface"].value("measure", std::string());
+  std::optional<StrainMeasure> from;
+  for (StrainMeasure k : {StrainMeasure::kTrue, StrainMeasure::kEngineering, StrainMeasure::kLagrangian})
+    if (measure_word(k) == written) from = k;
+  if (!from)
+    throw InputError(folder.dir + "/summary.json: mid_surface.measure '" + written +
+                     "' is not a strain measure (true, engineering, lagrangian)");
+  // A principal strain in one measure to the other through its stretch.
+  auto convert = [&](double e) {
+    if (!std::isfinite(e)) return e;
+    const double l = *from == StrainMeasure::kTrue          ? std::exp(e)
+                     : *from == StrainMeasure::kEngineering ? 1.0 + e
+                                                            : std::sqrt(1.0 + 2.0 * e);
+    return strain_of_stretch(l, m);
+  };
+  for (std::size_t row = 0; row < t.n_rows() && row < out.major.size(); ++row) {
+    if (!std::isfinite(out.major[row])) continue;  // not analysed
+    out.major[row] = convert(t.number(row, *c1, true));
+    out.minor[row] = convert(t.number(row, *c2, true));
+  }
+  return out;
+}
+
+void write_strains_with_margin(const ResultsFolder& folder, const std::string& out, const FlcMargins& margins,
+                               bool keep_zones) {
   const io::CsvTable& t = folder.strains;
   // Keep the leading comment lines of the original file (but an earlier margin's).
   std::vector<std::string> comments;
@@ -95,27 +126,44 @@ void write_strains_with_margin(const ResultsFolder& folder, const std::string& o
     while (std::getline(in, line)) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
       if (line.rfind('#', 0) != 0) break;
-      if (line.rfind("# flc_margin", 0) == 0 || line.rfind("# flc_radial_margin", 0) == 0) continue;
+      if (line.rfind("# flc_margin", 0) == 0 || (!keep_zones && line.rfind("# flc_radial_margin", 0) == 0)) continue;
       comments.push_back(line);
     }
   }
+  // The margin goes where it was when the zones stay (same columns as gsa analyse wrote),
+  // else last; the zones of an earlier curve go with it (gsa analyse writes them anew).
+  constexpr std::size_t kMargin = static_cast<std::size_t>(-1);
   std::vector<std::string> header;
   std::vector<std::size_t> keep;
-  for (std::size_t c = 0; c < t.n_columns(); ++c)
-    // The assessment of an earlier curve goes with it (gsa analyse writes it anew).
-    if (t.names()[c] != "flc_margin" && t.names()[c] != "flc_radial_margin" && t.names()[c] != "zone") {
-      header.push_back(t.names()[c]);
+  bool placed = false;
+  for (std::size_t c = 0; c < t.n_columns(); ++c) {
+    const std::string& name = t.names()[c];
+    if (name == "flc_margin") {
+      if (!keep_zones) continue;
+      placed = true;
+      header.push_back(name);
+      keep.push_back(kMargin);
+    } else if (keep_zones || (name != "flc_radial_margin" && name != "zone")) {
+      header.push_back(name);
       keep.push_back(c);
     }
-  header.push_back("flc_margin");
+  }
+  if (!placed) {
+    header.push_back("flc_margin");
+    keep.push_back(kMargin);
+  }
   io::write_file_atomic(out, [&](std::ostream& os) {
     for (const auto& c : comments) os << c << "\n";
     os << flc_margin_comment(margins) << "\n";
     io::CsvWriter w(os, header);
     for (std::size_t r = 0; r < t.n_rows(); ++r) {
       w.begin_row();
-      for (std::size_t c : keep) w.add(t.cell(r, c));
-      w.add(r < margins.margin.size() ? margins.margin[r] : std::nan(""));
+      for (std::size_t c : keep) {
+        if (c == kMargin)
+          w.add(r < margins.margin.size() ? margins.margin[r] : std::nan(""));
+        else
+          w.add(t.cell(r, c));
+      }
       w.end_row();
     }
   });

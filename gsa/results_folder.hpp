@@ -34,9 +34,16 @@ std::string case_name_of(const nlohmann::json& summary, const std::string& dir);
 // Major and minor strain per row of strains.csv in one measure (NaN unless status ok).
 // Throws sf::InputError when the measure's columns are missing or hold bad numbers.
 MarkStrains mark_strains(const io::CsvTable& strains, StrainMeasure m);
+// The strains the forming limit is assessed on, in measure m: the mid-surface strains
+// (mid_major, mid_minor, in the measure summary.json's mid_surface names) when gsa analyse
+// wrote them (--thickness), else the marked face's, as gsa analyse does.
+MarkStrains assessed_mark_strains(const ResultsFolder& folder, StrainMeasure m);
 
-// Writes the folder's strains.csv to `out` with a last column flc_margin (replacing one
-// already there), keeping its comment lines and adding flc_margin_comment().
-void write_strains_with_margin(const ResultsFolder& folder, const std::string& out, const FlcMargins& margins);
+// Writes the folder's strains.csv to `out` with the column flc_margin (new values),
+// keeping its comment lines and adding flc_margin_comment(). With keep_zones (the same
+// curve and measure as gsa analyse's assessment) the columns stay as they were, the zones
+// included; otherwise flc_radial_margin and zone are left out and flc_margin goes last.
+void write_strains_with_margin(const ResultsFolder& folder, const std::string& out, const FlcMargins& margins,
+                               bool keep_zones = false);
 
 }  // namespace sf::gsa

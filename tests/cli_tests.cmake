@@ -326,3 +326,27 @@ foreach(doc IN LISTS sf_doc_files)
     sf_gsa_cli_test(docs.${doc_id}.L${pending_line} COMMAND ${args} ${extra})
   endforeach()
 endforeach()
+
+# gsa plot with another forming limit curve: the zones of gsa analyse's curve are not
+# carried over (zones.png dropped, the report without the old counts).
+set(sf_zones ${SF_CLI_DIR}/zones)
+sf_gsa_cli_test(zones_analyse
+  COMMAND analyse data/gsa/dome/grid.csv --thickness 1 --flc-n 0.22 --out ${sf_zones}
+  REMOVE ${sf_zones}
+  EXISTS "${sf_zones}/zones.png"
+  FIXTURES_SETUP gsa_zones)
+sf_gsa_cli_test(zones_plot_other_curve
+  COMMAND plot ${sf_zones} --flc data/flc/illustrative.csv
+  ABSENT "${sf_zones}/zones.png"
+  EXISTS "${sf_zones}/report.html"
+  FIXTURES_REQUIRED gsa_zones)
+sf_gsa_cli_test(zones_analyse_table
+  COMMAND analyse data/gsa/dome/grid.csv --thickness 1 --flc data/flc/illustrative.csv --out ${sf_zones}_table
+  REMOVE ${sf_zones}_table
+  EXISTS "${sf_zones}_table/zones.png"
+  FIXTURES_SETUP gsa_zones_table)
+sf_gsa_cli_test(zones_plot_same_curve
+  COMMAND plot ${sf_zones}_table --flc data/flc/illustrative.csv
+  EXISTS "${sf_zones}_table/zones.png"
+  STDERR "120 of 441 marks beyond"
+  FIXTURES_REQUIRED gsa_zones_table)

@@ -538,7 +538,10 @@ TEST_F(GsaCli, FormingLimitMarginIsWrittenWithoutPictures) {
   EXPECT_EQ(entries(folder).count("report.html"), 0u);
   const Strains s = read_strains(folder);
   ASSERT_TRUE(s.t.has_column("flc_margin"));
-  EXPECT_EQ(s.t.column_index("flc_margin"), s.t.n_columns() - 1);
+  // The margin, then the assessment's radial margin and zone, last (docs/usage.md).
+  EXPECT_EQ(s.t.column_index("flc_margin"), s.t.n_columns() - 3);
+  EXPECT_EQ(s.t.column_index("flc_radial_margin"), s.t.n_columns() - 2);
+  EXPECT_EQ(s.t.column_index("zone"), s.t.n_columns() - 1);
   EXPECT_THAT(read_text(folder + "/strains.csv"), HasSubstr("# flc_margin: "));
   for (const auto& [id, row] : s.row) {
     // The curve's major strain at the mark's minor true strain, minus its major true strain.

@@ -236,16 +236,26 @@ TEST(GsaPlots, PicturesFromMemoryEqualPicturesRedrawnFromTheFolder) {
     ASSERT_TRUE(fs::exists(again / name));
     EXPECT_TRUE(read_text(dir / name) == read_text(again / name)) << "differs";
   }
-  // strains.csv: the same margins; `gsa analyse` also wrote the zones (flc_radial_margin,
-  // zone), which a redraw with a curve leaves out (docs/usage.md, "Redrawing").
+  // strains.csv: the same columns and margins; redrawn with the curve `gsa analyse` assessed
+  // with, the zones (flc_radial_margin, zone) stay (docs/usage.md, "Redrawing").
   const io::CsvTable a = io::read_csv((dir / "strains.csv").string()),
                      b = io::read_csv((again / "strains.csv").string());
   ASSERT_EQ(a.n_rows(), b.n_rows());
-  EXPECT_TRUE(a.has_column("zone"));
-  EXPECT_FALSE(b.has_column("zone"));
+  EXPECT_EQ(a.names(), b.names());
+  EXPECT_TRUE(b.has_column("zone"));
   for (std::size_t row = 0; row < a.n_rows(); ++row)
     EXPECT_EQ(a.cell(row, a.column_index("flc_margin")), b.cell(row, b.column_index("flc_margin")));
   EXPECT_NE(read_text(dir / "report.html").find("marks beyond the curve"), std::string::npos);
+  // Redrawn with another curve: the zones of the first go (strains.csv, the report's counts).
+  const fs::path other = dir.parent_path() / "memory_other_flc.csv";
+  std::ofstream(other) << "minor,major\n-0.3,0.35\n0,0.12\n0.3,0.3\n";
+  const fs::path third = test_dir("memory_other");
+  redraw_results_folder(dir.string(), StrainMeasure::kTrue, read_flc(other.string()), small_pictures(), into(third));
+  const io::CsvTable c = io::read_csv((third / "strains.csv").string());
+  EXPECT_FALSE(c.has_column("zone"));
+  EXPECT_FALSE(c.has_column("flc_radial_margin"));
+  EXPECT_EQ(c.names().back(), "flc_margin");
+  EXPECT_EQ(read_text(third / "report.html").find("Forming-limit assessment"), std::string::npos);
 }
 
 TEST(GsaPlots, FibreModeDrawsShearAngleAndFibres) {

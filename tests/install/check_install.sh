@@ -51,7 +51,9 @@ echo "installed simform check: ok"
 grep -q '^\.SS "gsa analyse"' "$prefix/share/man/man1/gsa.1" || fail "gsa.1 has no 'gsa analyse' section"
 grep -q 'batch' "$prefix/share/man/man1/gsa.1" || fail "gsa.1 does not mention gsa batch"
 if command -v man >/dev/null; then
-  MANWIDTH=100 man -l "$prefix/share/man/man1/gsa.1" 2>"$tmp/man.err" | grep -q -- '--out' ||
+  # Into a file first: with pipefail, grep -q quitting early would fail `man` with SIGPIPE.
+  MANWIDTH=100 man -l "$prefix/share/man/man1/gsa.1" >"$tmp/man.txt" 2>"$tmp/man.err" || true
+  grep -q -- '--out' "$tmp/man.txt" ||
     { cat "$tmp/man.err"; fail "man -l gsa.1 does not render the options"; }
   echo "man -l gsa.1 renders: ok"
 fi

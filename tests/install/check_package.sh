@@ -43,18 +43,20 @@ depends=$(dpkg-deb -f "$deb" Depends)
 echo "Depends: $depends"
 [ -n "$depends" ] || fail "the package lists no dependencies"
 # Runtime packages only: no -dev package, no compiler, no build tool.
-if echo "$depends" | tr ',' '\n' | grep -Eq -- '-dev( |$|\()|(^| )(g\+\+|cmake|ninja-build)( |$)'; then
+# Here-strings, not `echo | grep -q`: with pipefail, grep -q quitting at its first match can
+# kill echo with SIGPIPE on a long listing and fail the check at random.
+if grep -Eq -- '-dev( |$|\()|(^| )(g\+\+|cmake|ninja-build)( |$)' <<<"${depends//,/$'\n'}"; then
   fail "build-time packages in Depends: $depends"
 fi
 for want in libc6 libstdc++6; do
-  echo "$depends" | grep -q "$want" || fail "Depends lacks $want"
+  grep -q "$want" <<<"$depends" || fail "Depends lacks $want"
 done
-echo "$depends" | grep -Eq 'libvtk9' || fail "Depends lacks the VTK runtime library package"
-echo "$depends" | grep -Eq 'libcholmod|libsuitesparse' || fail "Depends lacks the CHOLMOD runtime library package"
+grep -Eq 'libvtk9' <<<"$depends" || fail "Depends lacks the VTK runtime library package"
+grep -Eq 'libcholmod|libsuitesparse' <<<"$depends" || fail "Depends lacks the CHOLMOD runtime library package"
 contents=$(dpkg-deb -c "$deb")
 for f in ./usr/bin/gsa ./usr/bin/simform ./usr/share/man/man1/gsa.1 ./usr/share/bash-completion/completions/gsa \
          ./usr/share/sheetform/data/gsa/dome/grid.csv; do
-  echo "$contents" | grep -q " $f\$" || echo "$contents" | grep -q " $f " || fail "$f is not in the package"
+  grep -q " $f\$" <<<"$contents" || grep -q " $f " <<<"$contents" || fail "$f is not in the package"
 done
 echo "package.deb: control file and contents ok"
 [ "$mode" = dpkg ] || exit 0

@@ -66,12 +66,38 @@ std::string f32(const std::vector<double>& v) {
 }
 std::string u32(const std::vector<std::uint32_t>& v) { return base64(v.data(), v.size() * sizeof(std::uint32_t)); }
 
-nlohmann::json range_of(const std::vector<double>& v) {
+// Smallest colour range of a field with this unit, as the PNG contour plots use (gsa/plots.cpp):
+// 0.01 of strain or stretch, 1 % or 1 degree. A nearly uniform field then shows as one or two
+// colours, not as its noise stretched over the whole bar. Other units (lengths): none.
+double min_span_of(const std::string& unit) {
+  if (unit == "-") return 0.01;
+  if (unit == "%" || unit == "\xC2\xB0") return 1.0;
+  return 0.0;
+}
+
+// {lo, hi} of the finite values; {null, null} when there are none.
+nlohmann::json data_range_of(const std::vector<double>& v) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (double x : v)
     if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
   if (!(lo <= hi)) return {nullptr, nullptr};
   return {lo, hi};
+}
+
+// The colour range: the data's, widened about its middle to at least `min_span`.
+nlohmann::json colour_range_of(const nlohmann::json& data_range, double min_span) {
+  if (data_range[0].is_null()) return data_range;
+  const double lo = data_range[0].get<double>(), hi = data_range[1].get<double>();
+  if (hi - lo >= min_span) return data_range;
+  const double mid = 0.5 * (lo + hi);
+  return {mid - 0.5 * min_span, mid + 0.5 * min_span};
+}
+
+// The "range" (colour) and "data_range" (values) keys of a field.
+void put_ranges(nlohmann::json& f, const std::vector<double>& v, const std::string& unit) {
+  const nlohmann::json data = data_range_of(v);
+  f["range"] = colour_range_of(data, min_span_of(unit));
+  f["data_range"] = data;
 }
 
 const io::FieldArray* field(const io::PolyMesh& m, const std::string& name, int components) {
@@ -260,7 +286,9 @@ nlohmann::json surface_json(const PlotData& d, const Tessellation& t, const View
     if (!f || f->values.size() != static_cast<std::size_t>(d.deformed.n_points())) continue;
     const std::vector<double> v = gather(*f, s.used);
     const auto [label, unit] = label_of(name, d.units);
-    fields.push_back({{"key", name}, {"label", label}, {"unit", unit}, {"range", range_of(v)}, {"data", f32(v)}});
+    nlohmann::json x = {{"key", name}, {"label", label}, {"unit", unit}, {"data", f32(v)}};
+    put_ranges(x, v, unit);
+    fields.push_back(std::move(x));
     st.surface_fields.push_back(name);
   }
   j["fields"] = std::move(fields);
@@ -428,7 +456,7 @@ nlohmann::json marks_json(const PlotData& d, const Tessellation& t, const io::Cs
     const auto [label, unit] = label_of(c.name, d.units);
     nlohmann::json x = {{"key", c.name}, {"label", label}, {"unit", unit}, {"data", f32(c.values)}};
     if (c.categories.empty())
-      x["range"] = range_of(c.values);
+      put_ranges(x, c.values, unit);
     else
       x["categories"] = c.categories;
     jc.push_back(std::move(x));

@@ -91,16 +91,18 @@
     var nv = S.n_vertices;
     var fields = [];  // {key, label, unit, range, values, where: 'surface'|'marks', categories}
     S.fields.forEach(function (f) {
-      fields.push({key: f.key, label: f.label, unit: f.unit, range: f.range, values: decode(f.data, Float32Array),
-                   where: 'surface'});
+      fields.push({key: f.key, label: f.label, unit: f.unit, range: f.range, dataRange: f.data_range || null,
+                   values: decode(f.data, Float32Array), where: 'surface'});
     });
+    var surfaceKeys = {};
+    S.fields.forEach(function (f) { surfaceKeys[f.key] = true; });
     var markPosU = null, markPosD = null, markCols = [];
     if (M && M.n > 0) {
       markPosU = decode(M.pos_u, Float32Array);
       markPosD = decode(M.pos_d, Float32Array);
       M.columns.forEach(function (c) {
-        var f = {key: c.key, label: c.label, unit: c.unit, range: c.range || null, values: decode(c.data, Float32Array),
-                 where: 'marks', categories: c.categories || null};
+        var f = {key: c.key, label: c.label, unit: c.unit, range: c.range || null, dataRange: c.data_range || null,
+                 values: decode(c.data, Float32Array), where: 'marks', categories: c.categories || null};
         markCols.push(f);
         fields.push(f);
       });
@@ -383,6 +385,16 @@
         });
         box.appendChild(ticks);
         legend.appendChild(box);
+        // A nearly uniform field: the bar is widened to the smallest range worth colouring
+        // (as in the PNG plots), so say what the values span.
+        var d = f.dataRange;
+        if (d && d[0] !== null && lo !== null && (d[0] > lo || d[1] < hi)) {
+          var u = document.createElement('div');
+          u.className = 'gv-uniform';
+          u.textContent = (d[0] === d[1] ? 'uniform: ' + fmt(d[0]) : 'nearly uniform: ' + fmt(d[0]) + ' to ' + fmt(d[1])) +
+              (f.unit && f.unit !== '-' ? ' ' + f.unit : '');
+          legend.appendChild(u);
+        }
       }
       if (state.arrows && arrowScale > 0) {
         var a = document.createElement('div');
@@ -483,13 +495,24 @@
           var hm = document.createElement('b');
           hm.textContent = 'Nearest mark ' + M.ids[best] + ', ' + fmt(Math.sqrt(bestD)) + ' ' + D.units + ' away';
           info.appendChild(hm);
-          var tm = document.createElement('table');
+          // The strains, status and assessment first; the other columns (directions, fit
+          // positions, residuals) folded away, so the panel stays short.
+          var tm = document.createElement('table'), more = document.createElement('table'), nMore = 0;
           markCols.forEach(function (f) {
             var v = f.values[best];
-            row(tm, f.label, f.categories ? (isFinite(v) ? f.categories[Math.round(v)] : '\u2013')
-                                          : fmt(v) + (f.unit && f.unit !== '-' ? ' ' + f.unit : ''));
+            var main = surfaceKeys[f.key] || /^(status|zone|flag|flc_margin|mid_major|mid_minor|thickness_)/.test(f.key);
+            if (!main) ++nMore;
+            row(main ? tm : more, f.label, f.categories ? (isFinite(v) ? f.categories[Math.round(v)] : '\u2013')
+                                                        : fmt(v) + (f.unit && f.unit !== '-' ? ' ' + f.unit : ''));
           });
           info.appendChild(tm);
+          if (nMore > 0) {
+            var det = document.createElement('details'), sum = document.createElement('summary');
+            sum.textContent = nMore + ' more values of this mark';
+            det.appendChild(sum);
+            det.appendChild(more);
+            info.appendChild(det);
+          }
         }
       }
       info.style.display = 'block';

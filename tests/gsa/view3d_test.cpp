@@ -173,7 +173,9 @@ TEST(GsaView3d, EveryColumnOfStrainsCsvIsOffered) {
   int row = 0;
   while (std::getline(in, line)) {
     if (!line.empty() && line[0] != '#')
-      line += row++ == 0 ? ",thickness_mm,zone" : row % 2 ? ",0.9,safe" : ",0.8,marginal";
+      line += row++ == 0 ? ",thickness_mm,zone,uniform_pct,near_strain"
+              : row % 2  ? ",0.9,safe,5,0.2031"
+                         : ",0.8,marginal,5,0.2029";
     text += line + "\n";
   }
   const io::CsvTable extended = io::read_csv_string(text, "strains.csv");
@@ -189,6 +191,27 @@ TEST(GsaView3d, EveryColumnOfStrainsCsvIsOffered) {
     if (c["key"] == "thickness_mm") {
       EXPECT_EQ(c["unit"], "mm");
       EXPECT_NEAR(c["range"][0].get<double>(), 0.8, 1e-6);
+    }
+    // A (nearly) uniform field is coloured over the smallest range worth colouring, as in
+    // the PNG plots (1 %, 0.01 of strain), not over its noise; its own span is kept beside.
+    if (c["key"] == "uniform_pct") {
+      EXPECT_NEAR(c["range"][0].get<double>(), 4.5, 1e-6);
+      EXPECT_NEAR(c["range"][1].get<double>(), 5.5, 1e-6);
+      EXPECT_NEAR(c["data_range"][0].get<double>(), 5.0, 1e-6);
+      EXPECT_NEAR(c["data_range"][1].get<double>(), 5.0, 1e-6);
+    }
+    if (c["key"] == "near_strain") {
+      // A column of unknown name has no unit: no widening.
+      EXPECT_NEAR(c["range"][1].get<double>() - c["range"][0].get<double>(), 0.0002, 1e-6);
+    }
+  }
+  for (const auto& sf : j["surface"]["fields"]) {
+    const double span = sf["range"][1].get<double>() - sf["range"][0].get<double>();
+    if (sf["unit"] == "-") {
+      EXPECT_GE(span, 0.01 - 1e-12) << sf["key"];
+    }
+    if (sf["unit"] == "%") {
+      EXPECT_GE(span, 1.0 - 1e-12) << sf["key"];
     }
   }
   // A small budget leaves out the directions first, and says so.

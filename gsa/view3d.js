@@ -391,7 +391,8 @@
         if (d && d[0] !== null && lo !== null && (d[0] > lo || d[1] < hi)) {
           var u = document.createElement('div');
           u.className = 'gv-uniform';
-          u.textContent = (d[0] === d[1] ? 'uniform: ' + fmt(d[0]) : 'nearly uniform: ' + fmt(d[0]) + ' to ' + fmt(d[1])) +
+          var a = fmt(d[0]), b = fmt(d[1]);
+          u.textContent = (a === b ? 'uniform: ' + a : 'nearly uniform: ' + a + ' to ' + b) +
               (f.unit && f.unit !== '-' ? ' ' + f.unit : '');
           legend.appendChild(u);
         }

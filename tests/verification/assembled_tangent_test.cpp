@@ -14,8 +14,9 @@
 //   * the same for each interaction alone (punch, die, holder, each ply-ply pass),
 // relative to the largest entry of each. A term left out of the contact tangent (the
 // tool's curvature, the moving foot point, friction's rate or pressure terms, the second
-// pass's master columns) shows as an error of 1e-3 or more; the complete tangent measures
-// 1e-9 .. 1e-7.
+// pass's master columns) shows as an error of 1e-3 or more (measured: without the viscous
+// taper's term every ply-ply pass 3.6e-3 .. 8.8e-3; without the tool's curvature term the
+// punch 4.0e-2, the die 4.9e-4); the complete tangent measures 1e-10 .. 4e-9.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -217,11 +218,12 @@ TEST(AssembledTangent, MatchedDieBendInContactAgreesWithFiniteDifferences) {
   // The whole model, as the solver assembles it.
   const auto eval = [&](const VecX& x, bool tangent) { return model_at(m, x, b.context, tangent); };
   const Sample s = eval(b.x, true);
-  // Every third column (the interactions' own columns are all checked above): the
-  // elements' kernels have their own FD tests, and each column costs two assemblies.
+  // Every fifth column (the interactions' own columns are all checked above; 12 dofs a
+  // node, so every parameter and coordinate is sampled): the elements' kernels have their
+  // own FD tests, and each column costs two assemblies.
   std::vector<Index> cols;
   for (const Index j : touched(s.stiffness))
-    if (j % 3 == 0) cols.push_back(j);
+    if (j % 5 == 0) cols.push_back(j);
   const double e = fd_error(eval, b.x, cols);
   std::printf("[ measured ] whole model: FD tangent error %.2e (largest entry %.3g N/mm)\n", e, max_abs(s.stiffness));
   EXPECT_LT(e, kFdRel);

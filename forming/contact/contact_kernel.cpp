@@ -125,11 +125,13 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   if (!k.tool) dw -= rates.master_d1 * dzeta.row(0) + rates.master_d2 * dzeta.row(1);
   const MatX dvt = -n.dot(rates.relative) * dn - n * (rates.relative.transpose() * dn) + P * dw;
   // (J^T v_T) dc/du.
-  if (law.coulomb > 0.0) {
-    Eigen::RowVectorXd dp(m);  // -S dg/du
+  if (law.coulomb > 0.0 || law.viscous_slope != 0.0) {
+    Eigen::RowVectorXd dg(m);  // dg/du
     for (int cc = 0; cc < k.n; ++cc)
-      dp.segment<3>(3 * cc) = (-S * k.phi[static_cast<std::size_t>(cc)]) * k.gap_gradient.transpose();
-    const Eigen::RowVectorXd dc = (law.coulomb / s) * dp - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
+      dg.segment<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.gap_gradient.transpose();
+    // dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du, dp/du = -S dg/du.
+    Eigen::RowVectorXd dc = law.viscous_slope * dg;
+    if (law.coulomb > 0.0) dc += (-law.coulomb * S / s) * dg - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
     out.stiffness.noalias() += w * jt_vt * dc;
   }
   // c (dJ^T/du) v_T (body: the master functions move with zeta) and c J^T dv_T/du.

@@ -27,14 +27,16 @@
 //   stiffness  tool: w phi_a phi_c (S n (dg/dx)^T - p dn/dx);
 //              body: w (S dg dg^T - p d2g),   S = the law's stiffness where closed.
 //   (Force along n: for a meshed tool n is not dg/dx, and the tangent is unsymmetric.)
-// Friction: v_T = P v_rel (P = I - n n^T), c = c_f + mu p / s, s = sqrt(|v_T|^2 + eps^2),
+// Friction: v_T = P v_rel (P = I - n n^T), c = c_v + mu p / s, s = sqrt(|v_T|^2 + eps^2),
+//   c_v = c_f h(g) the viscous coefficient where the layer is engaged,
 //   force  w c J^T v_T,
 //   stiffness  w [ (J^T v_T) dc/du + c (dJ^T/du) v_T + c J^T dv_T/du ],
 //     dv_T/du = -(n . v_rel) dn/du - n (v_rel^T dn/du) + P dv_rel/du,
 //     dv_rel/du = J / dt (quasi-static rates; 0 in dynamics) - sum_a m_a dzeta_a/du,
 //       m_a = d v_m / d zeta_a (the master's velocity gradient along its face),
 //     (dJ^T/du v_T)_((a,i), col) = -sum_a rho_a,a v_T,i dzeta_a/du,
-//     dc/du = (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du,  dp/du = -S dg/du;
+//     dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du,  dp/du = -S dg/du,
+//       c_v' = d(c_f h)/dg, the engagement taper of the viscous layer (PointLaw);
 //   damping (dynamic runs)  w [ (J^T v_T) dc/dv + c J^T P J ],  dc/dv = -(mu p/s^3) v_T^T J.
 // Every term is tested against central finite differences of the force
 // (tests/verification/contact_tangent_test.cpp).
@@ -74,7 +76,8 @@ struct PointRates {
 
 struct PointLaw {
   NormalResponse normal;
-  double viscous = 0.0;         // c_f where engaged, else 0
+  double viscous = 0.0;         // c_f h(g): c_f where engaged, tapering to 0 (surface_contact.hpp)
+  double viscous_slope = 0.0;   // d viscous / d g, N s/mm^4 (<= 0 in the taper, else 0)
   double coulomb = 0.0;         // mu
   double stick_velocity = 0.0;  // eps, mm/s
   bool friction() const { return viscous > 0.0 || coulomb > 0.0; }

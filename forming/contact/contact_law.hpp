@@ -24,7 +24,9 @@
 //   c = c_f [g <= g_v]  +  mu p / sqrt(|v_T|^2 + eps^2)
 // viscous inter-ply slip tau = c_f v (c_f = eta / theta: resin viscosity over the
 // inter-layer thickness; of order 2e7 Pa s/m = 0.02 N s/mm^3 in mm-N-s units), acting
-// where the gap is below the viscous layer's engage gap g_v (the plies are together);
+// where the gap is below the viscous layer's engage gap g_v (the plies are together;
+// c_f tapers smoothly to 0 over one band width delta beyond g_v: c_f h, h = 1 - 3 s^2 + 2 s^3,
+// s = (g - g_v) / delta, so the residual has no jump where a gap crosses g_v);
 // Coulomb friction tau = mu p regularised below the stick velocity eps (a stiff viscous
 // law there: per quasi-static step of length dt a stick stiffness mu p / (eps dt) per
 // unit area); both together = the combined (hydrodynamic) law. Rates come from the

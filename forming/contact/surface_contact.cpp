@@ -160,7 +160,19 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       }
       PointLaw law;
       law.normal = normal_response(options_.normal, k.gap, lambda_[id], band);
-      law.viscous = k.gap <= engage ? options_.friction.viscous : 0.0;
+      // The viscous layer: engaged up to the engage gap g_v, tapering smoothly (C1) to
+      // nothing over one band width beyond it, so a point whose gap crosses g_v does
+      // not switch its friction on and off between Newton iterates (a jump in the
+      // residual the tangent cannot see).
+      if (options_.friction.viscous > 0.0) {
+        const double s = (k.gap - engage) / band;
+        if (s <= 0.0) {
+          law.viscous = options_.friction.viscous;
+        } else if (s < 1.0) {
+          law.viscous = options_.friction.viscous * (1.0 - s * s * (3.0 - 2.0 * s));
+          law.viscous_slope = -options_.friction.viscous * 6.0 * s * (1.0 - s) / band;
+        }
+      }
       law.coulomb = options_.friction.coulomb;
       law.stick_velocity = options_.friction.stick_velocity;
       PointRates pr;

@@ -255,7 +255,21 @@ LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, Vec
     return Predicted::kFailed;
   }
   const VecX dxf = solver_->solve(rhs);
-  xt = x_new + free_.expand(dxf);
+  const VecX dx = free_.expand(dxf);
+  xt = x_new + dx;
+  // The predictor is a Newton step from x_new (the tools and prescribed dofs already at
+  // their new places) and is damped like the corrector's steps: linearised at the old
+  // state, with a tool a whole increment into a ply, the full step can overshoot far
+  // (a ply of near-inextensible fibres pushed into a curve it cannot take without
+  // stretch: |r| 1e3 N against forces of a few N in the matched-die bend).
+  if (options_.line_search && dxf.allFinite()) {
+    std::pair<double, double> at_step{0.0, 0.0};
+    const double alpha = line_search(lam_new, x_new, dx, dxf, -rhs, rhs.norm(), st.scale, rec, at_step);
+    if (alpha < 0.0) return Predicted::kFailed;
+    xt = x_new + alpha * dx;
+    static const bool trace = std::getenv("SF_NEWTON_TRACE") != nullptr;
+    if (trace) std::fprintf(stderr, "newton: lambda %.6g predictor |r| %.3e step %.3g\n", lam_new, rhs.norm(), alpha);
+  }
   return Predicted::kOk;
 }
 
@@ -330,6 +344,20 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       return;
     }
     const VecX dx = free_.expand(dxf);
+    // SF_NEWTON_CHECK=1 (with the trace): the tangent along the correction against a
+    // central difference of the residual there, and the linear solve's own residual.
+    static const bool check = trace && std::getenv("SF_NEWTON_CHECK") != nullptr;
+    if (check && dxf.size() > 0) {
+      const double h = 1e-6 / std::max(dxf.lpNorm<Eigen::Infinity>(), 1e-300);
+      const Residual kd = evaluate(lam_new, xt, false, &dx);
+      const Residual rp = evaluate(lam_new, xt + h * dx, false), rm = evaluate(lam_new, xt - h * dx, false);
+      if (kd.a.ok && rp.a.ok && rm.a.ok) {
+        const VecX kdf = free_.restrict(kd.a.tangent_times);
+        const VecX fd = free_.restrict(rp.residual - rm.residual) / (2 * h);
+        std::fprintf(stderr, "newton check: |dx| %.3e  |K dx + r| / |r| %.2e  |K dx - FD| / |K dx| %.2e\n",
+                     dxf.lpNorm<Eigen::Infinity>(), (kdf + rf).norm() / rf.norm(), (kdf - fd).norm() / kdf.norm());
+      }
+    }
     // Round-off floor: a correction this small cannot reduce |r| further.
     if (dxf.size() == 0 || dxf.lpNorm<Eigen::Infinity>() <= kIncrementTolRel * length_scale_) {
       xt += dx;

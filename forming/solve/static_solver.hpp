@@ -11,6 +11,8 @@
 //
 // Newton: each load step starts with a predictor that moves the prescribed dofs to
 // their new values and solves K_ff dx_f = -r_f - K_fp dx_p (consistent linearisation),
+// damped by the line search below (the full predictor of a tool moved a whole increment
+// into a ply of near-inextensible fibres overshoots far),
 // then corrects with K_ff dx_f = -r_f until
 //   |r_f| <= max(residual_tol_abs, residual_tol_rel * force_scale),
 // force_scale = max(|f_int| over all dofs (includes the reactions), |lambda f_ext|),

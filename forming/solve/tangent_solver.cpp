@@ -34,10 +34,23 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
     double& to;
     ~AddTime() { to += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
   } timer{t0, profile.factorize_s};
+  const auto record = [&profile](const linalg::SolveReport& r) {
+    if (!r.reused_analysis) {
+      ++profile.analyses;
+      profile.analyse_s += r.analyze_seconds;
+    }
+    profile.n = static_cast<long>(r.n_rows);
+    profile.nnz = static_cast<long>(r.n_nonzeros);
+    profile.factor_nnz = r.factor_nonzeros;
+    profile.factor_flops = r.factor_flops;
+    profile.solver = linalg::to_string(r.used);
+    profile.ordering = r.ordering;
+  };
   if (spd_ && skip_cholesky_ > 0) {
     --skip_cholesky_;
   } else if (spd_) {
     const linalg::SolveReport& r = spd_->factorize(k);
+    record(r);
     if (r.ok()) {
       active_ = spd_.get();
       return r;
@@ -46,6 +59,7 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
   }
   if (spd_) ++n_indefinite_;
   const linalg::SolveReport& r = general_->factorize(k);
+  record(r);
   active_ = r.ok() ? general_.get() : nullptr;
   return r;
 }

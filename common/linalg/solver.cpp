@@ -239,6 +239,13 @@ class UmfpackLu : public Eigen::UmfPackLU<SparseMatrix> {
 
 class UmfpackBackend final : public Backend {
  public:
+  // UMFPACK's own choice: kDefault and kAmd use AMD (symmetric strategy) or COLAMD,
+  // kMetis METIS; kNesdis (CHOLMOD's) is not UMFPACK's, so METIS stands in for it.
+  void set_ordering(Ordering ordering) override {
+    lu_.umfpackControl()(UMFPACK_ORDERING) =
+        ordering == Ordering::kMetis || ordering == Ordering::kNesdis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+  }
+
   Outcome analyze(const SparseMatrix& a) override {
     lu_.analyzePattern(a);
     if (lu_.info() != Eigen::Success) {

@@ -59,11 +59,12 @@ bool solver_available(SolverKind kind);
 // ones), so a matrix stored as its lower triangle may be passed.
 bool reads_lower_triangle(SolverKind kind);
 
-// Fill-reducing ordering of the CHOLMOD back ends (the others use their own):
+// Fill-reducing ordering of the CHOLMOD and UMFPACK back ends (the Eigen ones use their own):
 //   kDefault  CHOLMOD's choice: AMD, and METIS as well when AMD's fill looks high
 //   kAmd      approximate minimum degree
 //   kMetis    METIS nested dissection (through CHOLMOD)
 //   kNesdis   CHOLMOD's nested dissection (METIS partitions, constrained minimum degree)
+// UMFPACK: kDefault and kAmd give its AMD / COLAMD, kMetis and kNesdis its METIS.
 enum class Ordering { kDefault, kAmd, kMetis, kNesdis };
 // "default", "amd", "metis", "nesdis".
 std::string to_string(Ordering ordering);
@@ -159,8 +160,8 @@ class LinearSolver {
   // success the status is kNotFactorized.
   const SolveReport& analyze_pattern(const SparseMatrix& a);
 
-  // Fill-reducing ordering for the next analysis (CHOLMOD back ends; ignored by the
-  // others). Drops the current analysis when it changes.
+  // Fill-reducing ordering for the next analysis (CHOLMOD and UMFPACK back ends; ignored by
+  // the Eigen ones). Drops the current analysis when it changes.
   void set_ordering(Ordering ordering);
   Ordering ordering() const;
 

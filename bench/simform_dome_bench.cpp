@@ -13,13 +13,16 @@
 //   peak resident memory (getrusage high-water mark).
 // A program that prints figures, not a timed test.
 //   build/bin/simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE]
-//                                [--ordering amd|metis|nesdis|default] [--factor-only]
+//                                [--ordering amd|metis|nesdis|default] [--factor-only] [--time-limit S]
 //   --quick       4 x 4 bricks a ply, 2 of the 36 steps (a smoke test)
 //   --elements N  N x N bricks a ply (the mid size: 10)
 //   --max-steps N stop cleanly after N steps (the full run can take long)
 //   --case FILE   another case (default: the [0,90]s dome)
 //   --ordering O  fill-reducing ordering of the Newton tangent's solver (default: the
 //                 solvers' own choice; forming/solve/tangent_solver.hpp)
+//   --time-limit S  after S seconds print the figures so far (a snapshot taken while the
+//                 solve runs) and stop with status 3: a size that does not finish a step
+//                 still reports where its time went
 //   --factor-only no run: the tangent of the flat start (contact pattern included: the
 //                 plies touch and the die and holder touch the stack) factorised by each
 //                 direct solver and ordering, printing nnz, fill, flops and seconds (the
@@ -33,6 +36,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
@@ -66,6 +70,27 @@ static double thread_cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// The per-iteration split and the linear-algebra line from a profile.
+static void print_split(const SolveProfile& p, double total, double cpu, long iterations) {
+  const double n_it = static_cast<double>(std::max(1L, iterations));
+  const double other = total - p.elements_s - p.contact_s - p.factorize_s - p.solve_s;
+  std::printf(
+      "total %.2f s; per Newton iteration: elements %.4f s, contact %.4f s, factorise %.4f s, solve %.4f s, "
+      "other %.4f s\n",
+      total, p.elements_s / n_it, p.contact_s / n_it, p.factorize_s / n_it, p.solve_s / n_it, other / n_it);
+  std::printf("processor time %.2f s (user + system, all threads; wall %.2f s)\n", cpu, total);
+  std::printf("shares: elements %.0f %%, contact %.0f %%, factorise %.0f %%, solve %.0f %%, other %.0f %%\n",
+              100 * p.elements_s / total, 100 * p.contact_s / total, 100 * p.factorize_s / total,
+              100 * p.solve_s / total, 100 * other / total);
+  std::printf(
+      "contact: evaluation (search, laws, local tangents) %.4f s, merge into the pattern %.4f s per iteration; %.0f "
+      "entries merged per assembly\n",
+      p.contact_eval_s / n_it, p.contact_merge_s / n_it,
+      static_cast<double>(p.contact_entries) / static_cast<double>(std::max(1L, p.assemblies)));
+  std::printf("linear: %s\n", solve_profile_linear_summary(p).c_str());
+  std::printf("peak memory %.0f MB\n", peak_mb());
 }
 
 // --factor-only: the start tangent through each solver and ordering.
@@ -136,6 +161,7 @@ int main(int argc, char** argv) {
   int max_steps = 0;
   int n_elements = 0;
   bool only_factor = false;
+  double time_limit = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -153,6 +179,12 @@ int main(int argc, char** argv) {
         TangentSolver::set_default_ordering(linalg::parse_ordering(argv[++i], "--ordering"));
       } catch (const std::exception& e) {
         std::fprintf(stderr, "simform_dome_bench: %s\n", e.what());
+        return 2;
+      }
+    } else if (a == "--time-limit" && i + 1 < argc) {
+      time_limit = std::atof(argv[++i]);
+      if (!(time_limit > 0.0)) {
+        std::fprintf(stderr, "simform_dome_bench: --time-limit: expected seconds > 0, found '%s'\n", argv[i]);
         return 2;
       }
     } else if (a == "--factor-only") {
@@ -199,6 +231,19 @@ int main(int argc, char** argv) {
     solve_profile().reset();
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = cpu_seconds();
+    if (time_limit > 0.0) {
+      // A watchdog: the profile is read while the solve writes it (a benchmark's snapshot).
+      std::thread([time_limit, t0, cpu0] {
+        std::this_thread::sleep_for(std::chrono::duration<double>(time_limit));
+        const SolveProfile snapshot = solve_profile();
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::printf("time limit %.0f s reached before the run ended; figures so far (%ld factorisations):\n",
+                    time_limit, snapshot.factorizations);
+        print_split(snapshot, wall, cpu_seconds() - cpu0, snapshot.factorizations);
+        std::fflush(stdout);
+        std::_Exit(3);
+      }).detach();
+    }
     const RunReport r = run_case(spec, o);
     const double cpu = cpu_seconds() - cpu0;
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -212,29 +257,13 @@ int main(int argc, char** argv) {
                   std::stod(std::string(h.cell(row, col("punch_fz")))),
                   std::string(h.cell(row, col("newton_iterations"))).c_str(),
                   std::string(h.cell(row, col("cutbacks"))).c_str());
-    const double n_it = std::max(1, r.total_iterations);
-    const double other = total - p.elements_s - p.contact_s - p.factorize_s - p.solve_s;
     std::printf("status %s: %d steps, %d Newton iterations, %ld assemblies, %ld factorisations, %ld solves\n",
                 r.ok() ? "ok" : "not converged", r.steps_converged, r.total_iterations, p.assemblies, p.factorizations,
                 p.solves);
     if (!r.ok()) std::printf("message: %s\n", r.message.c_str());
     std::printf("largest displacement (x, y, z) %.12g %.12g %.12g mm\n", r.max_displacement.x(), r.max_displacement.y(),
                 r.max_displacement.z());
-    std::printf(
-        "total %.2f s; per Newton iteration: elements %.4f s, contact %.4f s, factorise %.4f s, solve %.4f s, "
-        "other %.4f s\n",
-        total, p.elements_s / n_it, p.contact_s / n_it, p.factorize_s / n_it, p.solve_s / n_it, other / n_it);
-    std::printf("processor time %.2f s (user + system, all threads; wall %.2f s)\n", cpu, total);
-    std::printf("shares: elements %.0f %%, contact %.0f %%, factorise %.0f %%, solve %.0f %%, other %.0f %%\n",
-                100 * p.elements_s / total, 100 * p.contact_s / total, 100 * p.factorize_s / total,
-                100 * p.solve_s / total, 100 * other / total);
-    std::printf(
-        "contact: evaluation (search, laws, local tangents) %.4f s, merge into the pattern %.4f s per "
-        "iteration; %.0f entries merged per assembly\n",
-        p.contact_eval_s / n_it, p.contact_merge_s / n_it,
-        static_cast<double>(p.contact_entries) / std::max(1L, p.assemblies));
-    std::printf("linear: %s\n", solve_profile_linear_summary(p).c_str());
-    std::printf("peak memory %.0f MB\n", peak_mb());
+    print_split(p, total, cpu, r.total_iterations);
     std::filesystem::remove_all(dir);
     return r.ok() ? 0 : 1;
   } catch (const std::exception& e) {

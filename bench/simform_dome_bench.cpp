@@ -12,26 +12,52 @@
 //     other      the rest (line search bookkeeping, outputs, set-up)
 //   peak resident memory (getrusage high-water mark).
 // A program that prints figures, not a timed test.
-//   build/bin/simform_dome_bench [--quick] [--max-steps N] [--case FILE]
+//   build/bin/simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE]
+//                                [--ordering amd|metis|nesdis|default] [--factor-only] [--time-limit S]
 //   --quick       4 x 4 bricks a ply, 2 of the 36 steps (a smoke test)
+//   --elements N  N x N bricks a ply (the mid size: 10)
 //   --max-steps N stop cleanly after N steps (the full run can take long)
 //   --case FILE   another case (default: the [0,90]s dome)
+//   --ordering O  fill-reducing ordering of the Newton tangent's solver (default: the
+//                 solvers' own choice; forming/solve/tangent_solver.hpp)
+//   --time-limit S  after S seconds print the figures so far (a snapshot taken while the
+//                 solve runs) and stop with status 3: a size that does not finish a step
+//                 still reports where its time went
+//   --factor-only no run: the tangent of the flat start (contact pattern included: the
+//                 plies touch and the die and holder touch the stack) factorised by each
+//                 direct solver and ordering, printing nnz, fill, flops and seconds (the
+//                 numeric factorisation is repeated with the analysis kept)
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
+#include "common/linalg/solver.hpp"
+#include "forming/case/build.hpp"
 #include "forming/case/reader.hpp"
+#include "forming/solve/tangent_solver.hpp"
 #include "forming/model/solve_profile.hpp"
 #include "forming/run/run.hpp"
 
 using namespace sf;
 using namespace sf::forming;
+
+// Processor seconds of the process (user + system, all threads): on a loaded machine
+// a steadier measure than the wall clock.
+static double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 static double peak_mb() {
   rusage u{};
@@ -39,20 +65,136 @@ static double peak_mb() {
   return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
+// Processor seconds of the calling thread.
+static double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// The per-iteration split and the linear-algebra line from a profile.
+static void print_split(const SolveProfile& p, double total, double cpu, long iterations) {
+  const double n_it = static_cast<double>(std::max(1L, iterations));
+  const double other = total - p.elements_s - p.contact_s - p.factorize_s - p.solve_s;
+  std::printf(
+      "total %.2f s; per Newton iteration: elements %.4f s, contact %.4f s, factorise %.4f s, solve %.4f s, "
+      "other %.4f s\n",
+      total, p.elements_s / n_it, p.contact_s / n_it, p.factorize_s / n_it, p.solve_s / n_it, other / n_it);
+  std::printf("processor time %.2f s (user + system, all threads; wall %.2f s)\n", cpu, total);
+  std::printf("shares: elements %.0f %%, contact %.0f %%, factorise %.0f %%, solve %.0f %%, other %.0f %%\n",
+              100 * p.elements_s / total, 100 * p.contact_s / total, 100 * p.factorize_s / total,
+              100 * p.solve_s / total, 100 * other / total);
+  std::printf(
+      "contact: evaluation (search, laws, local tangents) %.4f s, merge into the pattern %.4f s per iteration; %.0f "
+      "entries merged per assembly\n",
+      p.contact_eval_s / n_it, p.contact_merge_s / n_it,
+      static_cast<double>(p.contact_entries) / static_cast<double>(std::max(1L, p.assemblies)));
+  std::printf("linear: %s\n", solve_profile_linear_summary(p).c_str());
+  std::printf("peak memory %.0f MB\n", peak_mb());
+}
+
+// --factor-only: the start tangent through each solver and ordering.
+static int factor_only(const FormingCase& spec) {
+  const Problem problem = build_problem(spec);
+  const Model& model = problem.model;
+  const VecX x = model.reference_positions();
+  std::vector<bool> is_free = model.used_dofs();
+  for (const PrescribedDof& p : problem.prescriptions.at(1.0 / std::max(1, spec.solver.steps)))
+    is_free[static_cast<std::size_t>(p.dof)] = false;
+  InteractionContext context;
+  context.previous = &x;  // quasi-static rates over the first step (zero here: the pattern counts)
+  context.time = spec.solver.process_time / std::max(1, spec.solver.steps);
+  linalg::PatternAssembler full = model.make_pattern(is_free, false);
+  linalg::PatternAssembler lower = model.make_pattern(is_free, true);
+  for (linalg::PatternAssembler* pa : {&full, &lower}) {
+    const Assembly a = model.assemble_into(x, context, pa);
+    if (!a.ok) {
+      std::fprintf(stderr, "simform_dome_bench: start tangent: %s\n", a.message.c_str());
+      return 1;
+    }
+  }
+  std::printf("start tangent: n %ld, nnz %ld (both triangles), %ld (lower); %s\n", static_cast<long>(full.n_active()),
+              static_cast<long>(full.matrix().nonZeros()), static_cast<long>(lower.matrix().nonZeros()),
+              linalg::blas_description().c_str());
+  std::printf("%-20s %-8s %-30s %12s %7s %9s %10s %10s %10s %s\n", "solver", "ordering", "ordering used", "nnz(factor)",
+              "fill", "Gflop", "analyse_s", "factor_s", "factor_cpu", "status");
+  using linalg::Ordering;
+  using linalg::SolverKind;
+  struct Trial {
+    SolverKind kind;
+    linalg::MatrixProperty property;
+    bool use_lower;
+  };
+  const Trial trials[] = {
+      {SolverKind::kUmfpack, linalg::MatrixProperty::kUnsymmetric, false},
+      {SolverKind::kCholmod, linalg::MatrixProperty::kSymmetricPositiveDefinite, true},
+      {SolverKind::kCholmodLdlt, linalg::MatrixProperty::kSymmetricIndefinite, true},
+  };
+  for (const Trial& t : trials)
+    for (Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis}) {
+      if (t.kind == SolverKind::kUmfpack && o == Ordering::kNesdis) continue;  // METIS stands in for it
+      if (t.kind == SolverKind::kCholmodLdlt && full.n_active() > 20000) {
+        // Simplicial (no BLAS): 6-10 processor seconds a factorisation at 10.6k unknowns.
+        std::printf("%-20s %-8s skipped above 20000 unknowns (simplicial: minutes)\n", "cholmod-ldlt",
+                    linalg::to_string(o).c_str());
+        continue;
+      }
+      linalg::LinearSolver solver(t.kind, t.property);
+      solver.set_ordering(o);
+      const linalg::SparseMatrix& k = t.use_lower ? lower.matrix() : full.matrix();
+      const linalg::SolveReport first = solver.factorize(k);
+      const double c0 = thread_cpu_seconds();
+      const linalg::SolveReport& r = solver.factorize(k);  // the analysis kept: a Newton iteration's cost
+      const double cpu = thread_cpu_seconds() - c0;
+      std::printf("%-20s %-8s %-30s %12.4g %7.1f %9.3f %10.3f %10.3f %10.3f %s\n", linalg::to_string(t.kind).c_str(),
+                  linalg::to_string(o).c_str(), first.ordering.c_str(), r.factor_nonzeros,
+                  r.factor_nonzeros / static_cast<double>(k.nonZeros()), r.factor_flops * 1e-9, first.analyze_seconds,
+                  r.factor_seconds, cpu, r.ok() ? "ok" : linalg::to_string(r.status).c_str());
+      std::fflush(stdout);
+    }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   std::string file = std::string(SF_SOURCE_DIR) + "/data/forming/processes/dome_0_90s.yaml";
   bool quick = false;
   int max_steps = 0;
+  int n_elements = 0;
+  bool only_factor = false;
+  double time_limit = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       quick = true;
     } else if (a == "--max-steps" && i + 1 < argc) {
       max_steps = std::atoi(argv[++i]);
+    } else if (a == "--elements" && i + 1 < argc) {
+      n_elements = std::atoi(argv[++i]);
+      if (n_elements < 1) {
+        std::fprintf(stderr, "simform_dome_bench: --elements: expected a count >= 1, found '%s'\n", argv[i]);
+        return 2;
+      }
+    } else if (a == "--ordering" && i + 1 < argc) {
+      try {
+        TangentSolver::set_default_ordering(linalg::parse_ordering(argv[++i], "--ordering"));
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "simform_dome_bench: %s\n", e.what());
+        return 2;
+      }
+    } else if (a == "--time-limit" && i + 1 < argc) {
+      time_limit = std::atof(argv[++i]);
+      if (!(time_limit > 0.0)) {
+        std::fprintf(stderr, "simform_dome_bench: --time-limit: expected seconds > 0, found '%s'\n", argv[i]);
+        return 2;
+      }
+    } else if (a == "--factor-only") {
+      only_factor = true;
     } else if (a == "--case" && i + 1 < argc) {
       file = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: simform_dome_bench [--quick] [--max-steps N] [--case FILE]\n");
+      std::fprintf(stderr,
+                   "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
+                   "[--factor-only]\n");
       return 2;
     }
   }
@@ -65,6 +207,11 @@ int main(int argc, char** argv) {
       }
       if (max_steps == 0) max_steps = 2;
     }
+    if (n_elements > 0)
+      for (CasePly& p : spec.plies) {
+        p.n1 = n_elements;
+        p.n2 = n_elements;
+      }
     int elements = 0;
     for (const CasePly& p : spec.plies) elements += p.n1 * p.n2;
     std::printf("case %s%s: %zu plies, %d bricks, %zu contact pairs, %d steps requested%s\n", file.c_str(),
@@ -72,7 +219,10 @@ int main(int argc, char** argv) {
                 spec.contacts.size(), spec.solver.steps,
                 max_steps > 0 ? (", stopping after " + std::to_string(max_steps)).c_str() : "");
     std::fflush(stdout);
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sf_simform_dome_bench";
+    if (only_factor) return factor_only(spec);
+    // One folder per process: runs side by side (sizes, orderings) do not collide.
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("sf_simform_dome_bench_" + std::to_string(getpid()));
     std::filesystem::remove_all(dir);
     RunOptions o;
     o.out_dir = dir.string();
@@ -80,32 +230,40 @@ int main(int argc, char** argv) {
     o.stop_after = max_steps;
     solve_profile().reset();
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_seconds();
+    if (time_limit > 0.0) {
+      // A watchdog: the profile is read while the solve writes it (a benchmark's snapshot).
+      std::thread([time_limit, t0, cpu0] {
+        std::this_thread::sleep_for(std::chrono::duration<double>(time_limit));
+        const SolveProfile snapshot = solve_profile();
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::printf("time limit %.0f s reached before the run ended; figures so far (%ld factorisations):\n",
+                    time_limit, snapshot.factorizations);
+        print_split(snapshot, wall, cpu_seconds() - cpu0, snapshot.factorizations);
+        std::fflush(stdout);
+        std::_Exit(3);
+      }).detach();
+    }
     const RunReport r = run_case(spec, o);
+    const double cpu = cpu_seconds() - cpu0;
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const SolveProfile p = solve_profile();
 
     const io::CsvTable h = io::read_csv((dir / "history.csv").string());
     const auto col = [&](const char* name) { return h.column_index(name); };
-    std::printf("%5s %10s %10s %7s %9s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks");
+    std::printf("%5s %10s %18s %7s %9s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks");
     for (std::size_t row = 1; row < h.n_rows(); ++row)
-      std::printf("%5zu %10.4f %10.4f %7s %9s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
+      std::printf("%5zu %10.4f %18.12g %7s %9s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
                   std::stod(std::string(h.cell(row, col("punch_fz")))),
                   std::string(h.cell(row, col("newton_iterations"))).c_str(),
                   std::string(h.cell(row, col("cutbacks"))).c_str());
-    const double n_it = std::max(1, r.total_iterations);
-    const double other = total - p.elements_s - p.contact_s - p.factorize_s - p.solve_s;
     std::printf("status %s: %d steps, %d Newton iterations, %ld assemblies, %ld factorisations, %ld solves\n",
                 r.ok() ? "ok" : "not converged", r.steps_converged, r.total_iterations, p.assemblies, p.factorizations,
                 p.solves);
     if (!r.ok()) std::printf("message: %s\n", r.message.c_str());
-    std::printf(
-        "total %.2f s; per Newton iteration: elements %.4f s, contact %.4f s, factorise %.4f s, solve %.4f s, "
-        "other %.4f s\n",
-        total, p.elements_s / n_it, p.contact_s / n_it, p.factorize_s / n_it, p.solve_s / n_it, other / n_it);
-    std::printf("shares: elements %.0f %%, contact %.0f %%, factorise %.0f %%, solve %.0f %%, other %.0f %%\n",
-                100 * p.elements_s / total, 100 * p.contact_s / total, 100 * p.factorize_s / total,
-                100 * p.solve_s / total, 100 * other / total);
-    std::printf("peak memory %.0f MB\n", peak_mb());
+    std::printf("largest displacement (x, y, z) %.12g %.12g %.12g mm\n", r.max_displacement.x(), r.max_displacement.y(),
+                r.max_displacement.z());
+    print_split(p, total, cpu, r.total_iterations);
     std::filesystem::remove_all(dir);
     return r.ok() ? 0 : 1;
   } catch (const std::exception& e) {

@@ -6,6 +6,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <dlfcn.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <atomic>
@@ -70,6 +71,10 @@ class Backend {
   virtual bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const = 0;
   // Flops of one numeric factorisation with the current analysis (0: unknown).
   virtual double factor_flops() const { return 0.0; }
+  // Entries of the factor(s) of the last analysis or factorisation (0: unknown).
+  virtual double factor_nonzeros() const { return 0.0; }
+  // Fill-reducing ordering of the current analysis ("": unknown).
+  virtual std::string ordering_used() const { return {}; }
   // Fill-reducing ordering of the next analysis (back ends with a choice).
   virtual void set_ordering(Ordering) {}
 };
@@ -151,11 +156,36 @@ class CholmodBackend final : public Backend {
     if (llt_.factor() == nullptr || status < CHOLMOD_OK) {
       return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis failed (status {})", status)};
     }
-    flops_ = llt_.cholmod().fl;
+    const cholmod_common& c = llt_.cholmod();
+    flops_ = c.fl;
+    lnz_ = c.lnz;
+    const int selected = c.selected >= 0 && c.selected < CHOLMOD_MAXMETHODS ? c.selected : 0;
+    switch (c.method[selected].ordering) {
+      case CHOLMOD_NATURAL:
+        ordering_ = "natural";
+        break;
+      case CHOLMOD_AMD:
+        ordering_ = "amd";
+        break;
+      case CHOLMOD_METIS:
+        ordering_ = "metis";
+        break;
+      case CHOLMOD_NESDIS:
+        ordering_ = "nesdis";
+        break;
+      case CHOLMOD_COLAMD:
+        ordering_ = "colamd";
+        break;
+      default:
+        ordering_ = "given";
+        break;
+    }
     return {};
   }
 
   double factor_flops() const override { return flops_; }
+  double factor_nonzeros() const override { return lnz_; }
+  std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
     if (supernodal_) {
@@ -196,17 +226,47 @@ class CholmodBackend final : public Backend {
   bool ldlt_ = false;
   bool supernodal_ = false;
   double flops_ = 0.0;
+  double lnz_ = 0.0;
+  std::string ordering_;
+};
+
+// Eigen's wrapper keeps UMFPACK's Info array protected: factor sizes, flops, the ordering
+// and strategy the analysis chose.
+class UmfpackLu : public Eigen::UmfPackLU<SparseMatrix> {
+ public:
+  double umfpack_info(int field) const { return this->m_umfpackInfo(field); }
 };
 
 class UmfpackBackend final : public Backend {
  public:
+  // UMFPACK's own choice: kDefault and kAmd use AMD (symmetric strategy) or COLAMD,
+  // kMetis METIS; kNesdis (CHOLMOD's) is not UMFPACK's, so METIS stands in for it.
+  void set_ordering(Ordering ordering) override {
+    lu_.umfpackControl()(UMFPACK_ORDERING) =
+        ordering == Ordering::kMetis || ordering == Ordering::kNesdis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+  }
+
   Outcome analyze(const SparseMatrix& a) override {
     lu_.analyzePattern(a);
     if (lu_.info() != Eigen::Success) {
       return {Status::kFailed, "UMFPACK symbolic analysis failed"};
     }
+    const int ordering = static_cast<int>(lu_.umfpack_info(UMFPACK_ORDERING_USED));
+    const int strategy = static_cast<int>(lu_.umfpack_info(UMFPACK_STRATEGY_USED));
+    ordering_ = ordering == UMFPACK_ORDERING_AMD       ? (strategy == UMFPACK_STRATEGY_SYMMETRIC ? "amd" : "colamd")
+                : ordering == UMFPACK_ORDERING_METIS   ? "metis"
+                : ordering == UMFPACK_ORDERING_CHOLMOD ? "cholmod"
+                : ordering == UMFPACK_ORDERING_NONE    ? "natural"
+                                                       : "other";
+    ordering_ += strategy == UMFPACK_STRATEGY_SYMMETRIC ? ", symmetric strategy" : ", unsymmetric strategy";
     return {};
   }
+
+  double factor_flops() const override { return std::max(0.0, lu_.umfpack_info(UMFPACK_FLOPS)); }
+  double factor_nonzeros() const override {
+    return std::max(0.0, lu_.umfpack_info(UMFPACK_LNZ)) + std::max(0.0, lu_.umfpack_info(UMFPACK_UNZ));
+  }
+  std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
     lu_.factorize(a);
@@ -229,7 +289,8 @@ class UmfpackBackend final : public Backend {
   }
 
  private:
-  Eigen::UmfPackLU<SparseMatrix> lu_;
+  UmfpackLu lu_;
+  std::string ordering_;
 };
 
 #endif  // SF_LINALG_HAVE_SUITESPARSE
@@ -432,6 +493,23 @@ std::string blas_description() {
   return out;
 }
 
+bool keep_freed_memory() {
+  static const bool changed = [] {
+    const char* tunables = std::getenv("GLIBC_TUNABLES");
+    if ((tunables && std::string(tunables).find("glibc.malloc") != std::string::npos) ||
+        std::getenv("MALLOC_MMAP_THRESHOLD_") || std::getenv("MALLOC_TRIM_THRESHOLD_"))
+      return false;
+#ifdef M_MMAP_THRESHOLD
+    const bool mmap_ok = mallopt(M_MMAP_THRESHOLD, 1 << 30) == 1;
+    const bool trim_ok = mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max()) == 1;
+    return mmap_ok && trim_ok;
+#else
+    return false;
+#endif
+  }();
+  return changed;
+}
+
 std::string to_string(MatrixProperty property) {
   switch (property) {
     case MatrixProperty::kSymmetricPositiveDefinite:
@@ -507,6 +585,7 @@ struct LinearSolver::Impl {
 };
 
 LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property) : impl_(std::make_unique<Impl>()) {
+  keep_freed_memory();
   const bool needs_symmetry = reads_lower_triangle(kind);
   if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
     throw InputError(
@@ -590,6 +669,8 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   Outcome outcome = im.backend->factorize(im.matrix);
   im.report.factor_seconds = seconds_since(start);
   im.report.factor_flops = im.backend->factor_flops();
+  im.report.factor_nonzeros = im.backend->factor_nonzeros();
+  im.report.ordering = im.backend->ordering_used();
   im.report.status = outcome.status;
   im.report.message = std::move(outcome.message);
   return im.report;

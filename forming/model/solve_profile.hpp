@@ -5,6 +5,8 @@
 // forming/solve/tangent_solver.cpp (factorisation, triangular solves). One process-wide
 // record, updated only from the (single) thread that drives a solve; reset it before the
 // part to measure. Costs two clock reads per phase, nothing else.
+#include <string>
+
 namespace sf::forming {
 
 struct SolveProfile {
@@ -15,9 +17,31 @@ struct SolveProfile {
   long assemblies = 0;       // Model::assemble_into calls (with or without tangent)
   long factorizations = 0;
   long solves = 0;
+  // Parts of contact_s: the interactions' own evaluation (search, laws, local tangents,
+  // their triplets) and the merge of those triplets into the tangent pattern (with its
+  // growth when a contact entry falls outside it).
+  double contact_eval_s = 0.0;
+  double contact_merge_s = 0.0;
+  long contact_entries = 0;  // triplets merged (summed over assemblies)
+  long pattern_growths = 0;  // merges that grew the pattern (the next factorisation re-analyses)
+  // Symbolic analyses (fill-reducing ordering) and their seconds, part of factorize_s.
+  long analyses = 0;
+  double analyse_s = 0.0;
+  // The last factorised tangent: size, stored entries, factor entries, the back end that
+  // did the work and its ordering (solve_profile_linear_summary() prints them).
+  long n = 0;
+  long nnz = 0;
+  double factor_nnz = 0.0;
+  double factor_flops = 0.0;
+  std::string solver;
+  std::string ordering;
   void reset() { *this = SolveProfile{}; }
 };
 
 SolveProfile& solve_profile();
+
+// One line about the linear algebra so far, e.g. "n 2400, nnz(K) 1.1e6 (lower), nnz(L) ...,
+// solver cholmod (amd), 3 analyses in 44 factorisations".
+std::string solve_profile_linear_summary(const SolveProfile& p);
 
 }  // namespace sf::forming

@@ -31,12 +31,15 @@ struct FreeDofs {
 // (linalg::PatternAssembler). With kAuto and a symmetric tangent the matrix is stored as
 // its lower triangle (lower() is true) and factorised by supernodal Cholesky (CHOLMOD)
 // while it is positive definite, as it is at stable equilibria; where Cholesky breaks
-// down (past a limit point, under compressive instability) by a symmetric-indefinite
-// LDL^T that reads the same lower triangle (CHOLMOD, no pivoting), so a tangent that
-// loses definiteness is neither expanded to both triangles nor handed to an LU. After a
-// breakdown the next few factorisations go to the LDL^T directly. Unsymmetric tangents
-// (follower loads, friction) and an explicit solver kind go straight to that one, with
-// both triangles stored unless the kind reads only the lower one.
+// down (past a limit point, under compressive instability, the dome's flat start) by
+// UMFPACK's LU with its symmetric strategy on the matrix expanded from that lower
+// triangle (CHOLMOD's simplicial LDL^T without SuiteSparse's UMFPACK): measured on the
+// dome's start tangent, CHOLMOD's LDL^T (simplicial, no BLAS, no pivoting) took 9x the
+// LU's time at 10584 unknowns. After a breakdown the next few factorisations go to the
+// fallback directly. Unsymmetric tangents (follower loads, friction: the viscous
+// inter-ply slip of the forming cases) and an explicit solver kind go straight to that
+// one (kAuto: UMFPACK), with both triangles stored unless the kind reads only the lower
+// one.
 // Each back end keeps its symbolic analysis while the pattern stays the same (across
 // iterations and, with a solver kept between solves, load steps).
 class TangentSolver {
@@ -48,12 +51,24 @@ class TangentSolver {
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
   // Factorisations that fell back to the indefinite solver so far.
   int n_indefinite() const { return n_indefinite_; }
+  // The back end that did the last successful factorisation (null before one).
+  const linalg::LinearSolver* active() const { return active_; }
+  // Fill-reducing ordering of the Newton tangents' solvers made from now on (process-wide;
+  // linalg::Ordering::kDefault unless changed: CHOLMOD's AMD-then-METIS choice, UMFPACK's
+  // AMD). For benchmarks comparing orderings (bench/simform_dome_bench.cpp --ordering).
+  static void set_default_ordering(linalg::Ordering ordering);
+  static linalg::Ordering default_ordering();
 
  private:
   std::unique_ptr<linalg::LinearSolver> spd_, general_;
   const linalg::LinearSolver* active_ = nullptr;
   bool lower_ = false;
-  int skip_cholesky_ = 0;  // after a breakdown, the next few factorisations go to general_
+  // From this many unknowns up the LU orders by METIS (nested dissection) rather than
+  // UMFPACK's AMD, unless set_default_ordering() chose one.
+  static constexpr Index kMetisFrom = 5000;
+  bool ordering_chosen_ = false;
+  linalg::SparseMatrix expanded_;  // both triangles of a lower-stored tangent, for an LU fallback
+  int skip_cholesky_ = 0;          // after a breakdown, the next few factorisations go to general_
   int n_indefinite_ = 0;
 };
 

@@ -321,6 +321,36 @@ TEST(LinalgSolver, EveryCholmodOrderingSolves) {
   EXPECT_FALSE(blas_description().empty());
 }
 
+// UMFPACK takes the orderings too, and every SuiteSparse back end reports the size of its
+// factor and the ordering it used (the dome benchmark prints them).
+TEST(LinalgSolver, UmfpackOrderingsSolveAndFactorSizesAreReported) {
+  if (!solver_available(SolverKind::kUmfpack)) GTEST_SKIP() << "no SuiteSparse";
+  const SparseMatrix a = convection_diffusion_2d(kGridSize, 0.3, -0.2);
+  double flops_amd = 0.0;
+  for (const Ordering o : {Ordering::kAmd, Ordering::kMetis}) {
+    SCOPED_TRACE(to_string(o));
+    LinearSolver solver(SolverKind::kUmfpack, MatrixProperty::kUnsymmetric);
+    solver.set_ordering(o);
+    expect_solves(solver, a, "umfpack ordering");
+    const SolveReport& r = solver.last_report();
+    EXPECT_EQ(r.ordering.rfind(o == Ordering::kAmd ? "amd" : "metis", 0), 0u) << r.ordering;
+    EXPECT_GT(r.factor_nonzeros, static_cast<double>(a.rows()));  // L and U with their diagonals at least
+    EXPECT_GT(r.factor_flops, 0.0);
+    if (o == Ordering::kAmd)
+      flops_amd = r.factor_flops;
+    else
+      EXPECT_NE(r.factor_flops, flops_amd);  // another ordering, another factor
+  }
+  LinearSolver chol(SolverKind::kCholmod, MatrixProperty::kSymmetricPositiveDefinite);
+  chol.set_ordering(Ordering::kAmd);
+  const SparseMatrix spd = laplacian_2d(kGridSize, 1.0);
+  expect_solves(chol, spd, "cholmod sizes");
+  EXPECT_EQ(chol.last_report().ordering, "amd");
+  EXPECT_GE(chol.last_report().factor_nonzeros, static_cast<double>(spd.rows()));
+  // The freed-memory setting is made once, by the first solver (or left to the user).
+  EXPECT_EQ(keep_freed_memory(), keep_freed_memory());
+}
+
 TEST(LinalgSolver, AnalyzePatternThenFactorizeReusesIt) {
   const SparseMatrix a = laplacian_2d(kGridSize, 2.0);
   for (const SolverKind kind : kAllKinds) {

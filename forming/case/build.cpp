@@ -96,7 +96,19 @@ RampedLoads build_loads(const FormingCase& spec, const Model& model) {
         break;
       }
     }
-    out.add(cl.ramp, std::move(set));
+    if (cl.table.empty()) {
+      out.add(cl.ramp, std::move(set));
+      continue;
+    }
+    // A pressure time table: the set carries p = 1 MPa, scaled by p(t) at t = lambda T.
+    const double duration = spec.solver.dynamic ? spec.solver.end_time : spec.solver.process_time;
+    LoadTable table;
+    for (const auto& [t, p] : cl.table) {
+      table.lambda.push_back(t / duration);
+      table.factor.push_back(p);
+    }
+    set.pressures.back().pressure = 1.0;
+    out.add(std::move(table), std::move(set));
   }
   return out;
 }

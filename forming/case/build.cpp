@@ -14,6 +14,7 @@
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
+#include "forming/model/tied_faces.hpp"
 
 namespace sf::forming {
 namespace {
@@ -131,6 +132,11 @@ void add_contacts(const FormingCase& spec, Model& model) {
     o.friction = c.law.friction;
     o.points = c.law.points;
     o.band = c.law.band;
+    if (c.tie) {
+      model.add_interaction(std::make_shared<TiedFaces>(c.label, model, c.ply, c.top, c.with, c.with_top,
+                                                        c.law.normal.stiffness, c.law.points));
+      continue;
+    }
     ContactSurface slave = ContactSurface::whole_face(model, c.ply, c.top);
     if (c.tool >= 0) {
       model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),

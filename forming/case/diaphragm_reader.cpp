@@ -215,15 +215,16 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   CaseLoad vacuum;
   vacuum.ramp = Ramp::kLinear;  // constant: the first step must carry it all (cut-backs cannot reduce it)
   bool has_vacuum = false;
+  bool tie = false;  // vacuum hold: tie
   if (const YAML::Node v = n["vacuum"]; v.IsDefined()) {
     if (case_yaml::is_map(v) && v["table"].IsDefined() && !v["pressure"].IsDefined()) {
       // vacuum: {table: [[0, 0], [0.1, 0.09]]}
-      if (r.mapping(v, what + " vacuum", {"table"}))
+      if (r.mapping(v, what + " vacuum", {"table", "hold"}))
         has_vacuum = read_pressure_table(r, v["table"], what + " vacuum", vacuum);
     } else if (case_yaml::is_map(v) && v["pressure"].IsDefined()) {
       const YAML::Node p = v["pressure"];
-      // vacuum: {pressure: 0.09, ramp: constant}
-      if (r.mapping(v, what + " vacuum", {"pressure", "ramp"})) {
+      // vacuum: {pressure: 0.09, ramp: constant, hold: tie}
+      if (r.mapping(v, what + " vacuum", {"pressure", "ramp", "hold"})) {
         if (const auto x = r.positive(p, what + " vacuum pressure", "MPa, the atmosphere over the vacuum")) {
           vacuum.value = *x;
           has_vacuum = case_yaml::ramp_of(r, v, what + " vacuum", vacuum.ramp);
@@ -239,6 +240,19 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
     vacuum.kind = CaseLoad::Kind::kPressure;
     vacuum.follower = true;
     vacuum.place = place_of(v);
+    if (case_yaml::is_map(v) && v["hold"].IsDefined()) {
+      const YAML::Node h = v["hold"];
+      if (case_yaml::is_scalar(h) && (h.Scalar() == "tie" || h.Scalar() == "friction")) {
+        tie = h.Scalar() == "tie";
+      } else {
+        r.problem(ProblemKind::kWrongType, h,
+                  what +
+                      " vacuum hold: expected friction (the laminate held by the contact law's friction) or tie "
+                      "(its outer faces tied to the diaphragms), found " +
+                      describe(h));
+        ok = false;
+      }
+    }
     ok = has_vacuum && ok;
   }
   if (!has_forming && !n["pressure"].IsDefined() && !n["tools"].IsDefined()) {
@@ -401,6 +415,10 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   const SourcePlace grip_at = place_of(n["contact"]);
   add(static_cast<int>(first), false, d.lower, true, grip, grip_at);
   add(static_cast<int>(last), true, d.upper, false, grip, grip_at);
+  if (tie) {  // the vacuum's grip as a tie of the laminate's outer faces to the sheets
+    spec.contacts[spec.contacts.size() - 2].tie = true;
+    spec.contacts[spec.contacts.size() - 1].tie = true;
+  }
   add(d.upper, false, d.lower, true, grip, grip_at);
   for (const ToolPair& tp : tool_pairs) {
     CaseContact c;

@@ -207,6 +207,10 @@ struct CaseContact {
   int with = -1;  // index into spec.plies, or -1
   bool with_top = false;
   CaseContactLaw law;
+  // Ply-ply: the faces tied (forming/model/tied_faces.hpp, penalty law.normal.stiffness
+  // with law.points per face direction) instead of in contact: the vacuum's grip of
+  // `diaphragms: {vacuum: {hold: tie}}`.
+  bool tie = false;
   std::string label;  // "lam.1/lam.2", "lam.4/punch"
   SourcePlace place;
 };

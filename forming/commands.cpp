@@ -141,6 +141,10 @@ void register_commands(sf::cli::Program& program) {
         app.add_option("--frames", plot->options.frames, "Frames in the forming sequence (default 10; 0: none)")
             ->check(CLI::Range(0, 1000));
         app.add_flag("--no-animation", plot->no_animation, "Do not write plots/forming.avi");
+        app.add_option("--section", plot->options.section_angle_deg,
+                       "3-D parts: plan angle (deg from x) of the vertical section through the part centre "
+                       "(default 0)")
+            ->check(CLI::Range(-180.0, 180.0));
       },
       [plot, prog] { return run_plot(*plot, prog->common().quiet); });
 

@@ -168,3 +168,19 @@ sf_forming_cli_test(plot.run_no_plots
   REMOVE ${sf_noplot_out}
   EXISTS "${sf_noplot_out}/summary.json|${sf_noplot_out}/tool_force.csv"
   ABSENT "${sf_noplot_out}/report.html|${sf_noplot_out}/plots")
+# The section of a 3-D part (issue 13 item 4): a small quarter dome, its section along
+# the diagonal; a section angle out of range is named.
+set(sf_section_out ${SF_FORMING_CLI_DIR}/plot_dome_3d)
+sf_forming_cli_test(plot.run_dome_3d
+  COMMAND run tests/forming/cases/dome_3d.yaml --out ${sf_section_out} --no-plots
+  REMOVE ${sf_section_out}
+  EXISTS "${sf_section_out}/summary.json"
+  FIXTURES_SETUP sf_plot_dome_3d)
+sf_forming_cli_test(plot.section_3d
+  COMMAND plot ${sf_section_out} --section 45 --frames 0 --no-animation --size 800x600
+  STDERR "wrote 8 pictures"
+  EXISTS "${sf_section_out}/plots/section.png")
+set_tests_properties(forming.cli.plot.section_3d PROPERTIES FIXTURES_REQUIRED sf_plot_dome_3d)
+sf_forming_cli_test(plot.bad_section
+  COMMAND plot ${sf_section_out} --section 400 EXIT 2 STDERR "--section")
+set_tests_properties(forming.cli.plot.bad_section PROPERTIES FIXTURES_REQUIRED sf_plot_dome_3d)

@@ -14,6 +14,7 @@
 #include "forming/material/neo_hookean.hpp"
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
+#include "forming/model/tied_faces.hpp"
 
 namespace sf::forming {
 namespace {
@@ -96,7 +97,19 @@ RampedLoads build_loads(const FormingCase& spec, const Model& model) {
         break;
       }
     }
-    out.add(cl.ramp, std::move(set));
+    if (cl.table.empty()) {
+      out.add(cl.ramp, std::move(set));
+      continue;
+    }
+    // A pressure time table: the set carries p = 1 MPa, scaled by p(t) at t = lambda T.
+    const double duration = spec.solver.dynamic ? spec.solver.end_time : spec.solver.process_time;
+    LoadTable table;
+    for (const auto& [t, p] : cl.table) {
+      table.lambda.push_back(t / duration);
+      table.factor.push_back(p);
+    }
+    set.pressures.back().pressure = 1.0;
+    out.add(std::move(table), std::move(set));
   }
   return out;
 }
@@ -119,6 +132,11 @@ void add_contacts(const FormingCase& spec, Model& model) {
     o.friction = c.law.friction;
     o.points = c.law.points;
     o.band = c.law.band;
+    if (c.tie) {
+      model.add_interaction(std::make_shared<TiedFaces>(c.label, model, c.ply, c.top, c.with, c.with_top,
+                                                        c.law.normal.stiffness, c.law.points));
+      continue;
+    }
     ContactSurface slave = ContactSurface::whole_face(model, c.ply, c.top);
     if (c.tool >= 0) {
       model.add_interaction(std::make_shared<ToolContact>(c.label, model, std::move(slave),

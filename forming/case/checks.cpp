@@ -19,9 +19,10 @@ void check_solver_rules(const FormingCase& spec, std::vector<CaseProblem>& probl
             "solver control arc_length: prescribed displacements cannot follow the arc length "
             "(hold edges with clamp or symmetry; drive the case by loads)");
     for (const CaseLoad& l : spec.loads)
-      if (l.ramp != Ramp::kLinear)
+      if (l.ramp != Ramp::kLinear || !l.table.empty())
         add(ProblemKind::kUnsupported, l.place,
-            "solver control arc_length: loads must be proportional to the load factor (ramp: linear)");
+            "solver control arc_length: loads must be proportional to the load factor (ramp: linear, no time "
+            "table)");
     for (const CaseMaterial& m : spec.materials)
       if (m.incompressible || m.inextensible)
         add(ProblemKind::kUnsupported, at,

@@ -7,6 +7,7 @@
 
 #include "common/core/error.hpp"
 #include "common/io/stl.hpp"
+#include "forming/case/sheet_keys.hpp"
 #include "forming/contact/tool_shape.hpp"
 
 namespace sf::forming {
@@ -166,6 +167,104 @@ bool read_layup_list(Reader& r, const YAML::Node& l, const std::string& what, do
   return ok;
 }
 
+// The layup string "[0,90]s" of laminate `what`: one ply per angle, every ply of the
+// laminate's ply_thickness and material (`base`).
+bool read_layup_string(Reader& r, const YAML::Node& n, const YAML::Node& l, const std::string& what,
+                       const CasePly& base, std::vector<CasePly>& plies) {
+  std::string error;
+  std::size_t offset = 0;
+  const auto angles = parse_layup(l.Scalar(), error, offset);
+  if (!angles) {
+    r.problem(ProblemKind::kWrongType, place_in_scalar(l, offset), what + " layup '" + l.Scalar() + "': " + error);
+    return false;
+  }
+  bool ok = true;
+  if (!(base.thickness > 0.0)) {
+    r.problem(ProblemKind::kMissing, n, what + ": a layup string needs ply_thickness (mm)");
+    ok = false;
+  }
+  if (base.material.empty()) {
+    r.problem(ProblemKind::kMissing, n, what + ": a layup string needs material");
+    ok = false;
+  }
+  for (const double a : *angles) {
+    CasePly p;
+    p.angle_deg = a;
+    p.thickness = base.thickness;
+    p.material = base.material;
+    p.material_index = base.material_index;
+    p.place = place_of(l);
+    plies.push_back(p);
+  }
+  return ok;
+}
+
+// The required `layup` of laminate `what`: a string or an explicit list of plies.
+bool read_layup(Reader& r, const YAML::Node& n, const std::string& what, const CasePly& base, const FormingCase& spec,
+                CaseLaminate& lam, std::vector<CasePly>& plies) {
+  const YAML::Node l = r.required(n, "layup", what);
+  if (!l.IsDefined()) return false;
+  if (case_yaml::is_scalar(l)) {
+    lam.layup = l.Scalar();
+    return read_layup_string(r, n, l, what, base, plies);
+  }
+  if (case_yaml::is_sequence(l) && l.size() > 0) {
+    lam.layup = "list";
+    return read_layup_list(r, l, what, base.thickness, base.material, spec, plies);
+  }
+  r.problem(ProblemKind::kWrongType, l,
+            what +
+                " layup: expected a layup string such as \"[0,90]s\" or a list of {angle, thickness, material}, "
+                "found " +
+                describe(l));
+  return false;
+}
+
+// Stacks the laminate's plies (named NAME.1 from the bottom) from the laminate's origin
+// into spec.plies, with the laminate's plan size and mesh; false (with a problem) on a
+// name an earlier ply uses.
+bool add_laminate_plies(Reader& r, const YAML::Node& n, const std::string& what, const CasePly& base,
+                        const std::vector<CasePly>& plies, CaseLaminate& lam, FormingCase& spec) {
+  lam.first_ply = static_cast<int>(spec.plies.size());
+  double z = base.origin.z();
+  for (std::size_t k = 0; k < plies.size(); ++k) {
+    CasePly p = plies[k];
+    p.name = lam.name + "." + std::to_string(k + 1);
+    if (spec.find_ply(p.name) >= 0) {
+      r.problem(ProblemKind::kDuplicate, n["name"], what + ": ply name '" + p.name + "' used by an earlier ply");
+      return false;
+    }
+    p.origin = Vec3(base.origin.x(), base.origin.y(), z);
+    p.length_x = base.length_x;
+    p.length_y = base.length_y;
+    p.n1 = base.n1;
+    p.n2 = base.n2;
+    p.plane_strain = base.plane_strain;
+    z += p.thickness;
+    lam.angles.push_back(p.angle_deg);
+    spec.plies.push_back(p);
+  }
+  return true;
+}
+
+// Contact pairs between neighbouring plies of the laminate (the lower ply's top face is
+// the slave side), all with the interface law.
+void add_interfaces(const CaseLaminate& lam, std::size_t n_plies, const CaseContactLaw& law, const YAML::Node& iface,
+                    FormingCase& spec) {
+  for (std::size_t k = 0; k + 1 < n_plies; ++k) {
+    CaseContact c;
+    c.ply = lam.first_ply + static_cast<int>(k);
+    c.top = true;
+    c.with = c.ply + 1;
+    c.with_top = false;
+    c.law = law;
+    c.label =
+        spec.plies[static_cast<std::size_t>(c.ply)].name + "/" + spec.plies[static_cast<std::size_t>(c.with)].name;
+    c.place = place_of(iface);
+    spec.contacts.push_back(c);
+  }
+}
+
 void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   std::string what = "laminate " + std::to_string(index + 1);
   if (!r.mapping(
@@ -180,6 +279,7 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     what = "laminate '" + lam.name + "'";
   } else
     ok = false;
+  // The keys every ply of the laminate shares.
   CasePly base;
   if (const YAML::Node o = n["origin"]; o.IsDefined()) {
     if (const auto v = vector3(r, o, what + " origin", "mm"))
@@ -187,92 +287,13 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     else
       ok = false;
   }
-  if (const YAML::Node s = r.required(n, "size", what); s.IsDefined() && pair_of(r, s, what + " size")) {
-    const auto a = r.positive(s[0], what + " size Lx", "mm");
-    const auto b = r.positive(s[1], what + " size Ly", "mm");
-    if (a && b) {
-      base.length_x = *a;
-      base.length_y = *b;
-    } else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined() && pair_of(r, e, what + " elements")) {
-    const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
-    const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
-    if (a && b) {
-      base.n1 = *a;
-      base.n2 = *b;
-    } else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node ps = n["plane_strain"]; ps.IsDefined()) {
-    if (const auto v = r.boolean(ps, what + " plane_strain"))
-      base.plane_strain = *v;
-    else
-      ok = false;
-  }
-  double thickness = 0.0;
-  if (const YAML::Node t = n["ply_thickness"]; t.IsDefined()) {
-    if (const auto h = r.positive(t, what + " ply_thickness", "mm"))
-      thickness = *h;
-    else
-      ok = false;
-  }
-  std::string material;
-  if (const YAML::Node m = n["material"]; m.IsDefined()) {
-    if (const auto t = r.text(m, what + " material")) {
-      material = *t;
-      if (find_material(spec, material) < 0) {
-        r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + material + "'", material);
-        ok = false;
-      }
-    } else
-      ok = false;
-  }
+  ok = sheet_keys::read_size(r, n, what, base) && ok;
+  ok = sheet_keys::read_elements(r, n, what, base) && ok;
+  ok = sheet_keys::read_plane_strain(r, n, what, base) && ok;
+  ok = sheet_keys::read_thickness(r, n, "ply_thickness", what, false, base.thickness) && ok;
+  ok = sheet_keys::read_material(r, n, what, false, spec, base) && ok;
   std::vector<CasePly> plies;
-  if (const YAML::Node l = r.required(n, "layup", what); l.IsDefined()) {
-    if (case_yaml::is_scalar(l)) {
-      lam.layup = l.Scalar();
-      std::string error;
-      std::size_t offset = 0;
-      const auto angles = parse_layup(l.Scalar(), error, offset);
-      if (!angles) {
-        r.problem(ProblemKind::kWrongType, place_in_scalar(l, offset), what + " layup '" + l.Scalar() + "': " + error);
-        ok = false;
-      } else {
-        if (!(thickness > 0.0)) {
-          r.problem(ProblemKind::kMissing, n, what + ": a layup string needs ply_thickness (mm)");
-          ok = false;
-        }
-        if (material.empty()) {
-          r.problem(ProblemKind::kMissing, n, what + ": a layup string needs material");
-          ok = false;
-        }
-        for (const double a : *angles) {
-          CasePly p;
-          p.angle_deg = a;
-          p.thickness = thickness;
-          p.material = material;
-          p.material_index = find_material(spec, material);
-          p.place = place_of(l);
-          plies.push_back(p);
-        }
-      }
-    } else if (case_yaml::is_sequence(l) && l.size() > 0) {
-      lam.layup = "list";
-      ok = read_layup_list(r, l, what, thickness, material, spec, plies) && ok;
-    } else {
-      r.problem(ProblemKind::kWrongType, l,
-                what +
-                    " layup: expected a layup string such as \"[0,90]s\" or a list of {angle, thickness, material}, "
-                    "found " +
-                    describe(l));
-      ok = false;
-    }
-  } else
-    ok = false;
+  ok = read_layup(r, n, what, base, spec, lam, plies) && ok;
   CaseContactLaw law;
   const YAML::Node iface = n["interface"];
   if (plies.size() > 1) {
@@ -285,38 +306,8 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     } else
       ok = false;
   }
-  if (!ok) return;
-  lam.first_ply = static_cast<int>(spec.plies.size());
-  double z = base.origin.z();
-  for (std::size_t k = 0; k < plies.size(); ++k) {
-    CasePly p = plies[k];
-    p.name = lam.name + "." + std::to_string(k + 1);
-    if (spec.find_ply(p.name) >= 0) {
-      r.problem(ProblemKind::kDuplicate, n["name"], what + ": ply name '" + p.name + "' used by an earlier ply");
-      return;
-    }
-    p.origin = Vec3(base.origin.x(), base.origin.y(), z);
-    p.length_x = base.length_x;
-    p.length_y = base.length_y;
-    p.n1 = base.n1;
-    p.n2 = base.n2;
-    p.plane_strain = base.plane_strain;
-    z += p.thickness;
-    lam.angles.push_back(p.angle_deg);
-    spec.plies.push_back(p);
-  }
-  for (std::size_t k = 0; k + 1 < plies.size(); ++k) {
-    CaseContact c;
-    c.ply = lam.first_ply + static_cast<int>(k);
-    c.top = true;
-    c.with = c.ply + 1;
-    c.with_top = false;
-    c.law = law;
-    c.label =
-        spec.plies[static_cast<std::size_t>(c.ply)].name + "/" + spec.plies[static_cast<std::size_t>(c.with)].name;
-    c.place = place_of(iface);
-    spec.contacts.push_back(c);
-  }
+  if (!ok || !add_laminate_plies(r, n, what, base, plies, lam, spec)) return;
+  add_interfaces(lam, plies.size(), law, iface, spec);
   spec.laminates.push_back(lam);
 }
 

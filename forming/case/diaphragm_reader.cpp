@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "forming/case/contact_reader.hpp"
+#include "forming/case/sheet_keys.hpp"
 
 namespace sf::forming {
 
@@ -26,13 +27,65 @@ std::optional<PlySide> side_of(const std::string& s) {
   return std::nullopt;
 }
 
-// The pressure mapping {value, face?, ramp?} of `key`; false on a problem.
+// `table: [[t, p], ...]` (s, MPa) of pressure entry `p` into load.table (and load.value =
+// the largest p, for the summary): t from 0, increasing; p >= 0. False on a problem.
+bool read_pressure_table(Reader& r, const YAML::Node& t, const std::string& what, CaseLoad& load) {
+  const std::string tw = what + " table";
+  if (!case_yaml::is_sequence(t) || t.size() < 2) {
+    r.problem(ProblemKind::kWrongType, t,
+              tw + ": expected a list of at least two [t, p] pairs (s, MPa), e.g. [[0, 0], [0.5, 0.3]], found " +
+                  describe(t));
+    return false;
+  }
+  bool ok = true;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const std::string ew = tw + " entry " + std::to_string(k + 1);
+    if (!pair_of(r, t[k], ew + " [t, p]")) {
+      ok = false;
+      continue;
+    }
+    const auto time = r.number(t[k][0], ew + " t (s)");
+    const auto p = r.number(t[k][1], ew + " p (MPa)");
+    if (!time || !p) {
+      ok = false;
+      continue;
+    }
+    if (k == 0 && *time != 0.0) {
+      r.problem(ProblemKind::kOutOfRange, t[k][0],
+                ew + " t: expected the table to start at t = 0 s, found " + t[k][0].Scalar());
+      ok = false;
+    } else if (k > 0 && !load.table.empty() && !(*time > load.table.back()[0])) {
+      r.problem(ProblemKind::kOutOfRange, t[k][0],
+                ew + " t: expected times in increasing order (after " + t[k - 1][0].Scalar() + " s), found " +
+                    t[k][0].Scalar());
+      ok = false;
+    }
+    if (*p < 0.0) {
+      r.problem(ProblemKind::kOutOfRange, t[k][1],
+                ew + " p: expected a pressure >= 0 (MPa), found " + t[k][1].Scalar());
+      ok = false;
+    }
+    load.table.push_back({*time, *p});
+    load.value = std::max(load.value, *p);
+  }
+  if (!ok) load.table.clear();
+  return ok;
+}
+
+// The pressure mapping {value | table, face?, ramp?} of `key`; false on a problem.
 bool read_pressure_entry(Reader& r, const YAML::Node& p, const std::string& what, bool with_face, CaseLoad& load) {
-  std::vector<std::string> keys = {"value", "ramp"};
+  std::vector<std::string> keys = {"value", "table", "ramp"};
   if (with_face) keys.push_back("face");
   if (!r.mapping(p, what, keys)) return false;
   bool ok = true;
-  if (const YAML::Node v = r.required(p, "value", what); v.IsDefined()) {
+  if (p["table"].IsDefined()) {
+    if (p["value"].IsDefined() || p["ramp"].IsDefined()) {
+      r.problem(ProblemKind::kWrongType, p["table"],
+                what + ": give either value (MPa, with its ramp) or a time table, not both");
+      ok = false;
+    } else
+      ok = read_pressure_table(r, p["table"], what, load);
+  } else if (const YAML::Node v = r.required(p, "value", what); v.IsDefined()) {
     if (const auto x = r.positive(v, what + " value", "MPa"))
       load.value = *x;
     else
@@ -91,47 +144,20 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
       ok = false;
   } else
     ok = false;
-  // Geometry of the sheets.
+  // Geometry and law of the sheets (the keys a ply has).
   CasePly sheet;
-  if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined() && pair_of(r, e, what + " elements")) {
-    const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
-    const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
-    if (a && b) {
-      sheet.n1 = *a;
-      sheet.n2 = *b;
-    } else
+  ok = sheet_keys::read_elements(r, n, what, sheet) && ok;
+  ok = sheet_keys::read_thickness(r, n, "thickness", what, true, sheet.thickness) && ok;
+  if (sheet_keys::read_material(r, n, what, true, spec, sheet)) {
+    if (spec.materials[static_cast<std::size_t>(sheet.material_index)].kind ==
+        CaseMaterial::Kind::kTransverselyIsotropic) {
+      r.problem(ProblemKind::kOutOfRange, n["material"],
+                what +
+                    " material: a diaphragm is an isotropic rubber sheet; expected a neo_hookean or "
+                    "mooney_rivlin material, found '" +
+                    sheet.material + "' (transversely_isotropic)");
       ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node t = r.required(n, "thickness", what); t.IsDefined()) {
-    if (const auto h = r.positive(t, what + " thickness", "mm"))
-      sheet.thickness = *h;
-    else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node m = r.required(n, "material", what); m.IsDefined()) {
-    if (const auto t = r.text(m, what + " material")) {
-      sheet.material = *t;
-      const int index = [&] {
-        for (std::size_t i = 0; i < spec.materials.size(); ++i)
-          if (spec.materials[i].name == *t) return static_cast<int>(i);
-        return -1;
-      }();
-      sheet.material_index = index;
-      if (index < 0) {
-        r.problem(ProblemKind::kUnknownMaterial, m, what + ": unknown material '" + *t + "'", *t);
-        ok = false;
-      } else if (spec.materials[static_cast<std::size_t>(index)].kind == CaseMaterial::Kind::kTransverselyIsotropic) {
-        r.problem(ProblemKind::kOutOfRange, m,
-                  what +
-                      " material: a diaphragm is an isotropic rubber sheet; expected a neo_hookean or "
-                      "mooney_rivlin material, found '" +
-                      *t + "' (transversely_isotropic)");
-        ok = false;
-      }
-    } else
-      ok = false;
+    }
   } else
     ok = false;
   // Frame.
@@ -139,15 +165,10 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   bool origin_given = false;
   const YAML::Node frame = r.required(n, "frame", what);
   if (frame.IsDefined() && r.mapping(frame, what + " frame", {"origin", "size"})) {
-    if (const YAML::Node s = r.required(frame, "size", what + " frame");
-        s.IsDefined() && pair_of(r, s, what + " frame size")) {
-      const auto a = r.positive(s[0], what + " frame size Lx", "mm");
-      const auto b = r.positive(s[1], what + " frame size Ly", "mm");
-      if (a && b) {
-        flx = *a;
-        fly = *b;
-      } else
-        ok = false;
+    CasePly inside;  // the frame's inside, read like a ply's size
+    if (sheet_keys::read_size(r, frame, what + " frame", inside)) {
+      flx = inside.length_x;
+      fly = inside.length_y;
     } else
       ok = false;
     if (const YAML::Node o = frame["origin"]; o.IsDefined()) {
@@ -194,23 +215,43 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   CaseLoad vacuum;
   vacuum.ramp = Ramp::kLinear;  // constant: the first step must carry it all (cut-backs cannot reduce it)
   bool has_vacuum = false;
+  bool tie = false;  // vacuum hold: tie
   if (const YAML::Node v = n["vacuum"]; v.IsDefined()) {
-    if (case_yaml::is_map(v) && v["pressure"].IsDefined()) {
+    if (case_yaml::is_map(v) && v["table"].IsDefined() && !v["pressure"].IsDefined()) {
+      // vacuum: {table: [[0, 0], [0.1, 0.09]]}
+      if (r.mapping(v, what + " vacuum", {"table", "hold"}))
+        has_vacuum = read_pressure_table(r, v["table"], what + " vacuum", vacuum);
+    } else if (case_yaml::is_map(v) && v["pressure"].IsDefined()) {
       const YAML::Node p = v["pressure"];
-      // vacuum: {pressure: 0.09, ramp: constant}
-      if (r.mapping(v, what + " vacuum", {"pressure", "ramp"})) {
+      // vacuum: {pressure: 0.09, ramp: constant, hold: tie}
+      if (r.mapping(v, what + " vacuum", {"pressure", "ramp", "hold"})) {
         if (const auto x = r.positive(p, what + " vacuum pressure", "MPa, the atmosphere over the vacuum")) {
           vacuum.value = *x;
           has_vacuum = case_yaml::ramp_of(r, v, what + " vacuum", vacuum.ramp);
         }
       }
-      vacuum.kind = CaseLoad::Kind::kPressure;
-      vacuum.follower = true;
-      vacuum.place = place_of(v);
     } else {
-      r.problem(
-          ProblemKind::kWrongType, v,
-          what + " vacuum: expected {pressure: MPa (e.g. 0.09), ramp: constant|linear|smooth}, found " + describe(v));
+      r.problem(ProblemKind::kWrongType, v,
+                what +
+                    " vacuum: expected {pressure: MPa (e.g. 0.09), ramp: constant|linear|smooth} or {table: [[t, p], "
+                    "...]} (s, MPa), found " +
+                    describe(v));
+    }
+    vacuum.kind = CaseLoad::Kind::kPressure;
+    vacuum.follower = true;
+    vacuum.place = place_of(v);
+    if (case_yaml::is_map(v) && v["hold"].IsDefined()) {
+      const YAML::Node h = v["hold"];
+      if (case_yaml::is_scalar(h) && (h.Scalar() == "tie" || h.Scalar() == "friction")) {
+        tie = h.Scalar() == "tie";
+      } else {
+        r.problem(ProblemKind::kWrongType, h,
+                  what +
+                      " vacuum hold: expected friction (the laminate held by the contact law's friction) or tie "
+                      "(its outer faces tied to the diaphragms), found " +
+                      describe(h));
+        ok = false;
+      }
     }
     ok = has_vacuum && ok;
   }
@@ -374,6 +415,10 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   const SourcePlace grip_at = place_of(n["contact"]);
   add(static_cast<int>(first), false, d.lower, true, grip, grip_at);
   add(static_cast<int>(last), true, d.upper, false, grip, grip_at);
+  if (tie) {  // the vacuum's grip as a tie of the laminate's outer faces to the sheets
+    spec.contacts[spec.contacts.size() - 2].tie = true;
+    spec.contacts[spec.contacts.size() - 1].tie = true;
+  }
   add(d.upper, false, d.lower, true, grip, grip_at);
   for (const ToolPair& tp : tool_pairs) {
     CaseContact c;

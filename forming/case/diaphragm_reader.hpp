@@ -15,7 +15,11 @@
 //                                    # the other edges are clamped (plane strain: x0, x1 only)
 //     pressure: {value: 0.1, face: top, ramp: linear}   # forming pressure, MPa, on the
 //                                    # upper diaphragm's top (or the lower one's bottom)
-//     vacuum: {pressure: 0.09, ramp: linear}            # MPa on both outer faces
+//                                    # or {table: [[t, p], ...], face: top} (s, MPa)
+//     vacuum: {pressure: 0.09, ramp: linear, hold: friction}   # MPa on both outer
+//                                    # faces; hold: tie ties the laminate's outer faces
+//                                    # to the sheets (forming/model/tied_faces.hpp)
+//                                    # or {table: [[t, p], ...]} (s, MPa)
 //     contact: {stiffness: 50, coulomb: 0.5, stick_velocity: 0.01}  # diaphragm-laminate
 //                                    # and diaphragm-diaphragm law (the vacuum's grip)
 //     tools: [{tool: die, stiffness: 50}]   # lower diaphragm (bottom face) against tools;

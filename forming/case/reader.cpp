@@ -20,6 +20,7 @@
 #include "forming/case/contact_reader.hpp"
 #include "forming/case/diaphragm_reader.hpp"
 #include "forming/case/model_checks.hpp"
+#include "forming/case/sheet_keys.hpp"
 #include "forming/case/yaml_reader.hpp"
 
 namespace sf::forming {
@@ -232,65 +233,17 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
       }
     }
   }
-  if (const YAML::Node s = r.required(n, "size", what); s.IsDefined()) {
-    if (pair_of(r, s, what + " size")) {
-      const auto a = r.positive(s[0], what + " size Lx", "mm");
-      const auto b = r.positive(s[1], what + " size Ly", "mm");
-      if (a && b) {
-        ply.length_x = *a;
-        ply.length_y = *b;
-      } else
-        ok = false;
-    } else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node t = r.required(n, "thickness", what); t.IsDefined()) {
-    if (const auto h = r.positive(t, what + " thickness", "mm"))
-      ply.thickness = *h;
-    else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node e = r.required(n, "elements", what); e.IsDefined()) {
-    if (pair_of(r, e, what + " elements")) {
-      const auto a = r.integer(e[0], what + " elements along x", 1, 1000);
-      const auto b = r.integer(e[1], what + " elements along y", 1, 1000);
-      if (a && b) {
-        ply.n1 = *a;
-        ply.n2 = *b;
-      } else
-        ok = false;
-    } else
-      ok = false;
-  } else
-    ok = false;
+  ok = sheet_keys::read_size(r, n, what, ply) && ok;
+  ok = sheet_keys::read_thickness(r, n, "thickness", what, true, ply.thickness) && ok;
+  ok = sheet_keys::read_elements(r, n, what, ply) && ok;
   if (const YAML::Node a = n["angle"]; a.IsDefined()) {
     if (const auto v = r.number(a, what + " angle (degrees)"))
       ply.angle_deg = *v;
     else
       ok = false;
   }
-  if (const YAML::Node ps = n["plane_strain"]; ps.IsDefined()) {
-    if (const auto v = r.boolean(ps, what + " plane_strain"))
-      ply.plane_strain = *v;
-    else
-      ok = false;
-  }
-  if (const YAML::Node m = r.required(n, "material", what); m.IsDefined()) {
-    if (const auto name = r.text(m, what + " material")) {
-      ply.material = *name;
-      for (std::size_t i = 0; i < spec.materials.size(); ++i)
-        if (spec.materials[i].name == *name) ply.material_index = static_cast<int>(i);
-      if (ply.material_index < 0) {
-        r.problem(ProblemKind::kUnknownMaterial, m,
-                  what + ": unknown material '" + *name + "' (not defined under materials)", *name);
-        ok = false;
-      }
-    } else
-      ok = false;
-  } else
-    ok = false;
+  ok = sheet_keys::read_plane_strain(r, n, what, ply) && ok;
+  ok = sheet_keys::read_material(r, n, what, true, spec, ply) && ok;
   if (ok) spec.plies.push_back(ply);
 }
 

@@ -134,6 +134,10 @@ struct CaseLoad {
   int layer = -1;               // kPointForce: 0 bottom, 1 top, -1 both
   Vec3 vector = Vec3::Zero();   // gravity acceleration (mm/s^2) or force (N)
   Ramp ramp = Ramp::kLinear;
+  // kPressure: a time table (t s, p MPa), t from 0 increasing, linear between, the last
+  // pressure held; t is the process time (load control) or the time of a dynamic run.
+  // Empty: value * ramp.
+  std::vector<std::array<double, 2>> table;
   SourcePlace place;
 };
 
@@ -203,6 +207,10 @@ struct CaseContact {
   int with = -1;  // index into spec.plies, or -1
   bool with_top = false;
   CaseContactLaw law;
+  // Ply-ply: the faces tied (forming/model/tied_faces.hpp, penalty law.normal.stiffness
+  // with law.points per face direction) instead of in contact: the vacuum's grip of
+  // `diaphragms: {vacuum: {hold: tie}}`.
+  bool tie = false;
   std::string label;  // "lam.1/lam.2", "lam.4/punch"
   SourcePlace place;
 };

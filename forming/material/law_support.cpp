@@ -1,5 +1,6 @@
 #include "forming/material/law_support.hpp"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -62,6 +63,16 @@ void add_volumetric(const Mat3& Ci, double ln_j, double mu, double lambda, bool 
   r.energy += -mu * ln_j + 0.5 * lambda * ln_j * ln_j;
   r.stress += (lambda * ln_j - mu) * Ci;
   if (want_tangent) r.tangent += lambda * outer(Ci, Ci) + 2.0 * (mu - lambda * ln_j) * sym_product(Ci);
+}
+
+bool add_isotropic_volumetric(const char* law, const Mat3& C, double m, double lambda, bool want_tangent,
+                              MaterialResponse& r) {
+  (void)law;  // named in the debug check
+  SF_ASSERT(is_symmetric(C), std::string(law) + "::evaluate: C must be symmetric");
+  const double det = C.determinant();
+  if (!(det > 0.0)) return false;
+  add_volumetric(C.inverse(), 0.5 * std::log(det), m, lambda, want_tangent, r);
+  return true;
 }
 
 double young_isotropic(double mu, double lambda) { return mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu); }

@@ -40,6 +40,13 @@ bool is_symmetric(const Mat3& C);
 //   CC = lambda Ci (x) Ci + 2 (mu - lambda ln J) (Ci (.) Ci).
 void add_volumetric(const Mat3& Ci, double ln_j, double mu, double lambda, bool want_tangent, MaterialResponse& r);
 
+// The isotropic laws' (neo-Hookean, Mooney-Rivlin) shared volumetric step at C: checks C
+// (debug), and adds add_volumetric() with Ci = C^-1, ln J = ln(det C)/2 and mu = m to r,
+// which already holds the law's own invariant terms. False where det C <= 0 (the caller
+// returns inverted_response()).
+bool add_isotropic_volumetric(const char* law, const Mat3& C, double m, double lambda, bool want_tangent,
+                              MaterialResponse& r);
+
 // Isotropic small-strain Young's modulus from Lame constants.
 double young_isotropic(double mu, double lambda);
 

@@ -1,15 +1,11 @@
 #include "forming/material/mooney_rivlin.hpp"
 
-#include <Eigen/LU>
-#include <cmath>
-
 #include "common/core/error.hpp"
 #include "forming/material/law_support.hpp"
 
 namespace sf::forming {
 namespace {
 
-using detail::add_volumetric;
 using detail::bad_parameter;
 using detail::inverted_response;
 using detail::require_finite;
@@ -69,11 +65,6 @@ void MooneyRivlinParams::validate() const {
 MooneyRivlin::MooneyRivlin(const MooneyRivlinParams& params) : params_(params) { params_.validate(); }
 
 MaterialResponse MooneyRivlin::evaluate(const Mat3& C, bool want_tangent) const {
-  SF_ASSERT(detail::is_symmetric(C), "MooneyRivlin::evaluate: C must be symmetric");
-  const double det = C.determinant();
-  if (!(det > 0.0)) return inverted_response();
-  const Mat3 Ci = C.inverse();
-  const double ln_j = 0.5 * std::log(det);
   const double c10 = params_.c10;
   const double c01 = params_.c01;
   const double i1 = C.trace();
@@ -84,7 +75,8 @@ MaterialResponse MooneyRivlin::evaluate(const Mat3& C, bool want_tangent) const 
   r.energy = c10 * (i1 - 3.0) + c01 * (i2 - 3.0);
   r.stress = 2.0 * c10 * I + 2.0 * c01 * (i1 * I - C);
   // -2 (c10 + 2 c01) ln J + lambda/2 (ln J)^2 and its stress and tangent.
-  add_volumetric(Ci, ln_j, 2.0 * (c10 + 2.0 * c01), params_.lambda, want_tangent, r);
+  if (!detail::add_isotropic_volumetric("MooneyRivlin", C, 2.0 * (c10 + 2.0 * c01), params_.lambda, want_tangent, r))
+    return inverted_response();
   if (want_tangent && c01 != 0.0) r.tangent += 4.0 * c01 * (detail::outer(I, I) - detail::sym_product(I));
   return r;
 }

@@ -1,15 +1,11 @@
 #include "forming/material/neo_hookean.hpp"
 
-#include <Eigen/LU>
-#include <cmath>
-
 #include "common/core/error.hpp"
 #include "forming/material/law_support.hpp"
 
 namespace sf::forming {
 namespace {
 
-using detail::add_volumetric;
 using detail::bad_parameter;
 using detail::inverted_response;
 using detail::require_finite;
@@ -47,17 +43,12 @@ void NeoHookeanParams::validate() const {
 NeoHookean::NeoHookean(const NeoHookeanParams& params) : params_(params) { params_.validate(); }
 
 MaterialResponse NeoHookean::evaluate(const Mat3& C, bool want_tangent) const {
-  SF_ASSERT(detail::is_symmetric(C), "NeoHookean::evaluate: C must be symmetric");
-  const double det = C.determinant();
-  if (!(det > 0.0)) return inverted_response();
-  const Mat3 Ci = C.inverse();
-  const double ln_j = 0.5 * std::log(det);
   const double mu = params_.mu;
-
   MaterialResponse r;
   r.energy = 0.5 * mu * (C.trace() - 3.0);
   r.stress = mu * Mat3::Identity();
-  add_volumetric(Ci, ln_j, mu, params_.lambda, want_tangent, r);
+  if (!detail::add_isotropic_volumetric("NeoHookean", C, mu, params_.lambda, want_tangent, r))
+    return inverted_response();
   return r;
 }
 

@@ -179,6 +179,22 @@ ExternalLoad LoadSet::assemble(const Model& model, const Eigen::Ref<const VecX>&
   return out;
 }
 
+double LoadTable::at(double l) const {
+  if (lambda.empty()) return 0.0;
+  if (l <= lambda.front()) return factor.front();
+  for (std::size_t k = 1; k < lambda.size(); ++k)
+    if (l <= lambda[k]) {
+      const double s = (l - lambda[k - 1]) / (lambda[k] - lambda[k - 1]);
+      return factor[k - 1] + s * (factor[k] - factor[k - 1]);
+    }
+  return factor.back();
+}
+
+void RampedLoads::add(LoadTable table, LoadSet set) {
+  follower = follower || set.has_follower();
+  tabled.emplace_back(std::move(table), std::move(set));
+}
+
 void RampedLoads::add(Ramp ramp, LoadSet set) {
   follower = follower || set.has_follower();
   sets.emplace_back(ramp, std::move(set));
@@ -187,17 +203,18 @@ void RampedLoads::add(Ramp ramp, LoadSet set) {
 ExternalLoad RampedLoads::at(const Model& model, double lambda, const VecX& x, bool want_tangent) const {
   ExternalLoad out;
   out.force = VecX::Zero(model.n_dofs());
-  for (const auto& [ramp, set] : sets) {
-    const double factor = ramp_value(ramp, std::clamp(lambda, 0.0, 1.0));
-    if (factor == 0.0) continue;
+  const auto add = [&](const LoadSet& set, double factor) {
+    if (factor == 0.0) return;
     ExternalLoad l = set.assemble(model, x, factor, want_tangent);
     out.force += l.force;
-    if (l.tangent.size() == 0) continue;
+    if (l.tangent.size() == 0) return;
     if (out.tangent.size() == 0)
       out.tangent = std::move(l.tangent);
     else
       out.tangent += l.tangent;
-  }
+  };
+  for (const auto& [ramp, set] : sets) add(set, ramp_value(ramp, std::clamp(lambda, 0.0, 1.0)));
+  for (const auto& [table, set] : tabled) add(set, table.at(std::clamp(lambda, 0.0, 1.0)));
   return out;
 }
 

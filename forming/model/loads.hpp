@@ -94,12 +94,22 @@ struct LoadSet {
 
 // Load sets with their ramps: f_ext(lambda, x) = sum_i ramp_i(lambda) f_i(x), lambda
 // clamped to [0, 1] (a dynamic run passes t / end_time).
+// A load factor given as a table over the load factor: (lambda_k, factor_k) with
+// lambda_0 = 0 < lambda_1 < ..., linear between, held at the last factor beyond the last
+// lambda (a pressure's time table, t_k / process time; forming/case/build.cpp).
+struct LoadTable {
+  std::vector<double> lambda, factor;
+  double at(double l) const;
+};
+
 struct RampedLoads {
   std::vector<std::pair<Ramp, LoadSet>> sets;
-  bool follower = false;  // some load follows the deformation (unsymmetric tangent)
+  std::vector<std::pair<LoadTable, LoadSet>> tabled;  // sets whose factor follows a table
+  bool follower = false;                              // some load follows the deformation (unsymmetric tangent)
 
-  bool empty() const { return sets.empty(); }
+  bool empty() const { return sets.empty() && tabled.empty(); }
   void add(Ramp ramp, LoadSet set);
+  void add(LoadTable table, LoadSet set);
   ExternalLoad at(const Model& model, double lambda, const VecX& x, bool want_tangent) const;
 };
 

@@ -25,7 +25,13 @@ nlohmann::json loads_json(const FormingCase& spec) {
              {"node", {l.node_i, l.node_j}}};
         break;
     }
-    e["ramp"] = to_string(l.ramp);
+    if (l.table.empty()) {
+      e["ramp"] = to_string(l.ramp);
+    } else {
+      nlohmann::json t = nlohmann::json::array();
+      for (const auto& [time, p] : l.table) t.push_back({time, p});
+      e["table_s_MPa"] = t;
+    }
     lj.push_back(e);
   }
   return lj;

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdlib>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -156,6 +159,25 @@ std::vector<std::size_t> tool_cells_near(const Tool& t, const Vec3& lo, const Ve
   return out;
 }
 
+// Where the polygons `cells` of m (a tool's triangles) cross the plane through c with
+// normal n: one segment per polygon that the plane cuts in two points.
+std::vector<std::array<Vec3, 2>> plane_cuts(const io::VolumeMesh& m, const std::vector<std::size_t>& cells,
+                                            const Vec3& c, const Vec3& n) {
+  std::vector<std::array<Vec3, 2>> out;
+  for (const std::size_t cell : cells) {
+    const Index a = m.offsets[cell], e = m.offsets[cell + 1];
+    std::vector<Vec3> cut;
+    for (Index i = a; i < e; ++i) {
+      const Vec3 p = m.points.row(m.connectivity[static_cast<std::size_t>(i)]).transpose();
+      const Vec3 q = m.points.row(m.connectivity[static_cast<std::size_t>(i + 1 < e ? i + 1 : a)]).transpose();
+      const double dp = (p - c).dot(n), dq = (q - c).dot(n);
+      if ((dp < 0.0) != (dq < 0.0)) cut.push_back(p + (dp / (dp - dq)) * (q - p));
+    }
+    if (cut.size() == 2) out.push_back({cut[0], cut[1]});
+  }
+  return out;
+}
+
 // Tools below the plies' mean level as solid surfaces, the others as wireframes; only
 // their part near the plies (lo, hi: the plies' box).
 void add_tools(render::Scene& scene, const std::vector<Tool>& tools, double ply_level, double width, const Vec3& lo,
@@ -273,9 +295,14 @@ class Plotter {
 
   PlotReport run() {
     PlotReport report;
+    lap("read results");
     const auto guard = render::acquire_display();
+    lap("display");
     shape(report);
-    if (plane_strain_) section(report);
+    if (plane_strain_)
+      section(report);
+    else
+      section_3d(report);
     field(report,
           {"fibre_stress.png", "Fibre stress", "MPa",
            "Cauchy stress along the fibres (a . sigma . a) on each ply's top face, plies side by side "
@@ -313,6 +340,17 @@ class Plotter {
     force_chart(report);
     if (options_.frames > 0) sequence(report);
     write_report(report);
+    lap("report.html");
+    if (std::getenv("SF_PLOT_TIMING")) {
+      // Where the time goes (wall and process CPU s per piece), on stderr.
+      double wall = 0.0, cpu = 0.0;
+      for (const Lap& l : laps_) {
+        std::fprintf(stderr, "simform plot: %-28s wall %6.3f s  cpu %6.3f s\n", l.what.c_str(), l.wall, l.cpu);
+        wall += l.wall;
+        cpu += l.cpu;
+      }
+      std::fprintf(stderr, "simform plot: %-28s wall %6.3f s  cpu %6.3f s\n", "total (listed)", wall, cpu);
+    }
     return report;
   }
 
@@ -383,8 +421,11 @@ class Plotter {
     return c;
   }
 
-  template <class Value>
-  void field(PlotReport& report, const FieldPicture& p, Value value) {
+  // A field on the plies' top faces, the plies side by side in plan; `corners(face)`
+  // gives the values at the face's four top points. `smooth`: a continuous colour map
+  // (point data) rather than bands with iso-lines.
+  template <class Corners>
+  void plan_field(PlotReport& report, const FieldPicture& p, Corners corners, bool smooth) {
     render::Scene scene;
     scene.title = p.title + " [" + p.units + "]";
     scene.subtitle = plies_subtitle();
@@ -396,11 +437,11 @@ class Plotter {
     for (int b = 0; b < n_bodies(); ++b)
       for (const Face& f : top_faces(last_, b)) {
         std::vector<Index> poly;
-        const double v = value(f);
-        for (Index q : f.top) {
+        const std::array<double, 4> v = corners(f);
+        for (int k = 0; k < 4; ++k) {
           poly.push_back(static_cast<Index>(pts.size()));
-          pts.push_back(last_.at(q) + offset(b));
-          values.push_back(v);
+          pts.push_back(last_.at(f.top[static_cast<std::size_t>(k)]) + offset(b));
+          values.push_back(v[static_cast<std::size_t>(k)]);
         }
         s.polygons.push_back(poly);
       }
@@ -409,39 +450,38 @@ class Plotter {
     s.lines = outline_lines(pts, s.polygons, box_.size().norm());
     s.line_colour = {0.25, 0.25, 0.25};
     s.colouring = colouring(p, std::move(values));
+    if (smooth) {
+      s.colouring->banded = false;
+      s.colouring->iso_lines = false;
+    }
     s.outline = false;
     write(report, scene, p.file, p.caption);
   }
 
+  // A cell field, `value(face)` per face (NaN: grey).
+  template <class Value>
+  void field(PlotReport& report, const FieldPicture& p, Value value) {
+    plan_field(
+        report, p,
+        [&](const Face& f) {
+          const double v = value(f);
+          return std::array<double, 4>{v, v, v, v};
+        },
+        false);
+  }
+
+  // A point field given on both faces of a ply: the larger of the top and the bottom value.
   void field_points(PlotReport& report, const FieldPicture& p, const io::FieldArray& data) {
-    render::Scene scene;
-    scene.title = p.title + " [" + p.units + "]";
-    scene.subtitle = plies_subtitle();
-    scene.footnote = footnote();
-    scene.view.kind = plane_strain_ ? render::ViewKind::kIso : render::ViewKind::kTop;
-    render::Surface& s = scene.surfaces.emplace_back();
-    std::vector<double> values;
-    std::vector<Vec3> pts;
-    for (int b = 0; b < n_bodies(); ++b)
-      for (const Face& f : top_faces(last_, b)) {
-        std::vector<Index> poly;
-        for (int k = 0; k < 4; ++k) {
-          poly.push_back(static_cast<Index>(pts.size()));
-          pts.push_back(last_.at(f.top[k]) + offset(b));
-          values.push_back(std::max(data.values[static_cast<std::size_t>(f.top[k])],
-                                    data.values[static_cast<std::size_t>(f.bottom[k])]));
-        }
-        s.polygons.push_back(poly);
-      }
-    s.points.resize(static_cast<Index>(pts.size()), 3);
-    for (std::size_t i = 0; i < pts.size(); ++i) s.points.row(static_cast<Index>(i)) = pts[i].transpose();
-    s.lines = outline_lines(pts, s.polygons, box_.size().norm());
-    s.line_colour = {0.25, 0.25, 0.25};
-    s.colouring = colouring(p, std::move(values));
-    s.colouring->banded = false;
-    s.colouring->iso_lines = false;
-    s.outline = false;
-    write(report, scene, p.file, p.caption);
+    plan_field(
+        report, p,
+        [&](const Face& f) {
+          std::array<double, 4> v;
+          for (std::size_t k = 0; k < 4; ++k)
+            v[k] = std::max(data.values[static_cast<std::size_t>(f.top[k])],
+                            data.values[static_cast<std::size_t>(f.bottom[k])]);
+          return v;
+        },
+        true);
   }
 
   // The plies stacked as they are, with the tools, coloured by |u|.
@@ -533,21 +573,11 @@ class Plotter {
       g.kind = render::GlyphSet::Kind::kSegment;
       g.colour = kToolLine;
       g.width = 0.004 * box_.size().norm();
-      const double y = y0;
-      for (std::size_t c = 0; c < t.mesh.n_cells(); ++c) {
-        const Index a = t.mesh.offsets[c], e = t.mesh.offsets[c + 1];
-        std::vector<Vec3> cut;
-        for (Index i = a; i < e; ++i) {
-          const Vec3 p = t.mesh.points.row(t.mesh.connectivity[static_cast<std::size_t>(i)]).transpose();
-          const Vec3 q =
-              t.mesh.points.row(t.mesh.connectivity[static_cast<std::size_t>(i + 1 < e ? i + 1 : a)]).transpose();
-          const double dp = p[1] - y, dq = q[1] - y;
-          if ((dp < 0.0) != (dq < 0.0)) cut.push_back(p + (dp / (dp - dq)) * (q - p));
-        }
-        if (cut.size() == 2) {
-          g.tails.push_back(cut[0]);
-          g.heads.push_back(cut[1]);
-        }
+      std::vector<std::size_t> all(t.mesh.n_cells());
+      for (std::size_t c = 0; c < all.size(); ++c) all[c] = c;
+      for (const auto& [p, q] : plane_cuts(t.mesh, all, Vec3(0.0, y0, 0.0), Vec3::UnitY())) {
+        g.tails.push_back(p);
+        g.heads.push_back(q);
       }
       if (g.tails.empty()) continue;
       scene.glyphs.push_back(std::move(g));
@@ -555,6 +585,149 @@ class Plotter {
     }
     write(report, scene, "section.png",
           "Section of the 2-D (plane strain) part: every ply in its own colour, the tools' surfaces as lines.");
+  }
+
+  // The part's centre in plan (reference): the centre of the plies' plan box, moved onto
+  // the x0 / y0 symmetry planes of the case (a quarter model's symmetry corner), as the
+  // line profiles of profiles.csv (forming/output/forming_results.cpp).
+  Vec3 part_centre() const {
+    Box plan;
+    for (const auto& p : summary_["parameters"]["plies"]) {
+      const auto& o = p["origin"];
+      const auto& sz = p["size"];
+      if (!o.is_array() || !sz.is_array()) continue;
+      const Vec3 lo(o[0].get<double>(), o[1].get<double>(), o[2].get<double>());
+      plan.add(lo);
+      plan.add(lo + Vec3(sz[0].get<double>(), sz[1].get<double>(), 0.0));
+    }
+    if (plan.lo[0] > plan.hi[0]) return 0.5 * (box_.lo + box_.hi);
+    Vec3 c = 0.5 * (plan.lo + plan.hi);
+    for (const auto& bc : summary_["parameters"]["boundary_conditions"]) {
+      if (bc.value("kind", std::string()) != "symmetry") continue;
+      const std::string side = bc.value("side", std::string());
+      if (side == "x0") c[0] = plan.lo[0];
+      if (side == "y0") c[1] = plan.lo[1];
+    }
+    return c;
+  }
+
+  // A vertical section of a 3-D part: the plane through the part's centre along the plan
+  // angle options_.section_angle_deg, every ply's cut (its cells cut by the plane) in its
+  // own colour and the tools' cut lines, drawn in the plane: along the section (mm from the
+  // centre) against z.
+  void section_3d(PlotReport& report) {
+    const double a = options_.section_angle_deg * 3.14159265358979323846 / 180.0;
+    const Vec3 d(std::cos(a), std::sin(a), 0.0), nrm(-std::sin(a), std::cos(a), 0.0);
+    Vec3 c = part_centre();
+    c[2] = 0.0;
+    // A plane along a symmetry edge would cut the cells on their faces: move it a hair into
+    // the part.
+    const double size = std::max(box_.size().head<2>().norm(), 1e-12);
+    c += (0.5 * (box_.lo + box_.hi) - c).dot(nrm) >= 0.0 ? 1e-6 * size * nrm : -1e-6 * size * nrm;
+    const auto in_plane = [&](const Vec3& p) { return Vec3((p - c).dot(d), 0.0, p[2]); };
+    static const std::array<std::array<int, 2>, 12> kEdges = {
+        {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+    render::Scene scene;
+    scene.title = "Section through the part: every ply and the tools";
+    scene.subtitle = "vertical plane through the centre at " + fmt(options_.section_angle_deg, "%g") +
+                     "\u00b0 from x (plan); horizontal: distance along it [mm], vertical: z [mm], true scale";
+    scene.footnote = footnote();
+    scene.view.kind = render::ViewKind::kFront;
+    static const std::array<render::Colour, 6> palette = {
+        render::Colour::from_rgb8(0xd9, 0x5f, 0x02), render::Colour::from_rgb8(0x1b, 0x9e, 0x77),
+        render::Colour::from_rgb8(0x75, 0x70, 0xb3), render::Colour::from_rgb8(0xe7, 0x29, 0x8a),
+        render::Colour::from_rgb8(0x66, 0xa6, 0x1e), render::Colour::from_rgb8(0xe6, 0xab, 0x02)};
+    Box cut_box;
+    for (int b = 0; b < n_bodies(); ++b) {
+      render::Surface s;
+      std::vector<Vec3> pts;
+      for (const std::size_t cell : last_.cells[static_cast<std::size_t>(b)]) {
+        const Index* v = &last_.mesh.connectivity[static_cast<std::size_t>(last_.mesh.offsets[cell])];
+        std::array<double, 8> dist;
+        double lo = 1e300, hi = -1e300;
+        for (int k = 0; k < 8; ++k) {
+          dist[static_cast<std::size_t>(k)] = (last_.at(v[k]) - c).dot(nrm);
+          lo = std::min(lo, dist[static_cast<std::size_t>(k)]);
+          hi = std::max(hi, dist[static_cast<std::size_t>(k)]);
+        }
+        if (!(lo < 0.0 && hi > 0.0)) continue;
+        std::vector<Vec3> cut;
+        for (const auto& e : kEdges) {
+          const double da = dist[static_cast<std::size_t>(e[0])], db = dist[static_cast<std::size_t>(e[1])];
+          if ((da < 0.0) == (db < 0.0)) continue;
+          const Vec3 pa = last_.at(v[e[0]]), pb = last_.at(v[e[1]]);
+          cut.push_back(in_plane(pa + (da / (da - db)) * (pb - pa)));
+        }
+        if (cut.size() < 3) continue;
+        Vec3 m = Vec3::Zero();
+        for (const Vec3& q : cut) m += q / static_cast<double>(cut.size());
+        std::sort(cut.begin(), cut.end(), [&](const Vec3& p, const Vec3& q) {
+          return std::atan2(p[2] - m[2], p[0] - m[0]) < std::atan2(q[2] - m[2], q[0] - m[0]);
+        });
+        std::vector<Index> poly;
+        for (const Vec3& q : cut) {
+          poly.push_back(static_cast<Index>(pts.size()));
+          pts.push_back(q);
+          cut_box.add(q);
+        }
+        s.polygons.push_back(poly);
+      }
+      if (s.polygons.empty()) continue;
+      s.points.resize(static_cast<Index>(pts.size()), 3);
+      for (std::size_t i = 0; i < pts.size(); ++i) s.points.row(static_cast<Index>(i)) = pts[i].transpose();
+      s.colour = palette[static_cast<std::size_t>(b) % palette.size()];
+      s.shading = false;
+      s.outline = false;
+      scene.surfaces.push_back(std::move(s));
+      scene.legend.push_back(
+          {render::LegendEntry::Kind::kSwatch, palette[static_cast<std::size_t>(b) % palette.size()], ply_label(b)});
+    }
+    if (scene.surfaces.empty()) {
+      report.notes.push_back("no section: the plane at " + fmt(options_.section_angle_deg, "%g") +
+                             " deg through the centre misses the plies");
+      return;
+    }
+    // Tool profiles: each tool triangle near the plies cut by the plane, kept where it is
+    // within the plies' cut (padded) so that a large tool does not shrink the picture.
+    const double span = std::max(cut_box.size()[0], cut_box.size()[2]);
+    const Vec3 pad = Vec3::Constant(0.15 * span);
+    for (const Tool& t : tools_) {
+      render::GlyphSet g;
+      g.kind = render::GlyphSet::Kind::kSegment;
+      g.colour = kToolLine;
+      g.width = 0.003 * cut_box.size().norm();
+      // Clipped to the plies' extent along the section (a quarter model's tool goes on
+      // beyond its symmetry plane); kept within the pad above and below them.
+      const double u0 = cut_box.lo[0], u1 = cut_box.hi[0];
+      for (const auto& [p, q] : plane_cuts(t.mesh, tool_cells_near(t, box_.lo, box_.hi), c, nrm)) {
+        Vec3 u = in_plane(p), v = in_plane(q);
+        if (u[0] > v[0]) std::swap(u, v);
+        if (v[0] < u0 || u[0] > u1) continue;
+        const Vec3 w = v - u;
+        if (u[0] < u0) u += ((u0 - u[0]) / w[0]) * w;
+        if (v[0] > u1) v -= ((v[0] - u1) / w[0]) * w;
+        if (std::min(u[2], v[2]) < cut_box.lo[2] - pad[2] || std::max(u[2], v[2]) > cut_box.hi[2] + pad[2]) continue;
+        g.tails.push_back(u);
+        g.heads.push_back(v);
+      }
+      if (g.tails.empty()) continue;
+      scene.glyphs.push_back(std::move(g));
+      scene.legend.push_back({render::LegendEntry::Kind::kLine, kToolLine, "tool '" + t.name + "'"});
+    }
+    // Scale: an arrow of a round length in the legend, drawn to the picture's scale.
+    const double decade = std::pow(10.0, std::floor(std::log10(0.2 * span)));
+    const double bar = 0.2 * span >= 5 * decade ? 5 * decade : 0.2 * span >= 2 * decade ? 2 * decade : decade;
+    render::GlyphSet scale;
+    scale.kind = render::GlyphSet::Kind::kArrow;
+    scale.colour = {0.2, 0.2, 0.2};
+    scale.width = 0.004 * span;
+    scene.glyphs.push_back(scale);
+    scene.legend.push_back({render::LegendEntry::Kind::kArrow, scale.colour, fmt(bar, "%g") + " mm (scale)", 0, 2, bar,
+                            static_cast<int>(scene.glyphs.size()) - 1});
+    write(report, scene, "section.png",
+          "Vertical section through the part's centre at " + fmt(options_.section_angle_deg, "%g") +
+              " deg from x: every ply in its own colour (true scale), the tools' profiles as lines (cut from the "
+              "tools' output triangles: a sphere's chords can look as if they entered the top ply).");
   }
 
   void fibres(PlotReport& report) {
@@ -656,6 +829,7 @@ class Plotter {
     }
     if (chart.series.empty()) return;
     render::write_chart_png(chart, options_.size, (dir_ / "plots" / "force_displacement.png").string());
+    lap("render force_displacement.png");
     report.pictures.push_back("plots/force_displacement.png");
     captions_["plots/force_displacement.png"] =
         "Force the press needs against the tool's stroke (tool_force.csv; one dot per converged step).";
@@ -681,6 +855,7 @@ class Plotter {
           hi = std::max(hi, Vec3(u->values[p], u->values[p + 1], u->values[p + 2]).norm());
       for (Index p = 0; p < frames.back().mesh.points.rows(); ++p) all.add(frames.back().at(p));
     }
+    lap("read " + std::to_string(pick.size()) + " frames");
     const render::Bands bands = render::nice_bands(0.0, hi, 10);
     fs::create_directories(dir_ / "plots" / "frames");
     std::vector<std::string> files;
@@ -704,6 +879,7 @@ class Plotter {
       char name[64];
       std::snprintf(name, sizeof name, "plots/frames/frame_%04zu.png", k);
       render::write_png(scene, options_.frame_size, (dir_ / name).string());
+      lap("render frame " + std::to_string(k));
       files.push_back((dir_ / name).string());
     }
     report.notes.push_back(std::to_string(files.size()) + " frames in plots/frames/");
@@ -711,7 +887,9 @@ class Plotter {
     if (options_.animation) {
       std::string why;
       const std::string movie = (dir_ / "plots" / "forming.avi").string();
-      if (write_animation(files, movie, 4.0, &why))
+      const bool movie_ok = write_animation(files, movie, 4.0, &why);
+      lap("animation");
+      if (movie_ok)
         report.animation = "plots/forming.avi";
       else
         report.notes.push_back("no animation: " + why);
@@ -720,6 +898,7 @@ class Plotter {
 
   void write(PlotReport& report, const render::Scene& scene, const std::string& file, const std::string& caption) {
     render::write_png(scene, options_.size, (dir_ / "plots" / file).string());
+    lap("render " + file);
     report.pictures.push_back("plots/" + file);
     captions_["plots/" + file] = caption;
   }
@@ -796,6 +975,24 @@ class Plotter {
   Box box_;
   std::map<std::string, std::string> captions_;
   std::string frames_first_;
+  // SF_PLOT_TIMING: wall and CPU time of each piece.
+  using Clock = std::chrono::steady_clock;
+  struct Lap {
+    std::string what;
+    double wall, cpu;
+  };
+  std::vector<Lap> laps_;
+  Clock::time_point wall_mark_ = Clock::now();
+  std::clock_t cpu_mark_ = std::clock();
+  // The time since the previous lap (or since reading the results) goes to `what`.
+  void lap(const std::string& what) {
+    const std::clock_t now = std::clock();
+    const Clock::time_point wall = Clock::now();
+    laps_.push_back({what, std::chrono::duration<double>(wall - wall_mark_).count(),
+                     static_cast<double>(now - cpu_mark_) / CLOCKS_PER_SEC});
+    cpu_mark_ = now;
+    wall_mark_ = wall;
+  }
 };
 
 }  // namespace

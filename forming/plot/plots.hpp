@@ -18,7 +18,10 @@
 //   plots/fibres.png              fibre directions of one ply (default: the top
 //                                 fibre-reinforced ply) as short line segments on it
 //   plots/section.png             2-D (plane strain) cases: the front section of every
-//                                 ply in its own colour with the tools' section lines
+//                                 ply in its own colour with the tools' section lines;
+//                                 3-D parts: the vertical section through the part's
+//                                 centre at the plan angle section_angle_deg (every ply's
+//                                 cut in its own colour, the tools' profiles)
 //   plots/force_displacement.png  press force against stroke of every tool (tool_force.csv)
 //   plots/frames/frame_NNNN.png   the forming as a frame sequence (displacement magnitude
 //                                 on one colour range), and plots/forming.avi (Motion JPEG)
@@ -37,9 +40,10 @@ namespace sf::forming {
 struct PlotOptions {
   std::string ply;  // fibre glyph ply name; empty: the top fibre-reinforced ply
   render::ImageSize size{1200, 900};
-  int frames = 10;        // frames in the sequence (0: none); evenly spread, last included
+  int frames = 10;                         // frames in the sequence (0: none); evenly spread, last included
   render::ImageSize frame_size{800, 600};  // of the frames of the sequence
-  bool animation = true;  // forming.avi when possible
+  bool animation = true;                   // forming.avi when possible
+  double section_angle_deg = 0.0;          // 3-D parts: plan angle of the vertical section plane through the centre
   bool quiet = false;
 };
 

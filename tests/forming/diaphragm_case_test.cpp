@@ -17,6 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "common/io/vtk_xml.hpp"
 #include "forming/case/build.hpp"
@@ -155,6 +156,67 @@ TEST(DiaphragmCase, BadInputIsReportedWithItsPlace) {
   const CaseCheck c = check_case_text(text, "aniso.yaml");
   ASSERT_EQ(c.problems.size(), 1u) << c.located(0);
   EXPECT_NE(c.problems[0].message.find("isotropic"), std::string::npos) << c.problems[0].message;
+}
+
+// A forming pressure (and a vacuum) given as a time table (t s, p MPa): read, checked
+// with its place, and followed by the assembled load: the upper diaphragm's top face
+// (30 x 5 mm, flat at the reference) carries p(t) x 150 mm^2 at t = lambda x process_time.
+TEST(DiaphragmCase, PressureTimeTableIsCheckedAndFollowedLinearlyBetweenItsPoints) {
+  std::string text = kBend;
+  const std::string from = "pressure: {value: 0.02, face: top, ramp: linear}";
+  text.replace(text.find(from), from.size(), "pressure: {table: [[0, 0], [0.025, 0.01], [0.05, 0.03]], face: top}");
+  const CaseCheck c = check_case_text(text, "table.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  ASSERT_EQ(c.spec.loads[0].table.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.spec.loads[0].value, 0.03);  // the largest, for the summary
+  Model model = build_model(c.spec);
+  const RampedLoads loads = build_loads(c.spec, model);
+  ASSERT_EQ(loads.tabled.size(), 1u);
+  const VecX X = model.reference_positions();
+  // process_time 0.1 s: lambda 0.125 -> t = 0.0125 s (p = 0.005), 0.375 -> 0.0375 s
+  // (0.02), 0.8 -> beyond the table (0.03 held). The vacuum (0.02 MPa, linear) acts on
+  // both outer faces and cancels in the total; the forming pressure pushes down.
+  for (const auto& [lambda, p] : {std::pair{0.125, 0.005}, {0.375, 0.02}, {0.8, 0.03}, {0.0, 0.0}}) {
+    const ExternalLoad f = loads.at(model, lambda, X, false);
+    double fz = 0.0;
+    for (Index k = 2; k < f.force.size(); k += 3) fz += f.force(k);
+    EXPECT_NEAR(fz, -p * 30.0 * 5.0, 1e-9) << "lambda " << lambda;
+  }
+  // Bad tables, each reported at its place.
+  struct Bad {
+    const char* to;
+    int line;
+    const char* words;
+  };
+  const Bad bad[] = {
+      {"pressure: {table: [[0, 0], [0.05, 0.01], [0.02, 0.03]], face: top}", 27, "increasing order"},
+      {"pressure: {table: [[0.01, 0], [0.05, 0.01]], face: top}", 27, "start at t = 0"},
+      {"pressure: {table: [[0, 0], [0.05, -0.01]], face: top}", 27, "pressure >= 0"},
+      {"pressure: {table: [[0, 0]], face: top}", 27, "at least two"},
+      {"pressure: {table: [[0, 0], [0.05]], face: top}", 27, "[t, p]"},
+      {"pressure: {value: 0.02, table: [[0, 0], [0.05, 0.01]], face: top}", 27, "not both"},
+  };
+  for (const Bad& b : bad) {
+    const CaseProblem p = only_problem(from, b.to);
+    EXPECT_EQ(p.place.line, b.line) << b.to << ": " << p.message;
+    EXPECT_GT(p.place.column, 0) << b.to;
+    EXPECT_NE(p.message.find(b.words), std::string::npos) << b.to << ": " << p.message;
+  }
+  // The vacuum as a table too.
+  std::string v = kBend;
+  const std::string vac = "vacuum: {pressure: 0.02, ramp: linear}";
+  v.replace(v.find(vac), vac.size(), "vacuum: {table: [[0, 0], [0.01, 0.09]]}");
+  const CaseCheck cv = check_case_text(v, "vacuum.yaml");
+  ASSERT_TRUE(cv.ok()) << cv.located(0);
+  EXPECT_EQ(cv.spec.loads[1].table.size(), 2u);
+  EXPECT_EQ(cv.spec.loads[2].table.size(), 2u);
+  // Arc length cannot scale a table.
+  std::string arc = text;
+  arc.replace(arc.find("solver: {steps: 3,"), 18, "solver: {control: arc_length, arc_length: 1, steps: 3,");
+  const CaseCheck ca = check_case_text(arc, "arc.yaml");
+  bool said = false;
+  for (const CaseProblem& p : ca.problems) said = said || p.message.find("no time table") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 TEST(DiaphragmCase, CoarseBendSinksIntoTheDieWithoutPenetration) {

@@ -6,6 +6,9 @@
 //    interior free; the trellis shear angle of the solution must be the closed form
 //    gamma = 90 - 2 theta, cos theta = (sqrt(2) L + d) / (2 L), everywhere, and the fibres
 //    unstretched;
+//  * bias extension (section 1.1): a tied +-45 pair's shear in zone C against the
+//    closed form of the inextensible kinematics (the refinement study is in
+//    docs/forming.md "Bias extension");
 //  * a symmetric laminate under a centred spherical punch (full model, no symmetry
 //    conditions) stays mirror-symmetric about both mid-planes;
 //  * the punch's reaction force (tool_force.csv) equals the integral of the contact
@@ -127,62 +130,113 @@ class TiedPair final : public Material {
 
 double bias_gamma_deg(double L0, double d) { return 90.0 - 2.0 * std::acos((L0 + d) / (std::sqrt(2.0) * L0)) / kDeg; }
 
+// Zone-C shear angles of a solved bias-extension specimen (H = 2 W): the mean over the
+// elements whose centres lie in the central box used before (|x - H/2| < 0.15 H,
+// |y - W/2| < 0.2 W), the area mean over zone C itself (the diamond |x - H/2| + |y - W/2|
+// <= W/2, sampled on a 0.5 mm grid) and the value at the centre.
+struct BiasZoneC {
+  double box_mean = 0.0, zone_mean = 0.0, centre = 0.0, max_stretch = 0.0;
+};
+
+double pair_shear_deg(const Mat3& F) {
+  const Vec3 ap = F * Vec3(1, 1, 0).normalized(), am = F * Vec3(1, -1, 0).normalized();
+  return 90.0 - std::acos(ap.dot(am) / (ap.norm() * am.norm())) / kDeg;
+}
+
+BiasZoneC bias_zone_c(const Model& model, const VecX& x, double H, double W) {
+  const FormingFields fields(model, x);
+  const PlyMesh& ply = model.ply(0);
+  BiasZoneC out;
+  int n = 0;
+  std::vector<std::array<Vec3, 2>> corners;  // reference plan corners of each element
+  for (Index e = 0; e < ply.n_elements(); ++e) {
+    const PlyPointFields f = fields.at(0, e, Vec3(0.5, 0.5, 0.5));
+    corners.push_back({fields.at(0, e, Vec3(0, 0, 0.5)).X, fields.at(0, e, Vec3(1, 1, 0.5)).X});
+    if (std::abs(f.X[0] - 0.5 * H) > 0.15 * H || std::abs(f.X[1] - 0.5 * W) > 0.2 * W) continue;
+    out.box_mean += pair_shear_deg(f.F);
+    ++n;
+  }
+  out.box_mean /= std::max(1, n);
+  const auto at = [&](double X, double Y) {
+    for (Index e = 0; e < ply.n_elements(); ++e) {
+      const auto& c = corners[static_cast<std::size_t>(e)];
+      if (X < c[0][0] || X > c[1][0] || Y < c[0][1] || Y > c[1][1]) continue;
+      return fields.at(0, e, Vec3((X - c[0][0]) / (c[1][0] - c[0][0]), (Y - c[0][1]) / (c[1][1] - c[0][1]), 0.5));
+    }
+    throw Error("bias_zone_c: no element at the point");
+  };
+  double sum = 0.0;
+  int m = 0;
+  for (double X = 0.25; X < H; X += 0.5)
+    for (double Y = 0.25; Y < W; Y += 0.5) {
+      if (std::abs(X - 0.5 * H) + std::abs(Y - 0.5 * W) > 0.5 * W) continue;
+      const PlyPointFields f = at(X, Y);
+      sum += pair_shear_deg(f.F);
+      const Vec3 ap = f.F * Vec3(1, 1, 0).normalized(), am = f.F * Vec3(1, -1, 0).normalized();
+      out.max_stretch = std::max({out.max_stretch, std::abs(ap.norm() - 1.0), std::abs(am.norm() - 1.0)});
+      ++m;
+    }
+  out.zone_mean = sum / m;
+  out.centre = pair_shear_deg(at(0.5 * H, 0.5 * W).F);
+  return out;
+}
+
+// Solves the bias extension of the tied pair (H x W, 2m x m bricks, fibre constant
+// kappa_f against a matrix of mu = 0.01 MPa) to clamp displacement d.
+VecX solve_bias(Model& model, double H, double d) {
+  const PlyMesh& ply = model.ply(0);
+  VecX target = model.reference_positions();
+  const std::vector<Index> pulled = fixtures::surface_nodes_at_x(ply, H);
+  for (Index s : pulled)
+    for (int layer = 0; layer < 2; ++layer) target(model.dof(0, ply.node(s, layer), 0, 0)) += d;
+  std::vector<Index> held = fixtures::node_dofs(model, 0, fixtures::surface_nodes_at_x(ply, 0.0));
+  const std::vector<Index> end = fixtures::node_dofs(model, 0, pulled);
+  held.insert(held.end(), end.begin(), end.end());
+  StaticOptions options;
+  options.initial_increment = 0.25;
+  options.max_increment = 0.5;
+  options.max_steps = 200;
+  options.max_iterations = 40;
+  const StaticResult res =
+      solve_static(model, model.reference_positions(), fixtures::held_at(held, target), VecX(), options);
+  EXPECT_TRUE(res.report.ok()) << res.report.brief();
+  return res.positions;
+}
+
 TEST(BiasExtension, CentralZoneShearOfATiedPlusMinus45PairApproachesTheInextensibleKinematics) {
-  // H x W = 100 x 50 mm (H/W = 2, L0 = H - W = 50 mm), 16 x 8 bricks, clamped ends, one
-  // end pulled by d along x. Fibres 1e4 times stiffer than the matrix.
+  // H x W = 100 x 50 mm (H/W = 2, L0 = H - W = 50 mm), clamped ends, one end pulled by d
+  // along x, fibres kappa_f = 200 MPa against a matrix of mu = 0.01 MPa (2e4), 12 x 6
+  // bricks. SF_BIAS_BRICKS_ACROSS (default 6), SF_BIAS_KAPPA (MPa, default 200) and
+  // SF_BIAS_D (mm, default 5) set up the study of docs/forming.md "Bias extension": the
+  // closed form is the inextensible limit with uniform shear in zone C and kinks at the
+  // zone boundaries. The C1 Hermite mesh cannot kink, so near-inextensible fibres put
+  // more shear at the centre and less near the boundaries (centre +53 % here, converging
+  // as h^1.1 to h^1.5); the area mean over zone C, which the kinematics fix, is within
+  // 1 % from 8 x 4 bricks on. Softer fibres (2e2) stretch and fall 14 % short.
   const double H = 100.0, W = 50.0, L0 = H - W;
-  // SF_BIAS_BRICKS_ACROSS (default 8) sets the mesh for a refinement study.
-  const char* env = std::getenv("SF_BIAS_BRICKS_ACROSS");
-  const int m = env ? std::max(2, std::atoi(env)) : 8;
+  const char* env_m = std::getenv("SF_BIAS_BRICKS_ACROSS");
+  const char* env_k = std::getenv("SF_BIAS_KAPPA");
+  const char* env_d = std::getenv("SF_BIAS_D");
+  const int m = env_m ? std::max(2, std::atoi(env_m)) : 6;
+  const double kappa = env_k ? std::atof(env_k) : 200.0;
+  const double d = env_d ? std::atof(env_d) : 5.0;
   Model model;
   model.add_ply(fixtures::rectangle_ply(H, W, 1.0, 2 * m, m, 45.0),
-                std::make_shared<TiedPair>(fixtures::ti_compressible(0.01, 0.01, 200.0, 0.02)));
-  const PlyMesh& ply = model.ply(0);
-  const std::vector<double> ds = {2.5, 5.0};
-  for (const double d : ds) {
-    VecX target = model.reference_positions();
-    const std::vector<Index> pulled = fixtures::surface_nodes_at_x(ply, H);
-    for (Index s : pulled)
-      for (int layer = 0; layer < 2; ++layer) target(model.dof(0, ply.node(s, layer), 0, 0)) += d;
-    std::vector<Index> held = fixtures::node_dofs(model, 0, fixtures::surface_nodes_at_x(ply, 0.0));
-    const std::vector<Index> end = fixtures::node_dofs(model, 0, pulled);
-    held.insert(held.end(), end.begin(), end.end());
-    StaticOptions options;
-    options.initial_increment = 0.1;
-    options.max_increment = 0.2;
-    options.max_steps = 200;
-    options.max_iterations = 40;
-    const StaticResult res =
-        solve_static(model, model.reference_positions(), fixtures::held_at(held, target), VecX(), options);
-    ASSERT_TRUE(res.report.ok()) << res.report.brief();
-    // The central zone: the elements around the specimen's centre (x = 50, y = 25).
-    const FormingFields fields(model, res.positions);
-    double sum = 0.0, lo = 1e9, hi = -1e9, stretch = 0.0;
-    int n = 0;
-    const MatX xb = PlyMesh::unflatten(res.positions);
-    for (Index e = 0; e < ply.n_elements(); ++e) {
-      const PlyPointFields f = fields.at(0, e, Vec3(0.5, 0.5, 0.5));
-      if (std::abs(f.X[0] - 0.5 * H) > 0.15 * H || std::abs(f.X[1] - 0.5 * W) > 0.2 * W) continue;
-      const Vec3 ap = f.F * Vec3(1, 1, 0).normalized(), am = f.F * Vec3(1, -1, 0).normalized();
-      const double g = 90.0 - std::acos(ap.dot(am) / (ap.norm() * am.norm())) / kDeg;
-      sum += g;
-      lo = std::min(lo, g);
-      hi = std::max(hi, g);
-      stretch = std::max({stretch, std::abs(ap.norm() - 1.0), std::abs(am.norm() - 1.0)});
-      ++n;
-    }
-    const double mean = sum / n, exact = bias_gamma_deg(L0, d);
-    std::printf(
-        "bias extension 100 x 50 mm, %d x %d bricks, d = %.1f mm: zone C shear angle %.3f deg (%d points, %.3f .. "
-        "%.3f), "
-        "closed form %.3f deg, error %.1f %%; max |fibre stretch - 1| %.1e\n",
-        2 * m, m, d, mean, n, lo, hi, exact, 100.0 * (mean - exact) / exact, stretch);
-    EXPECT_GT(n, 0);
-    // Measured: +22 % on 16 x 8 bricks (the zone boundaries are smeared over a brick of
-    // 6 mm, zone C shears more to make up for them); see the report for the trend.
-    EXPECT_NEAR(mean, exact, 0.3 * exact);
-    EXPECT_GT(mean, exact);
-  }
+                std::make_shared<TiedPair>(fixtures::ti_compressible(0.01, 0.01, kappa, 0.02)));
+  const VecX x = solve_bias(model, H, d);
+  const BiasZoneC z = bias_zone_c(model, x, H, W);
+  const double exact = bias_gamma_deg(L0, d);
+  const auto err = [&](double v) { return 100.0 * (v - exact) / exact; };
+  std::printf(
+      "bias extension 100 x 50 mm, %d x %d bricks, kappa_f/mu = %g, d = %.1f mm: closed form %.3f deg; zone C "
+      "area mean %.3f deg (%+.1f %%), centre %.3f (%+.1f %%), central box mean %.3f (%+.1f %%); max |fibre "
+      "stretch - 1| in zone C %.1e\n",
+      2 * m, m, kappa / 0.01, d, exact, z.zone_mean, err(z.zone_mean), z.centre, err(z.centre), z.box_mean,
+      err(z.box_mean), z.max_stretch);
+  if (env_m || env_k || env_d) return;  // a study: the bounds below are for the default set-up
+  EXPECT_NEAR(z.zone_mean, exact, 0.02 * exact);  // measured +0.6 %
+  EXPECT_LT(z.max_stretch, 2e-3);                  // measured 7.9e-4 (near the zone boundaries)
+  EXPECT_GT(z.centre, exact);                      // the smeared boundaries (see above)
 }
 
 // A full [0,90,90,0]-like laminate of two neo-Hookean stand-in plies (as

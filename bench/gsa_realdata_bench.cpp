@@ -148,7 +148,9 @@ int main(int argc, char** argv) {
         ao.mesh.elements1 = std::atoi(std::getenv("ELEM1")), ao.mesh.elements2 = std::atoi(std::getenv("ELEM2"));
       if (std::getenv("GCV")) ao.smoothing.rule = SmoothingRule::kGcv;
       if (std::getenv("NOLOCAL")) ao.smoothing.local = false;
-      const AnalysisResult ra = analyse(m.grid, ao);
+      // NOREFINE: the first round alone (the uniform automatic mesh, no refinement).
+      const AnalysisResult ra =
+          std::getenv("NOREFINE") ? analyse_deformed(analyse_undeformed(m.grid, ao), m.grid, ao) : analyse(m.grid, ao);
       const Errors ea = analysis_errors(m, h, ra);
       mesh = std::to_string(ra.elements1) + "x" + std::to_string(ra.elements2);
       a += ea.interior;
@@ -160,7 +162,8 @@ int main(int argc, char** argv) {
       none += ea.without;
       // Oracle: fixed smoothing (one pass), no outlier flags, best interior error.
       double best = std::numeric_limits<double>::infinity(), best_lg = 0, best_peak = 0;
-      for (double l = -3.0; l <= 6.01; l += 0.5) {
+      const bool oracle = !std::getenv("NOORACLE");
+      for (double l = -3.0; oracle && l <= 6.01; l += 0.5) {
         AnalyseOptions fo;
         fo.outliers.sigma = 1e12;
         fo.mesh = ao.mesh;
@@ -186,6 +189,34 @@ int main(int argc, char** argv) {
       });
       nn += en.interior;
       nne += en.edge;
+      if (std::getenv("PEAKDIAG")) {
+        // Where the automatic peak is, and the exact strain there.
+        std::size_t at = 0, at_exact = 0;
+        double best_a = -1, best_e = -1;
+        for (std::size_t p = 0; p < m.exact.size(); ++p) {
+          if (green(m.exact[p].lambda1) > best_e) best_e = green(m.exact[p].lambda1), at_exact = p;
+          if (ra.points[p].strain && green(ra.points[p].strain->lambda1) > best_a)
+            best_a = green(ra.points[p].strain->lambda1), at = p;
+        }
+        if (std::getenv("EDGEROW"))
+          for (std::size_t p = 0; p < m.exact.size(); ++p)
+            if (std::abs(m.nominal[p].y() - 6.0) < 1e-6 && std::abs(m.nominal[p].x()) < 2.5 && ra.points[p].strain)
+              std::printf("    X %6.2f exact %.3f got %.3f (%+.3f) E2 exact %.4f got %.4f\n", m.nominal[p].x(),
+                          green(m.exact[p].lambda1), green(ra.points[p].strain->lambda1),
+                          green(ra.points[p].strain->lambda1) - green(m.exact[p].lambda1), green(m.exact[p].lambda2),
+                          green(ra.points[p].strain->lambda2));
+        std::printf("  peak %.3f at (%.2f, %.2f) exact there %.3f edge %.2f h; exact peak %.3f at (%.2f, %.2f)\n",
+                    best_a, m.nominal[at].x(), m.nominal[at].y(), green(m.exact[at].lambda1), m.edge_distance[at] / h,
+                    best_e, m.nominal[at_exact].x(), m.nominal[at_exact].y());
+      }
+      if (std::getenv("PERSEED"))
+        std::printf(
+            "  seed %d: lg %.2f gauge %.2f auto %.2e peak %.3f/%.3f sc/t %.2f L/h %.2f sw/t %.2f relaxed %ld mesh %s "
+            "rounds %d\n",
+            seed, ra.log10_delta_optimum, ra.gauge_length / h, ea.interior, ea.peak, ea.peak_exact,
+            ra.noise.sigma_correlated / std::max(1e-12, opt.deformed_noise.sigma_correlated * std::sqrt(2.0)),
+            ra.noise.correlation_length / h, ra.noise.sigma_white / (opt.deformed_noise.sigma_white * std::sqrt(2.0)),
+            static_cast<long>(ra.relaxed_elements), mesh.c_str(), ra.refinement_rounds);
     }
     const double k = 1.0 / seeds;
     std::printf(

@@ -133,9 +133,11 @@ TEST(GsaRealData, NeckIsNeverFlaggedAndItsPeakIsKept) {
 
 // A neck narrower than an element (width parameter 0.4 mm, peak 30 % engineering strain,
 // on 1.2 mm elements of the automatic mesh): the misfit band is found and the mesh refined
-// there, so the peak is kept within 5 % and the strain error is at most half the
+// there, so the peak is kept within 5 % and the strain error is about half the
 // 24-nearest-neighbour local fit's. Without refinement (measured, seed 1): peak 12 % high,
-// error 0.77 of the local fit's.
+// error 0.77 of the local fit's. Refined in halves (0.6 mm): 0.46; in thirds (0.4 mm, as
+// now, for the 100 % neck's peak, next test): 0.52, so the bound is 0.55 (the bench's
+// neckn30 cases: 0.18-0.48 of the local fit's, 0-14 % more than with halves).
 TEST(GsaRealData, NeckNarrowerThanAnElementIsRefined) {
   const PointLayout layout = tensile_strip();
   SyntheticMeasurementOptions o = dic_like(layout, 1.0, 1);
@@ -158,11 +160,81 @@ TEST(GsaRealData, NeckNarrowerThanAnElementIsRefined) {
     return true;
   });
   const double e = analysis_rms(m, layout.spacing, r);
-  EXPECT_LT(e, 0.5 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
+  EXPECT_LT(e, 0.55 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
   // Switched off with the local smoothing: the uniform mesh.
   AnalyseOptions plain;
   plain.smoothing.local = false;
   EXPECT_EQ(analyse(m.grid, plain).refinement_rounds, 0);
+}
+
+// A 100 % neck of width parameter 0.4 mm (1.3 spacings) on the strip, noise correlated over
+// 2.5 spacings (sigma 0.5 % of the spacing), seed 1. Its peak lies at the strip's edges,
+// where the neck's contraction shears the strip (the shear Y dmu/dX grows with the distance
+// from the axis). Split in halves (0.6 mm) the refined elements let that shear ring between
+// the marks: peak 1.094 x the exact one, at the edge. Split in thirds (0.4 mm): 1.019.
+TEST(GsaRealData, NarrowHundredPercentNeckKeepsItsPeakAtTheEdges) {
+  const PointLayout layout = tensile_strip();
+  SyntheticMeasurementOptions o;
+  o.layout = layout;
+  const double sigma = 0.005 * layout.spacing;
+  o.undeformed_noise = o.deformed_noise = NoiseModel{sigma, 2.5 * layout.spacing, 0.3 * sigma};
+  o.seed = 1;
+  const SyntheticMeasurement m = make_measurement(neck_deformation(0.2, 1.0, 0.4), o);
+  const AnalysisResult r = analyse(m.grid, {});
+  EXPECT_GE(r.refinement_rounds, 1);
+  EXPECT_LT(r.smallest_element, 1.5 * layout.spacing);
+  EXPECT_EQ(without_strain(r), 0);
+  EXPECT_LE(flagged(r), m.grid.n_points() / 1000);
+  double peak = 0.0, peak_exact = 0.0;
+  for (std::size_t p = 0; p < m.exact.size(); ++p) {
+    peak_exact = std::max(peak_exact, green(m.exact[p].lambda1));
+    if (r.points[p].strain) peak = std::max(peak, green(r.points[p].strain->lambda1));
+  }
+  EXPECT_NEAR(peak / peak_exact, 1.0, 0.05) << "peak " << peak << " of " << peak_exact;
+}
+
+// A 30 % neck about 1 mm wide (2-3 elements of the automatic mesh) under DIC-like noise
+// correlated over 5 spacings (sigma 0.5 % of the spacing, 30 % of it independent), seed 1:
+// the neck's misfit is no noise. The old estimate took it for noise, 23 x too high at the
+// light pilots where the misfit stands out less against the median, so the smoothing
+// flattened the peak (0.219 of the exact 0.346 on the first, uniform mesh; the refinement
+// round then caught the misfit, with 1.6 x the error of the other seeds). Measured after:
+// sigma_c 0.86 of the truth, peak 0.348, no refinement, error 0.62 of the 24-neighbour fit.
+TEST(GsaRealData, NeckUnderLongCorrelatedNoiseIsNotTakenForNoise) {
+  const PointLayout layout = tensile_strip();
+  SyntheticMeasurementOptions o;
+  o.layout = layout;
+  const double sigma = 0.005 * layout.spacing;
+  o.undeformed_noise = o.deformed_noise = NoiseModel{sigma, 5.0 * layout.spacing, 0.3 * sigma};
+  o.seed = 1;
+  const SyntheticMeasurement m = make_measurement(neck_deformation(0.1, 0.3, 1.0), o);
+  double peak_exact = 0.0;
+  for (const ExactStrain& e : m.exact) peak_exact = std::max(peak_exact, green(e.lambda1));
+  auto peak_of = [&](const AnalysisResult& r) {
+    double peak = 0.0;
+    for (const PointResult& p : r.points)
+      if (p.strain) peak = std::max(peak, green(p.strain->lambda1));
+    return peak;
+  };
+  // The first round alone (the uniform automatic mesh): the estimate and the peak.
+  const AnalyseOptions defaults;
+  const AnalysisResult first = analyse_deformed(analyse_undeformed(m.grid, defaults), m.grid, defaults);
+  const double truth = sigma * std::sqrt(2.0);  // both states' noise in the displacement
+  EXPECT_NEAR(first.noise.sigma_correlated / truth, 1.0, 0.35);
+  EXPECT_NEAR(peak_of(first) / peak_exact, 1.0, 0.05) << "peak " << peak_of(first) << " of " << peak_exact;
+  // The whole analysis: nothing to refine, every point a strain, better than the local fit.
+  const AnalysisResult r = analyse(m.grid, defaults);
+  EXPECT_EQ(r.refinement_rounds, 0);
+  EXPECT_EQ(without_strain(r), 0);
+  EXPECT_LE(flagged(r), m.grid.n_points() / 1000);
+  EXPECT_NEAR(peak_of(r) / peak_exact, 1.0, 0.05);
+  const auto local = local_fit_stretches(m.grid, 24);
+  const double e_local = interior_rms(m, layout.spacing, [&](Index p, double& l1, double& l2) {
+    if (!local[static_cast<std::size_t>(p)]) return false;
+    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
+    return true;
+  });
+  EXPECT_LT(analysis_rms(m, layout.spacing, r), 0.75 * e_local);
 }
 
 // Smooth parts are not refined: the dome under correlated noise and the wavy part.

@@ -10,4 +10,11 @@ function(sf_target_warnings target)
                                              -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  # The fuzz build tree (tests/fuzz/CMakeLists.txt): the libraries the fuzz targets link,
+  # with the sanitizers and libFuzzer's coverage instrumentation (no libFuzzer main).
+  if(SF_FUZZ)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined,fuzzer-no-link -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
 endfunction()

@@ -20,6 +20,7 @@
 #include "common/io/grid_file.hpp"
 #include "common/render/display.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/analysis_checks.hpp"
 #include "gsa/batch_command.hpp"
 #include "gsa/centring.hpp"
 #include "gsa/command_options.hpp"
@@ -175,44 +176,6 @@ PictureProgress picture_bar(bool quiet) {
   };
 }
 
-// A run that analysed no mark fails (exit 1) instead of writing a results folder that looks
-// complete: the message counts the marks by status.
-void refuse_if_nothing_analysed(const AnalysisResult& result, const GridData& grid, const std::string& method) {
-  std::map<std::string, Index> by_status;
-  for (const auto& p : result.points) {
-    if (p.strain) return;
-    ++by_status[p.status];
-  }
-  std::string counts;
-  for (const auto& [status, n] : by_status) counts += (counts.empty() ? "" : ", ") + std::to_string(n) + " " + status;
-  std::string hint;
-  if (method == "triangles")
-    hint =
-        "; the triangles method needs neighbouring marks (grid indices i, j one apart, or marks spread over an "
-        "area, not along a line)";
-  throw InputError((grid.sources.empty() ? std::string("input") : grid.sources.front()) +
-                   ": no mark could be analysed (" + (counts.empty() ? "no marks" : counts) + ")" + hint);
-}
-
-// A user mesh that does not cover the marks: those outside are fitted by extrapolation
-// (their projection lands on the mesh's edge, far from them). Warns with the count.
-void warn_uncovered_marks(AnalysisResult& result, const std::string& mesh_file, bool quiet) {
-  if (!(result.mark_spacing > 0.0)) return;
-  Index outside = 0, measured = 0;
-  for (const auto& p : result.points) {
-    if (std::isnan(p.residual_undeformed)) continue;
-    ++measured;
-    if (p.residual_undeformed > 0.5 * result.mark_spacing) ++outside;
-  }
-  if (outside == 0) return;
-  const std::string w = std::to_string(outside) + " of " + std::to_string(measured) + " marks lie more than half a " +
-                        "mark spacing off the surface fitted on the mesh of " + mesh_file +
-                        ": the mesh does not cover them and their strains are unreliable; give a mesh that covers "
-                        "every mark";
-  cli::status(quiet, "gsa: warning: " + w);
-  result.warnings.push_back(w);
-}
-
 int run_analyse(const AnalyseFlags& a, bool quiet) {
   if (a.out.empty()) throw UsageError("--out: empty; give the folder to write the results into (e.g. --out results)");
   if (!a.stages.empty() || !a.stage_column.empty()) {
@@ -245,7 +208,8 @@ int run_analyse(const AnalyseFlags& a, bool quiet) {
   report_gross_blunders(result, in.grid, blunders, output.units);
   for (std::size_t b = 0; b < blunders.size(); ++b)
     cli::status(quiet, "gsa: warning: " + result.warnings[result.warnings.size() - blunders.size() + b]);
-  if (!a.mesh.empty()) warn_uncovered_marks(result, a.mesh, quiet);
+  if (!a.mesh.empty())
+    if (const auto w = warn_uncovered_marks(result, a.mesh)) cli::status(quiet, "gsa: warning: " + *w);
   if (!centring.warning.empty()) {
     cli::status(quiet, "gsa: warning: " + centring.warning);
     result.warnings.push_back(centring.warning);

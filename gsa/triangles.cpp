@@ -28,7 +28,8 @@ std::vector<std::array<Index, 3>> grid_triangles(const GridData& g, const std::v
   std::map<std::pair<long, long>, Index> at;
   for (Index p : usable) at[{g.i[p], g.j[p]}] = p;
   std::vector<std::array<Index, 3>> tris;
-  for (const auto& [ij, p00] : at) {
+  for (const auto& [cell, p00] : at) {
+    const std::pair<long, long>& ij = cell;  // C++17 lambdas cannot capture a structured binding (clang)
     auto f = [&](long di, long dj) {
       auto it = at.find({ij.first + di, ij.second + dj});
       return it == at.end() ? Index(-1) : it->second;

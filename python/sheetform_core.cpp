@@ -21,6 +21,7 @@
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/analysis_checks.hpp"
 #include "gsa/command_options.hpp"
 #include "gsa/grid.hpp"
 #include "gsa/mark_strains.hpp"
@@ -346,6 +347,9 @@ py::dict analyse_grid(sf::gsa::GridData grid, const AnalyseFlags& flags, const s
     py::gil_scoped_release release;  // other Python threads run during the analysis
     result = sf::gsa::analyse(grid, options);
   }
+  // The same warning and refusal as `gsa analyse` (gsa/analysis_checks.hpp).
+  if (!flags.mesh.empty()) sf::gsa::warn_uncovered_marks(result, flags.mesh);
+  sf::gsa::refuse_if_nothing_analysed(result, grid, flags.method);
   return to_python(grid, std::move(result), flags, info);
 }
 

@@ -14,6 +14,7 @@ packages=(
   libjs-three  # three.js r111, inlined into gsa's 3-D view (report.html, gsa view; gsa/view3d.hpp)
   chromium  # headless browser for the 3-D view's tests (tests/gsa/view3d_browser.py; skipped without it)
   clang libclang-rt-14-dev  # libFuzzer targets of the readers (scripts/fuzz.sh, run by scripts/extras.sh in CI)
+  libomp-dev  # clang's OpenMP: the fuzz build compiles the real sf_forming (tests/fuzz/CMakeLists.txt)
 )
 
 missing=()

@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -37,6 +38,9 @@ std::string temp_suffix(const char* kind = ".tmp-") {
 [[noreturn]] void throw_errno(const fs::path& path, const std::string& what) {
   throw_fs_error(path, what, std::error_code(errno, std::generic_category()));
 }
+
+// ".NAME.lock" beside the folder NAME.
+fs::path lock_path(const fs::path& dir) { return dir.parent_path() / ("." + dir.filename().string() + ".lock"); }
 
 bool process_running(long pid) {
   if (pid <= 0) return false;
@@ -147,25 +151,41 @@ AtomicOutputDir::AtomicOutputDir(const fs::path& final_dir, const OutputDirOptio
   fs::create_directories(dir.parent_path(), ec);
   if (ec) throw_fs_error(dir.parent_path(), "cannot create the folder", ec);
 
-  // The lock: one run per output folder at a time.
-  const fs::path lock = dir.parent_path() / ("." + dir.filename().string() + ".lock");
-  lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (lock_fd_ < 0) throw_errno(lock, "cannot create the lock file of the output folder");
-  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
-    char buf[32] = {0};
-    const ssize_t n = ::pread(lock_fd_, buf, sizeof buf - 1, 0);
-    std::string holder = n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string("?");
-    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
-    ::close(lock_fd_);
+  // The lock: one run per output folder at a time. An flock() belongs to the open file and
+  // the kernel drops it when its process ends, however it ends: the lock file a killed run
+  // leaves behind is never locked, so it cannot block the next run (which takes it over and
+  // removes it when it ends). The run holding the lock removes the file before it lets go;
+  // a run that opened the file just before that removal would hold a lock on a file that is
+  // gone, so after locking it checks that the path still names the file it locked.
+  const fs::path lock = lock_path(dir);
+  for (int attempt = 0;; ++attempt) {
+    lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0) throw_errno(lock, "cannot create the lock file of the output folder");
+    if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char buf[32] = {0};
+      const ssize_t n = ::pread(lock_fd_, buf, sizeof buf - 1, 0);
+      std::string holder = n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string("?");
+      while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+      ::close(lock_fd_);
+      lock_fd_ = -1;
+      if (err == EWOULDBLOCK)
+        throw Error(located_message(final_dir_.string(), 0, 0,
+                                    "another run (process " + holder +
+                                        ") is writing this folder now; wait for it to finish or choose another "
+                                        "output folder"));
+      errno = err;
+      throw_errno(lock, "cannot lock the output folder");
+    }
+    struct stat held {
+    }, named{};
+    if (::fstat(lock_fd_, &held) == 0 && ::stat(lock.c_str(), &named) == 0 && held.st_dev == named.st_dev &&
+        held.st_ino == named.st_ino)
+      break;
+    ::close(lock_fd_);  // removed by the run that held it: lock the file that is there now
     lock_fd_ = -1;
-    if (err == EWOULDBLOCK)
-      throw Error(located_message(final_dir_.string(), 0, 0,
-                                  "another run (process " + holder +
-                                      ") is writing this folder now; wait for it to finish or choose another "
-                                      "output folder"));
-    errno = err;
-    throw_errno(lock, "cannot lock the output folder");
+    if (attempt == 100)
+      throw Error(located_message(lock.string(), 0, 0, "cannot lock the output folder (the lock file keeps changing)"));
   }
   const std::string me = std::to_string(static_cast<long>(::getpid())) + "\n";
   if (::ftruncate(lock_fd_, 0) == 0) {
@@ -183,6 +203,7 @@ AtomicOutputDir::AtomicOutputDir(const fs::path& final_dir, const OutputDirOptio
   }
   fs::create_directories(temp_dir_, ec);
   if (ec) {
+    ::unlink(lock.c_str());
     ::close(lock_fd_);
     lock_fd_ = -1;
     throw_fs_error(temp_dir_, "cannot create the temporary output directory", ec);
@@ -193,7 +214,10 @@ AtomicOutputDir::~AtomicOutputDir() {
   std::error_code ec;
   // Nothing left after commit(); everything when abandoned (but a working folder stays).
   if (committed_ || options_.work_suffix.empty()) fs::remove_all(temp_dir_, ec);
-  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
+  if (lock_fd_ >= 0) {
+    ::unlink(lock_path(final_dir_).c_str());  // still held: no other run can have locked this file
+    ::close(lock_fd_);                        // releases the lock
+  }
 }
 
 std::string AtomicOutputDir::path(const std::string& name) const {

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <system_error>
 #include <tuple>
+#include <unordered_set>
 
 #include "common/core/error.hpp"
 
@@ -351,9 +352,11 @@ std::pair<std::size_t, std::int64_t> CsvTable::find_header(std::size_t pos, cons
   auto accept = [&](std::string_view content, std::int64_t number, char delim) {
     if (!split_names(content, delim, options.brackets_in_header, names, bad_field, problem))
       throw InputError(located_message(file_name_, static_cast<int>(number), bad_field, problem));
+    // Hashed (linear in the fields): a header line may hold tens of thousands of names.
+    std::unordered_set<std::string_view> seen;
+    seen.reserve(names.size());
     for (std::size_t f = 0; f < names.size(); ++f) {
-      if (!names[f].empty() && std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(f), names[f]) !=
-                                   names.begin() + static_cast<std::ptrdiff_t>(f))
+      if (!names[f].empty() && !seen.insert(names[f]).second)
         throw InputError(located_message(file_name_, static_cast<int>(number), static_cast<int>(f + 1),
                                          fmt::format("duplicate column name '{}'", names[f])));
     }

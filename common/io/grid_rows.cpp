@@ -43,15 +43,22 @@ std::string triple_text(const ColumnTriple& t) {
 // The header's names with their units split off, and lookups by full or base name.
 class Header {
  public:
+  // Hashed lookups (the first column of a name wins): the header test runs on up to 1000
+  // lines of every format, so a lookup must not cost a pass over a line's fields.
   explicit Header(const std::vector<std::string>& names) : names_(names) {
-    for (const std::string& n : names) split_.push_back(split_unit(n));
+    split_.reserve(names.size());
+    by_name_.reserve(names.size());
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      split_.push_back(split_unit(names[c]));
+      by_name_.emplace(names[c], c);
+      if (split_[c].has_unit) by_base_.emplace(split_[c].base, c);
+    }
   }
+  // The column named `name`, else the first whose name is `name` with a unit ("X [mm]").
   std::optional<std::size_t> find(const std::string& name) const {
     if (name.empty()) return std::nullopt;
-    for (std::size_t c = 0; c < names_.size(); ++c)
-      if (names_[c] == name) return c;
-    for (std::size_t c = 0; c < names_.size(); ++c)
-      if (split_[c].has_unit && split_[c].base == name) return c;
+    if (const auto it = by_name_.find(name); it != by_name_.end()) return it->second;
+    if (const auto it = by_base_.find(name); it != by_base_.end()) return it->second;
     return std::nullopt;
   }
   const NameAndUnit& unit(std::size_t c) const { return split_[c]; }
@@ -61,6 +68,7 @@ class Header {
  private:
   std::vector<std::string> names_;
   std::vector<NameAndUnit> split_;
+  std::unordered_map<std::string, std::size_t> by_name_, by_base_;
 };
 
 // The resolved columns of one candidate layout, or why it did not resolve.

@@ -123,7 +123,7 @@ int run(Args& a, bool quiet) {
     if (r.have) continue;
     if (a.input.empty())
       throw UsageError(std::string(r.option) + " is required without an input file (or give INPUT.yaml)");
-    throw InputError(a.input + ": missing required key '" + r.key + "' (or give " + r.option + ")");
+    throw InputError(in.at + ": stability input: missing required key '" + r.key + "' (or give " + r.option + ")");
   }
 
   const TrellisFlow flow = build_trellis_flow(spec);

@@ -118,6 +118,18 @@ StabilityInput read_stability_input(const std::string& path) {
 
   StabilityInput s;
   TrellisSpec& spec = s.spec;
+  // A key the file does not give is reported at the top-level mapping, by name (the
+  // defaults name the command-line options, which the file's user may not have used).
+  s.at = r.at(root);
+  const auto absent = [&](const char* key) { return s.at + ": key '" + key + "'"; };
+  spec.fibres_at = absent("fibres");
+  spec.viscosity_at = absent("viscosity");
+  spec.thickness_at = absent("thickness");
+  spec.rates_at = absent("rates");
+  spec.rate33_at = absent("rates.D33");
+  spec.shear_rate_at = absent("shear_rate");
+  spec.tensions_at = absent("tensions");
+  spec.tractions_at = absent("tractions");
   if (const YAML::Node n = root["units"]; n.IsDefined()) {
     if (!n.IsScalar()) r.fail(n, "units: expected a text note such as \"mm, s, MPa\", found " + describe(n));
     s.units = n.Scalar();

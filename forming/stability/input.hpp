@@ -27,6 +27,9 @@ struct StabilityInput {
   ScanOptions scan;
   bool has_fibres = false, has_viscosity = false, has_thickness = false;
   std::string units;  // the optional note
+  // FILE:LINE:COLUMN of the file's top-level mapping: where a missing key is reported (the
+  // *_at fields of a key the file does not give read "FILE:LINE:COLUMN: key 'NAME'").
+  std::string at;
 };
 
 // Reads and checks the structure of the file. Throws sf::InputError.

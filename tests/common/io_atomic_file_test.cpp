@@ -1,11 +1,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "common/core/error.hpp"
 #include "common/io/atomic_file.hpp"
@@ -148,6 +151,96 @@ TEST(IoAtomicFile, SecondWriterOfTheSameFolderStopsWithAClearMessage) {
   EXPECT_THAT(msg, ::testing::HasSubstr(out.string()));
   // Another folder beside it is free.
   EXPECT_NO_THROW(AtomicOutputDir other(scratch.path() / "results2"));
+}
+
+TEST(IoAtomicFile, TheLockFileIsRemovedWhenTheRunEnds) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  const fs::path lock = scratch.path() / ".results.lock";
+  {
+    AtomicOutputDir dir(out);
+    EXPECT_EQ(test::read_text(lock), std::to_string(::getpid()) + "\n");  // the holder, for the message
+    test::write_text(dir.path("strains.csv"), "id\n");
+    dir.commit();
+  }
+  EXPECT_FALSE(fs::exists(lock));
+  { AtomicOutputDir abandoned(out); }  // a failed run (no commit) removes it too
+  EXPECT_FALSE(fs::exists(lock));
+  EXPECT_EQ(count_entries(scratch.path(), ""), 1);  // results/ alone
+}
+
+// A run killed with SIGKILL while it holds the lock leaves the lock file (nothing runs at
+// a SIGKILL); the kernel dropped its lock, so the next run is not blocked, and removes it.
+TEST(IoAtomicFile, TheLockFileOfAKilledRunDoesNotBlockTheNext) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  const fs::path lock = scratch.path() / ".results.lock";
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    AtomicOutputDir dir(out);
+    const char c = 'x';
+    [[maybe_unused]] const ssize_t w = ::write(ready[1], &c, 1);
+    ::pause();
+    ::_exit(0);
+  }
+  char c = 0;
+  ASSERT_EQ(::read(ready[0], &c, 1), 1);  // the child holds the lock
+  EXPECT_THAT(test::message_of<Error>([&] { AtomicOutputDir second(out); }),
+              ::testing::HasSubstr("another run (process " + std::to_string(child) + ")"));
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ::close(ready[0]);
+  ::close(ready[1]);
+  ASSERT_TRUE(fs::exists(lock));  // left by the killed run, naming it
+  EXPECT_EQ(test::read_text(lock), std::to_string(child) + "\n");
+  {
+    AtomicOutputDir next(out);  // not blocked
+    test::write_text(next.path("strains.csv"), "id\n");
+    next.commit();
+  }
+  EXPECT_TRUE(fs::exists(out / "strains.csv"));
+  EXPECT_FALSE(fs::exists(lock));
+  EXPECT_EQ(count_entries(scratch.path(), "results."), 0);  // the killed run's temporary: cleaned
+}
+
+// Runs that take the lock of one folder again and again, at the same time: never two
+// holders at once, even though each removes the lock file when it ends (a run that opened
+// the file just before its removal must not count as holding the lock).
+TEST(IoAtomicFile, RemovingTheLockFileNeverLetsTwoRunsHoldTheLock) {
+  test::ScratchDir scratch;
+  const fs::path out = scratch.path() / "results";
+  const std::string busy = (scratch.path() / "busy").string();
+  std::vector<pid_t> children;
+  for (int k = 0; k < 3; ++k) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      int held = 0;
+      for (int i = 0; i < 400; ++i) {
+        try {
+          AtomicOutputDir dir(out);
+          const int fd = ::open(busy.c_str(), O_CREAT | O_EXCL | O_WRONLY, 0644);
+          if (fd < 0) ::_exit(2);  // another run holds the lock at the same time
+          ::close(fd);
+          ++held;
+          ::unlink(busy.c_str());
+        } catch (const Error&) {
+          // another run holds it: that is the expected refusal
+        }
+      }
+      ::_exit(held > 0 ? 0 : 3);
+    }
+    children.push_back(child);
+  }
+  for (const pid_t child : children) {
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 2) << "two runs held the lock of one folder at once";
+  }
+  EXPECT_FALSE(fs::exists(scratch.path() / ".results.lock"));
 }
 
 TEST(IoAtomicFile, StaleTemporariesOfDeadRunsAreRemoved) {

@@ -96,7 +96,9 @@ TEST(TriangleSurface, GapAndNormalDerivativesMatchFiniteDifferences) {
   std::mt19937 rng(test::kSeed + 1);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int seen[3] = {0, 0, 0};
-  for (int k = 0; k < 200; ++k) {
+  // 600 points: with 200, the points whose finite differences stay in one edge region were
+  // 3 (not more than 5) in the clang build of the sanitized tests (scripts/sanitize.sh).
+  for (int k = 0; k < 600; ++k) {
     Vec3 x(u(rng), u(rng), u(rng));
     // Half inside, half outside (edge and vertex regions open up outside a convex surface).
     x = x.normalized() * (k % 2 == 0 ? 2.0 - 0.3 * std::abs(u(rng)) : 2.1 + 0.6 * std::abs(u(rng)));

@@ -43,6 +43,12 @@ file(WRITE ${sf_stab}/bad.yaml "fibres: [30, -30]\nviscosity: 2.0e-3\nthickness:
 sf_forming_cli_test(stability.bad_yaml_value
   COMMAND stability ${sf_stab}/bad.yaml --out ${sf_stab}/bad5 --no-plots
   EXIT 1 STDERR "bad\\.yaml:3:12: expected a positive thickness \\(mm\\), found -2" ABSENT ${sf_stab}/bad5)
+# A required key missing from the file: its place and name (issue 20).
+file(WRITE ${sf_stab}/no_viscosity.yaml "# no viscosity\nfibres: [30, -30]\nthickness: 2\nshear_rate: 0.5\ntensions: {T_a: 0.01, T_b: 0.004}\n")
+sf_forming_cli_test(stability.missing_key
+  COMMAND stability ${sf_stab}/no_viscosity.yaml --out ${sf_stab}/bad6 --no-plots
+  EXIT 1 STDERR "no_viscosity\\.yaml:2:1: stability input: missing required key 'viscosity' \\(or give --viscosity\\)"
+  ABSENT ${sf_stab}/bad6)
 
 # Wrong usage: exit 2.
 sf_forming_cli_test(stability.no_out COMMAND stability --fibres 30,-30 ${sf_stab_opts} EXIT 2 STDERR "--out")

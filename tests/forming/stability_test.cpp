@@ -406,6 +406,16 @@ TEST(StabilityInput, ReadsTheSampleAndReportsPlaces) {
                "in\\.yaml:4:13: shear_rate \\(1/s\\): expected a finite number, found 'fast'");
   expect_error(ok + "shear_rat: 1\n", "in\\.yaml:4:1: stability input: unknown key 'shear_rat'");
   expect_error("fibres: [30, -30, 5]\n", "in\\.yaml:1:9: fibres .*expected a list of 2 numbers, found a list of 3");
+  // A missing key: file, line and column of the mapping it belongs in, and which key.
+  expect_error(ok + "shear_rate: 1\ntensions: {T_a: 0}\n",
+               "^.*in\\.yaml:5:11: tensions \\(MPa\\): missing required key 'T_b'$");
+  expect_error(
+      "# comment\n" + ok + "shear_rate: 1\n",
+      "^.*in\\.yaml:2:1: key 'tensions': missing: give the fibre tensions T_a, T_b \\(MPa\\) with the rates, or "
+      "the tractions \\(.*in\\.yaml:2:1: key 'tractions'\\)$");
+  expect_error(ok + "tensions: {T_a: 0, T_b: 0}\n", "^.*in\\.yaml:1:1: key 'rates': missing: give the rates D11");
+  const std::string no_viscosity = write_file(d / "in.yaml", "\nfibres: [30, -30]\nthickness: 2\n");
+  EXPECT_EQ(read_stability_input(no_viscosity).at, no_viscosity + ":2:1");
 }
 
 TEST(StabilityOutput, WritesCsvJsonAndPicturesWithoutADisplay) {

@@ -458,8 +458,8 @@ TEST_F(GsaCli, BadInputExitsOneNamingFileLineColumnAndLeavesNoOutput) {
   EXPECT_THAT(r.err, HasSubstr(bad + ":3:4:"));
   EXPECT_THAT(r.err, Not(HasSubstr("internal error")));
   EXPECT_FALSE(fs::exists(dir_.file("out")));
-  // No out/ and no out.tmp-* either; only the hidden lock file (.out.lock) of the run that failed.
-  EXPECT_EQ(entries(dir_.path()), (std::set<std::string>{"bad.csv", ".out.lock"}));
+  // No out/, no out.tmp-* and no lock file (.out.lock) either: the failed run removed its lock.
+  EXPECT_EQ(entries(dir_.path()), (std::set<std::string>{"bad.csv"}));
 }
 
 TEST_F(GsaCli, FailedRunKeepsPreviousResults) {

@@ -223,6 +223,10 @@ class Errors(unittest.TestCase):
             sheetform.analyse(U, U, ids=["a"] * 10)
         with self.assertRaises(sheetform.InputError):  # all marks at one point: nothing to fit
             sheetform.analyse(U, U)
+        # Marks two grid steps apart form no triangle: refused as by gsa analyse.
+        U4 = np.array([[0, 0, 0], [10, 0, 0], [0, 10, 0], [10, 10, 0]], dtype=float)
+        with self.assertRaisesRegex(sheetform.InputError, r"no mark could be analysed \(4 no_triangle\)"):
+            sheetform.analyse(U4, U4 * 1.01, ij=[[0, 0], [2, 0], [0, 2], [2, 2]], method="triangles")
         with self.assertRaisesRegex(sheetform.UsageError, "unknown option 'smoothing'"):
             sheetform.analyse(U, U, smoothing=2)
         with self.assertRaisesRegex(sheetform.UsageError, "--alpha: expected a number"):

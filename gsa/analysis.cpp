@@ -188,7 +188,8 @@ constexpr double kRefineFactor = 3.0;
 constexpr double kRefineMinSpacings = 1.3;
 constexpr int kRefinePieces = 3;
 constexpr int kRefineRounds = 2;
-constexpr int kRefineMinMarks = 4;  // marks a cell needs to be judged
+constexpr int kRefineMinMarks = 4;     // marks a cell needs to be judged
+constexpr double kRefineFloor = 1e-6;  // RMS residual (x the mark spacing) below which a cell fits
 
 // The refined breaks (fractions) of the automatic mesh `setup` from the result `r`;
 // false when nothing is to be refined.
@@ -219,7 +220,11 @@ bool refined_breaks(const FrameAndMesh& setup, const FitMarks& marks, const Anal
   if (ms.size() < 4) return false;
   const auto mid = ms.begin() + static_cast<std::ptrdiff_t>(ms.size() / 2);
   std::nth_element(ms.begin(), mid, ms.end());
-  const double limit = kRefineFactor * kRefineFactor * *mid;
+  // Residuals of round-off size are no feature, whatever their ratio: on noise-free marks
+  // (a simulated part's virtual grid) the median cell is at 1e-14 mm and a few cells at
+  // 1e-13 are no neck (their refinement made the fit singular).
+  const double floor = kRefineFloor * setup.mark_spacing;
+  const double limit = std::max(kRefineFactor * kRefineFactor * *mid, floor * floor);
   std::vector<int> col(static_cast<std::size_t>(n1), 0), row(static_cast<std::size_t>(n2), 0);
   for (int j = 0; j < n2; ++j)
     for (int i = 0; i < n1; ++i) {
@@ -286,7 +291,20 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
     refined.mesh.breaks1 = std::move(b1);
     refined.mesh.breaks2 = std::move(b2);
     const StageTimes before = res.times;
-    res = analyse_once(grid, refined, progress, &u);
+    // Refinement is an improvement, never a reason to lose the analysis: a refined fit that
+    // fails (a singular system: parts with too few marks and no noise to smooth by) leaves
+    // the last result, with a warning.
+    UndeformedStages next_u;
+    AnalysisResult next;
+    try {
+      next = analyse_once(grid, refined, progress, &next_u);
+    } catch (const InputError& e) {
+      res.warnings.push_back(std::string("mesh refinement at a localised feature skipped (") + e.what() +
+                             "); strains are from the mesh before it");
+      break;
+    }
+    res = std::move(next);
+    u = std::move(next_u);
     res.refinement_rounds = round + 1;
     double smallest = std::numeric_limits<double>::infinity();
     for (int axis = 0; axis < 2; ++axis) {

@@ -231,6 +231,7 @@ DisplayGuard::DisplayGuard() {
 }
 
 DisplayGuard::~DisplayGuard() {
+  while (!held_.empty()) held_.pop_back();  // windows go before their display
   if (server_pid_ <= 0) return;
   stop_server(server_pid_);
   if (had_display_env_)

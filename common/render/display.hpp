@@ -14,11 +14,14 @@
 //     (and what to do); VTK is never reached.
 //
 // Guards may nest; render::write_png() acquires the shared one itself. Hold a guard across
-// several renders (acquire_display()) to start Xvfb only once. Destroy every render window
-// before the guard that gave it its display (the renderer in this folder does).
+// several renders (acquire_display()) to start Xvfb only once; the renderer in this folder
+// then also reuses one window for all of them (held by the guard, see hold()). Destroy every
+// render window before the guard that gave it its display.
 
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 #include <sys/types.h>
 
 namespace sf::render {
@@ -36,11 +39,16 @@ class DisplayGuard {
   // True when this guard started (and will stop) a private Xvfb.
   bool owns_server() const { return server_pid_ > 0; }
 
+  // Keeps `resource` (e.g. a render window reused across pictures) alive as long as this
+  // guard, and destroys it first in the guard's destructor, while the display still exists.
+  void hold(std::shared_ptr<void> resource) { held_.push_back(std::move(resource)); }
+
  private:
   std::string display_;
   pid_t server_pid_ = -1;
   bool had_display_env_ = false;
   std::string previous_display_;
+  std::vector<std::shared_ptr<void>> held_;
 };
 
 // The process-wide guard: the one alive if any, else a new one. It lives while a caller

@@ -34,6 +34,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -685,8 +687,36 @@ Vec2 text_extent(const std::string& text, double size_px, bool bold) {
 
 namespace {
 
-// Renders the scene at `size` into `image` (RGB, VTK's bottom-up rows).
-Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* image) {
+// One off-screen window for every picture drawn while a display guard lives. A new window
+// per picture creates a GL context and allocates and clears its framebuffers afresh: that
+// was a fifth of `simform plot`'s processor time (memset of new framebuffer textures) plus
+// the page faults behind it. The guard holds the window and destroys it before its display.
+struct ReusedWindow {
+  vtkSmartPointer<vtkRenderWindow> win = vtkSmartPointer<vtkRenderWindow>::New();
+  ReusedWindow() {
+    win->SetOffScreenRendering(1);
+    win->SetMultiSamples(0);
+  }
+  ~ReusedWindow() { win->Finalize(); }
+  ReusedWindow(const ReusedWindow&) = delete;
+  ReusedWindow& operator=(const ReusedWindow&) = delete;
+};
+
+vtkRenderWindow* window_for(DisplayGuard& guard) {
+  static std::weak_ptr<ReusedWindow> cached;
+  static const DisplayGuard* owner = nullptr;
+  std::shared_ptr<ReusedWindow> w = cached.lock();
+  if (!w || owner != &guard) {
+    w = std::make_shared<ReusedWindow>();
+    guard.hold(w);
+    cached = w;
+    owner = &guard;
+  }
+  return w->win;
+}
+
+// Renders the scene at `size` into `image` (RGB, VTK's bottom-up rows) in `win`.
+Framing render_image(const Scene& scene, const ImageSize& size, vtkRenderWindow* win, vtkImageData* image) {
   const Fonts ft(size);
   const Layout layout = layout_of(scene, size);
   const ViewFrame vf = view_frame(scene);
@@ -812,9 +842,6 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
     ren->AddActor2D(actor);
   }
 
-  vtkNew<vtkRenderWindow> win;
-  win->SetOffScreenRendering(1);
-  win->SetMultiSamples(0);
   win->SetSize(size.width, size.height);
   win->AddRenderer(ren);
   win->Render();
@@ -825,7 +852,7 @@ Framing render_image(const Scene& scene, const ImageSize& size, vtkImageData* im
   grab->Update();
 
   image->DeepCopy(grab->GetOutput());
-  win->Finalize();
+  win->RemoveRenderer(ren);  // releases the scene's graphics resources; the window stays
   return framing;
 }
 
@@ -859,13 +886,15 @@ Framing write_png(const Scene& scene, const ImageSize& size, const std::string& 
     if (g.tails.size() != g.heads.size())
       throw std::invalid_argument("render: glyph set with different numbers of tails and heads");
 
+  static std::mutex rendering;  // one window, one picture at a time
+  const std::lock_guard<std::mutex> lock(rendering);
   const auto display = acquire_display();  // before any window exists
   // Supersampling: render at k times the size (with 4x multisampling) and average k x k
   // pixel blocks, for smooth lines, arrow heads and text.
   const int k = std::max(size.width, size.height) * kSupersample <= kMaxRenderSide ? kSupersample : 1;
   const ImageSize big{size.width * k, size.height * k};
   vtkNew<vtkImageData> rendered;
-  Framing framing = render_image(k == 1 ? scene : scaled_overlay(scene, k), big, rendered);
+  Framing framing = render_image(k == 1 ? scene : scaled_overlay(scene, k), big, window_for(*display), rendered);
   framing.width = size.width;
   framing.height = size.height;
   framing.pixels_per_unit /= k;

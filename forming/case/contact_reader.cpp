@@ -48,13 +48,9 @@ const std::vector<std::string> kLawKeys = {"stiffness",  "tolerance", "viscous",
 // The contact law keys of mapping n (those present in kLawKeys); false on a problem.
 bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
   bool ok = true;
-  if (const YAML::Node s = r.required(n, "stiffness", what); s.IsDefined()) {
-    if (const auto v = r.positive(s, what + " stiffness", "S_n, N/mm^3"))
-      law.normal.stiffness = *v;
-    else
-      ok = false;
-  } else
-    ok = false;
+  ok = r.required_key(n, "stiffness", what, law.normal.stiffness, [&](const YAML::Node& s) {
+    return r.positive(s, what + " stiffness", "S_n, N/mm^3");
+  }) && ok;
   if (n["tolerance"].IsDefined()) {
     if (const auto v =
             r.positive(n["tolerance"], what + " tolerance", "largest penetration, mm; augmented Lagrangian")) {
@@ -64,20 +60,8 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
       ok = false;
   }
   const auto nonneg = [&](const char* key, const std::string& unit, double& out) {
-    const YAML::Node v = n[key];
-    if (!v.IsDefined()) return;
-    const auto x = r.number(v, what + " " + key);
-    if (!x) {
-      ok = false;
-      return;
-    }
-    if (*x < 0.0) {
-      r.problem(ProblemKind::kOutOfRange, v,
-                what + " " + key + ": expected a value >= 0 (" + unit + "), found " + v.Scalar());
-      ok = false;
-      return;
-    }
-    out = *x;
+    ok = r.optional_key(n, key, out, [&](const YAML::Node& v) { return r.non_negative(v, what + " " + key, unit); }) &&
+         ok;
   };
   nonneg("viscous", "c_f, N s/mm^3", law.friction.viscous);
   nonneg("coulomb", "mu", law.friction.coulomb);
@@ -92,31 +76,21 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
               what + ": Coulomb friction needs stick_velocity (mm/s, the slip rate below which it sticks)");
     ok = false;
   }
-  if (n["points"].IsDefined()) {
-    if (const auto v = r.integer(n["points"], what + " points (per face direction)", 1, 12))
-      law.points = *v;
-    else
-      ok = false;
-  }
-  if (n["band"].IsDefined()) {
-    if (const auto v = r.positive(n["band"], what + " band", "mm"))
-      law.band = *v;
-    else
-      ok = false;
-  }
-  if (n["two_pass"].IsDefined()) {
-    if (const auto v = r.boolean(n["two_pass"], what + " two_pass"))
-      law.two_pass = *v;
-    else
-      ok = false;
-  }
+  ok = r.optional_key(n, "points", law.points, [&](const YAML::Node& v) {
+    return r.integer(v, what + " points (per face direction)", 1, 12);
+  }) && ok;
+  ok = r.optional_key(n, "band", law.band, [&](const YAML::Node& v) { return r.positive(v, what + " band", "mm"); }) &&
+       ok;
+  ok = r.optional_key(n, "two_pass", law.two_pass, [&](const YAML::Node& v) {
+    return r.boolean(v, what + " two_pass");
+  }) && ok;
   return ok;
 }
 
 std::optional<bool> face_of(Reader& r, const YAML::Node& n, const std::string& what) {
-  if (case_yaml::is_scalar(n) && (n.Scalar() == "top" || n.Scalar() == "bottom")) return n.Scalar() == "top";
-  r.problem(ProblemKind::kWrongType, n, what + ": expected top or bottom, found " + describe(n));
-  return std::nullopt;
+  const auto k = r.choice(n, what, {"top", "bottom"}, "top or bottom");
+  if (!k) return std::nullopt;
+  return *k == 0;
 }
 
 // Explicit list of plies: [{angle, thickness, material}, ...], defaults from the laminate.
@@ -147,12 +121,9 @@ bool read_layup_list(Reader& r, const YAML::Node& l, const std::string& what, do
       ok = false;
     }
     ply.material = material;
-    if (p["material"].IsDefined()) {
-      if (const auto m = r.text(p["material"], pw + " material"))
-        ply.material = *m;
-      else
-        ok = false;
-    }
+    ok = r.optional_key(p, "material", ply.material, [&](const YAML::Node& v) {
+      return r.text(v, pw + " material");
+    }) && ok;
     ply.material_index = find_material(spec, ply.material);
     if (ply.material.empty()) {
       r.problem(ProblemKind::kMissing, p, pw + ": no material (give it here or for the laminate)");
@@ -281,12 +252,9 @@ void read_laminate(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
     ok = false;
   // The keys every ply of the laminate shares.
   CasePly base;
-  if (const YAML::Node o = n["origin"]; o.IsDefined()) {
-    if (const auto v = vector3(r, o, what + " origin", "mm"))
-      base.origin = *v;
-    else
-      ok = false;
-  }
+  ok = r.optional_key(n, "origin", base.origin, [&](const YAML::Node& o) {
+    return vector3(r, o, what + " origin", "mm");
+  }) && ok;
   ok = sheet_keys::read_size(r, n, what, base) && ok;
   ok = sheet_keys::read_elements(r, n, what, base) && ok;
   ok = sheet_keys::read_plane_strain(r, n, what, base) && ok;
@@ -531,13 +499,7 @@ void read_contact(Reader& r, const YAML::Node& n, int index, FormingCase& spec) 
   bool ok = true;
   std::string ply_name;
   ok = case_yaml::ply_of(r, n, what, spec, ply_name, c.ply) && ok;
-  if (const YAML::Node f = r.required(n, "face", what); f.IsDefined()) {
-    if (const auto top = face_of(r, f, what + " face"))
-      c.top = *top;
-    else
-      ok = false;
-  } else
-    ok = false;
+  ok = r.required_key(n, "face", what, c.top, [&](const YAML::Node& f) { return face_of(r, f, what + " face"); }) && ok;
   const YAML::Node tool = n["tool"], with = n["with"];
   std::string partner;
   if (tool.IsDefined() == with.IsDefined()) {
@@ -577,13 +539,9 @@ void read_contact(Reader& r, const YAML::Node& n, int index, FormingCase& spec) 
       }
     } else
       ok = false;
-    if (const YAML::Node f = r.required(n, "with_face", what); f.IsDefined()) {
-      if (const auto top = face_of(r, f, what + " with_face"))
-        c.with_top = *top;
-      else
-        ok = false;
-    } else
-      ok = false;
+    ok = r.required_key(n, "with_face", what, c.with_top, [&](const YAML::Node& f) {
+      return face_of(r, f, what + " with_face");
+    }) && ok;
   }
   ok = read_law(r, n, what, c.law) && ok;
   if (ok && spec.solver.arc_length > 0.0 && c.law.friction.active()) {

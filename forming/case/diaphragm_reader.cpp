@@ -85,25 +85,17 @@ bool read_pressure_entry(Reader& r, const YAML::Node& p, const std::string& what
       ok = false;
     } else
       ok = read_pressure_table(r, p["table"], what, load);
-  } else if (const YAML::Node v = r.required(p, "value", what); v.IsDefined()) {
-    if (const auto x = r.positive(v, what + " value", "MPa"))
-      load.value = *x;
+  } else {
+    ok = r.required_key(p, "value", what, load.value,
+                        [&](const YAML::Node& v) { return r.positive(v, what + " value", "MPa"); });
+  }
+  if (with_face && p["face"].IsDefined()) {
+    if (const auto k = r.choice(p["face"], what + " face", {"top", "bottom"},
+                                "top (on the upper diaphragm, pushing down) or bottom (on the lower diaphragm, "
+                                "pushing up)"))
+      load.top = *k == 0;
     else
       ok = false;
-  } else
-    ok = false;
-  if (with_face && p["face"].IsDefined()) {
-    const YAML::Node f = p["face"];
-    if (case_yaml::is_scalar(f) && (f.Scalar() == "top" || f.Scalar() == "bottom"))
-      load.top = f.Scalar() == "top";
-    else {
-      r.problem(ProblemKind::kWrongType, f,
-                what +
-                    " face: expected top (on the upper diaphragm, pushing down) or bottom (on the lower "
-                    "diaphragm, pushing up), found " +
-                    describe(f));
-      ok = false;
-    }
   }
   if (!case_yaml::ramp_of(r, p, what, load.ramp)) ok = false;
   load.kind = CaseLoad::Kind::kPressure;
@@ -241,17 +233,12 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
     vacuum.follower = true;
     vacuum.place = place_of(v);
     if (case_yaml::is_map(v) && v["hold"].IsDefined()) {
-      const YAML::Node h = v["hold"];
-      if (case_yaml::is_scalar(h) && (h.Scalar() == "tie" || h.Scalar() == "friction")) {
-        tie = h.Scalar() == "tie";
-      } else {
-        r.problem(ProblemKind::kWrongType, h,
-                  what +
-                      " vacuum hold: expected friction (the laminate held by the contact law's friction) or tie "
-                      "(its outer faces tied to the diaphragms), found " +
-                      describe(h));
+      if (const auto k = r.choice(v["hold"], what + " vacuum hold", {"friction", "tie"},
+                                  "friction (the laminate held by the contact law's friction) or tie (its outer "
+                                  "faces tied to the diaphragms)"))
+        tie = *k == 1;
+      else
         ok = false;
-      }
     }
     ok = has_vacuum && ok;
   }
@@ -261,12 +248,9 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
   }
   // Contact laws.
   CaseContactLaw grip;
-  if (const YAML::Node c = r.required(n, "contact", what); c.IsDefined()) {
-    if (r.mapping(c, what + " contact", contact_law_keys()))
-      ok = read_contact_law(r, c, what + " contact", grip) && ok;
-    else
-      ok = false;
-  } else
+  if (const YAML::Node c = r.required(n, "contact", what); r.mapping(c, what + " contact", contact_law_keys()))
+    ok = read_contact_law(r, c, what + " contact", grip) && ok;
+  else
     ok = false;
   struct ToolPair {
     int tool = -1;
@@ -306,13 +290,11 @@ void read_diaphragms(Reader& r, const YAML::Node& n, FormingCase& spec) {
         } else
           ok = false;
         if (const YAML::Node f = ts[i]["face"]; f.IsDefined()) {
-          if (case_yaml::is_scalar(f) && (f.Scalar() == "top" || f.Scalar() == "bottom"))
-            tp.top = f.Scalar() == "top";
-          else {
-            r.problem(ProblemKind::kWrongType, f,
-                      tw + " face: expected bottom (the lower diaphragm) or top (the upper one), found " + describe(f));
+          if (const auto k =
+                  r.choice(f, tw + " face", {"bottom", "top"}, "bottom (the lower diaphragm) or top (the upper one)"))
+            tp.top = *k == 1;
+          else
             ok = false;
-          }
         }
         ok = read_contact_law(r, ts[i], tw, tp.law) && ok;
         tool_pairs.push_back(tp);

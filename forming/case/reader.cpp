@@ -236,12 +236,9 @@ void read_ply(Reader& r, const YAML::Node& n, int index, FormingCase& spec) {
   ok = sheet_keys::read_size(r, n, what, ply) && ok;
   ok = sheet_keys::read_thickness(r, n, "thickness", what, true, ply.thickness) && ok;
   ok = sheet_keys::read_elements(r, n, what, ply) && ok;
-  if (const YAML::Node a = n["angle"]; a.IsDefined()) {
-    if (const auto v = r.number(a, what + " angle (degrees)"))
-      ply.angle_deg = *v;
-    else
-      ok = false;
-  }
+  ok = r.optional_key(n, "angle", ply.angle_deg, [&](const YAML::Node& a) {
+    return r.number(a, what + " angle (degrees)");
+  }) && ok;
   ok = sheet_keys::read_plane_strain(r, n, what, ply) && ok;
   ok = sheet_keys::read_material(r, n, what, true, spec, ply) && ok;
   if (ok) spec.plies.push_back(ply);
@@ -291,13 +288,9 @@ void read_boundary(Reader& r, const YAML::Node& n, int index, FormingCase& spec)
   bool ok = ply_of(r, b, bw, spec, bc.ply, bc.ply_index);
   const bool symmetry = bc.kind == CaseBoundary::Kind::kSymmetry;
   const std::string side_key = symmetry ? "plane" : "edge";
-  if (const YAML::Node s = r.required(b, side_key, bw); s.IsDefined()) {
-    if (const auto side = side_of(r, s, bw + " " + side_key, symmetry))
-      bc.side = *side;
-    else
-      ok = false;
-  } else
-    ok = false;
+  ok = r.required_key(b, side_key, bw, bc.side, [&](const YAML::Node& s) {
+    return side_of(r, s, bw + " " + side_key, symmetry);
+  }) && ok;
   if (bc.kind == CaseBoundary::Kind::kDisplacement) {
     const YAML::Node v = r.required(b, "value", bw);
     if (v.IsDefined()) {
@@ -341,19 +334,12 @@ bool read_pressure(Reader& r, const YAML::Node& b, const std::string& lw, CaseLo
     }
   } else
     ok = false;
-  if (const YAML::Node v = r.required(b, "value", lw); v.IsDefined()) {
-    if (const auto p = r.number(v, lw + " value (MPa)"))
-      load.value = *p;
-    else
-      ok = false;
-  } else
-    ok = false;
-  if (b["follower"].IsDefined()) {
-    if (const auto f = r.boolean(b["follower"], lw + " follower"))
-      load.follower = *f;
-    else
-      ok = false;
-  }
+  ok = r.required_key(b, "value", lw, load.value, [&](const YAML::Node& v) {
+    return r.number(v, lw + " value (MPa)");
+  }) && ok;
+  ok = r.optional_key(b, "follower", load.follower, [&](const YAML::Node& v) {
+    return r.boolean(v, lw + " follower");
+  }) && ok;
   return ok;
 }
 
@@ -381,20 +367,12 @@ bool read_gravity(Reader& r, const YAML::Node& b, const YAML::Node& key, const s
 
 bool read_edge_force(Reader& r, const YAML::Node& b, const std::string& lw, CaseLoad& load) {
   bool ok = true;
-  if (const YAML::Node e = r.required(b, "edge", lw); e.IsDefined()) {
-    if (const auto side = side_of(r, e, lw + " edge", false))
-      load.side = *side;
-    else
-      ok = false;
-  } else
-    ok = false;
-  if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-    if (const auto v = vector3(r, f, lw + " force", "N, total over the edge"))
-      load.vector = *v;
-    else
-      ok = false;
-  } else
-    ok = false;
+  ok = r.required_key(b, "edge", lw, load.side, [&](const YAML::Node& e) {
+    return side_of(r, e, lw + " edge", false);
+  }) && ok;
+  ok = r.required_key(b, "force", lw, load.vector, [&](const YAML::Node& f) {
+    return vector3(r, f, lw + " force", "N, total over the edge");
+  }) && ok;
   return ok;
 }
 
@@ -417,24 +395,14 @@ bool read_point_force(Reader& r, const YAML::Node& b, const std::string& lw, con
   } else
     ok = false;
   if (const YAML::Node l = b["layer"]; l.IsDefined()) {
-    if (case_yaml::is_scalar(l) && l.Scalar() == "bottom")
-      load.layer = 0;
-    else if (case_yaml::is_scalar(l) && l.Scalar() == "top")
-      load.layer = 1;
-    else if (case_yaml::is_scalar(l) && l.Scalar() == "both")
-      load.layer = -1;
-    else {
-      r.problem(ProblemKind::kWrongType, l, lw + " layer: expected bottom, top or both, found " + describe(l));
-      ok = false;
-    }
-  }
-  if (const YAML::Node f = r.required(b, "force", lw); f.IsDefined()) {
-    if (const auto v = vector3(r, f, lw + " force", "N"))
-      load.vector = *v;
+    if (const auto k = r.choice(l, lw + " layer", {"bottom", "top", "both"}, "bottom, top or both"))
+      load.layer = *k == 2 ? -1 : *k;  // 0 bottom, 1 top, -1 both
     else
       ok = false;
-  } else
-    ok = false;
+  }
+  ok = r.required_key(b, "force", lw, load.vector, [&](const YAML::Node& f) {
+    return vector3(r, f, lw + " force", "N");
+  }) && ok;
   return ok;
 }
 

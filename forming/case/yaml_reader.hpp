@@ -1,6 +1,6 @@
 #pragma once
-// The YAML walking helpers of the case reader (forming/case/reader.cpp and
-// forming/case/contact_reader.cpp), internal to forming/case: yaml-cpp appears in no
+// The YAML walking helpers of the case readers (forming/case/reader.cpp,
+// contact_reader.cpp, diaphragm_reader.cpp), internal to forming/case: yaml-cpp appears in no
 // other header. A Reader collects problems with their places while walking the
 // document; every accessor returns what it could read (or nothing) and records a
 // problem otherwise, so the walk goes on.
@@ -113,6 +113,15 @@ class Reader {
     return v;
   }
 
+  std::optional<double> non_negative(const YAML::Node& n, const std::string& what, const std::string& unit) {
+    const std::optional<double> v = number(n, what);
+    if (v && *v < 0.0) {
+      problem(ProblemKind::kOutOfRange, n, what + ": expected a value >= 0 (" + unit + "), found " + n.Scalar());
+      return std::nullopt;
+    }
+    return v;
+  }
+
   std::optional<int> integer(const YAML::Node& n, const std::string& what, int lo, int hi) {
     if (!n.IsDefined()) return std::nullopt;  // missing: required() said so
     if (!is_scalar(n)) {
@@ -162,7 +171,42 @@ class Reader {
     return n;
   }
 
+  // The shape every reader repeats: key `key` of mapping `parent` read by `read` (an
+  // accessor above, or the like, given the key's node; it returns an optional and
+  // records the problem, with the node's line and column, when the value is bad) into
+  // `field`. optional_key: an absent key leaves `field` alone; required_key: an absent
+  // key is recorded at `parent` as required() does. Both return false on a problem.
+  template <class T, class Read>
+  bool optional_key(const YAML::Node& parent, const std::string& key, T& field, Read read) {
+    const YAML::Node n = parent[key];
+    return !n.IsDefined() || store(read(n), field);
+  }
+  template <class T, class Read>
+  bool required_key(const YAML::Node& parent, const std::string& key, const std::string& what, T& field, Read read) {
+    const YAML::Node n = required(parent, key, what);
+    return n.IsDefined() && store(read(n), field);
+  }
+
+  // One of `words` (its index), else the problem "`what`: expected `expected`, found ..."
+  // (`expected` spells the choices out, e.g. "top or bottom").
+  std::optional<int> choice(const YAML::Node& n, const std::string& what, const std::vector<std::string>& words,
+                            const std::string& expected) {
+    if (is_scalar(n)) {
+      const auto it = std::find(words.begin(), words.end(), n.Scalar());
+      if (it != words.end()) return static_cast<int>(it - words.begin());
+    }
+    problem(ProblemKind::kWrongType, n, what + ": expected " + expected + ", found " + describe(n));
+    return std::nullopt;
+  }
+
  private:
+  template <class T, class V>
+  static bool store(const std::optional<V>& v, T& field) {
+    if (!v) return false;
+    field = *v;
+    return true;
+  }
+
   std::vector<CaseProblem>& problems_;
 };
 

@@ -31,41 +31,8 @@ namespace {
 // p up to ~0.5 MPa and S_n = 50 N/mm^3 is 0.01 mm; twice that.
 constexpr double kPenetrationTol = 0.02;
 
-const char* kBend = R"(units: "mm, N, MPa, s"
-materials:
-  ply_law: {neo_hookean: {E: 200, nu: 0.3}}
-  rubber: {mooney_rivlin: {c10: 0.3, c01: 0.05, nu: 0.45}}
-laminates:
-  - name: lam
-    origin: [0, 0, 1]
-    size: [20, 5]
-    elements: [6, 1]
-    layup: "[0_2]"
-    ply_thickness: 0.5
-    material: ply_law
-    plane_strain: true
-    interface: {stiffness: 50, viscous: 0.02, band: 0.01}
-tools:
-  - name: die
-    die: {centre: [0, 0, 0], normal: [0, 0, 1], slot_half_width: 10, along: [0, 1, 0], edge_radius: 3}
-    motion: {fixed: true}
-diaphragms:
-  name: dd
-  laminate: lam
-  frame: {origin: [0, 0], size: [30, 5]}
-  elements: [10, 1]
-  thickness: 1
-  material: rubber
-  symmetry: [x0]
-  pressure: {value: 0.02, face: top, ramp: linear}
-  vacuum: {pressure: 0.02, ramp: linear}
-  contact: {stiffness: 50, viscous: 0.05, band: 0.01}
-  tools: [{tool: die, stiffness: 50, band: 0.01}]
-boundary_conditions:
-  - symmetry: {ply: lam.1, plane: x0}
-  - symmetry: {ply: lam.2, plane: x0}
-solver: {steps: 3, process_time: 0.1, max_iterations: 40, tolerance: 1.0e-6}
-)";
+// The coarse plane-strain double-diaphragm bend (tests/forming/fixtures.hpp).
+const char* const kBend = fixtures::kDiaphragmBend;
 
 TEST(DiaphragmCase, BuildsTwoSheetsTheirFrameLoadsAndContacts) {
   const CaseCheck c = check_case_text(kBend, "bend.yaml");

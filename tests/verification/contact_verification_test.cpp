@@ -11,7 +11,9 @@
 //     under the rising pressure is the error) and F_x = mu N with N the tool's normal
 //     force (Coulomb, v >> the stick velocity);
 //   * ply pull-out: the middle of three plies (width w, overlap L0) pulled out at speed v
-//     between two held plies: F = 2 w (L0 - d) c_f v at pull-out distance d.
+//     between two held plies: F = 2 w (L0 - d) c_f v at pull-out distance d, and each
+//     interface carries half of it; with the molten fibre law the rig's platen pressure
+//     holds the plies together (without it half of each interface opened: issue 12).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -222,35 +224,52 @@ solver: {steps: 1, tolerance: 1.0e-10}
               penalty, updates);
 }
 
-TEST(PlyPullOut, ForceIsTwoWidthsTimesOverlapTimesCfV) {
-  // Plies 40 x 10 x 0.5; the middle one pulled along x at v = 1 mm/s to d = 8 mm.
+// Ply pull-out (issue 12): plies 40 x 10 x 0.5, the middle one pulled along x at
+// v = 1 mm/s to d = 8 mm in `steps` steps between the outer two, clamped at both ends;
+// `material` (a materials entry's law) for all three, `loads` appended to the case.
+// Per step after the first (which holds the start-up transient) it compares the pull
+// force (reaction of the pulled edge) with F = 2 w (L0 - d) c_f v and the drag of each
+// interface (sum of the friction traction over its contact points) with half of it, and
+// checks that no point of the overlap has opened past the viscous layer's engage gap.
+// Returns the largest relative error of F and of each interface's drag.
+struct PullOutErrors {
+  double force = 0.0, interface = 0.0, largest_gap = 0.0, engage_gap = 0.0;
+};
+
+PullOutErrors pull_out(const std::string& material, const std::string& elements, int steps, const std::string& loads) {
   const double w = 10.0, L0 = 40.0, cf = 0.02, v = 1.0;
   CaseRun r;
   run(R"(
 materials:
-  ply: {neo_hookean: {E: 1000, nu: 0.3}}
+  ply: {)" +
+          material + R"(}
 laminates:
   - name: stack
     size: [40, 10]
-    elements: [6, 1]
+    elements: )" +
+          elements + R"(
     layup: "[0_3]"
     ply_thickness: 0.5
     material: ply
-    interface: {stiffness: 1000, viscous: 0.02}
+    interface: {stiffness: 200, viscous: 0.02}
 boundary_conditions:
   - clamp: {ply: stack.1, edge: x0}
   - clamp: {ply: stack.1, edge: x1}
   - clamp: {ply: stack.3, edge: x0}
   - clamp: {ply: stack.3, edge: x1}
   - displacement: {ply: stack.2, edge: x1, value: [8, 0, 0]}
-solver: {steps: 4, process_time: 8, tolerance: 1.0e-10}
+)" + loads +
+          "\nsolver: {steps: " + std::to_string(steps) +
+          R"(, process_time: 8, tolerance: 1.0e-8}
 )",
       r);
-  // Reaction on the pulled edge (x components of its value dofs, both layers).
+  PullOutErrors e;
+  e.engage_gap = 0.01 * 0.5;  // the viscous layer's default: 0.01 ply thicknesses (mm)
+  if (r.steps.x.size() != static_cast<std::size_t>(steps)) return {1e300, 1e300, 1e300, 0.0};
   const Model& m = r.problem.model;
-  double worst = 0.0;
-  for (std::size_t k = 2; k <= r.steps.x.size(); ++k) {  // step 1 holds the start-up transient
-    const double d = 8.0 * static_cast<double>(k) / 4.0;
+  for (std::size_t k = 2; k <= r.steps.x.size(); ++k) {
+    const double d = 8.0 * static_cast<double>(k) / steps;
+    // Reaction on the pulled edge (x components of its value dofs, both layers).
     double F = 0.0;
     const PlyMesh& ply = m.ply(1);
     for (Index node = 0; node < ply.n_nodes(); ++node) {
@@ -258,11 +277,48 @@ solver: {steps: 4, process_time: 8, tolerance: 1.0e-10}
       if (std::abs(r.x0(dof) - L0) < 1e-9) F += r.steps.reactions[k - 1](dof);
     }
     const double expected = 2.0 * w * (L0 - d) * cf * v;
-    worst = std::max(worst, std::abs(F - expected) / expected);
-    std::printf("pull-out d = %.1f mm: F = %.5g N, 2 w (L0 - d) c_f v = %.5g N\n", d, F, expected);
+    e.force = std::max(e.force, std::abs(F - expected) / expected);
+    std::printf("pull-out d = %.1f mm: F = %.5g N, 2 w (L0 - d) c_f v = %.5g N;", d, F, expected);
+    for (int i = 0; i < m.n_interactions(); ++i) {
+      const auto& c = dynamic_cast<const SurfaceContact&>(m.interaction(i));
+      double drag = 0.0;
+      for (const ContactPointRecord& rec : c.sample(r.steps.x[k - 1], context_of(r, k))) {
+        drag += rec.weight * rec.shear.x();
+        // Points of the overlap (away from the trailing end of the pulled ply).
+        if (rec.partner && rec.position.x() > d + 1.0) e.largest_gap = std::max(e.largest_gap, rec.gap);
+      }
+      e.interface = std::max(e.interface, std::abs(std::abs(drag) - expected / 2) / (expected / 2));
+      std::printf(" interface %d drag %.5g N;", i + 1, std::abs(drag));
+    }
+    std::printf(" largest gap %.3g mm\n", e.largest_gap);
   }
-  EXPECT_LT(worst, 0.03);
-  std::printf("pull-out: largest relative force error %.2e\n", worst);
+  std::printf("pull-out: largest relative error of F %.2e, of an interface's drag %.2e\n", e.force, e.interface);
+  return e;
+}
+
+TEST(PlyPullOut, ForceIsTwoWidthsTimesOverlapTimesCfV) {
+  // The stiff neo-Hookean stand-in (E = 1000 MPa): nothing else presses the plies together.
+  const PullOutErrors e = pull_out("neo_hookean: {E: 1000, nu: 0.3}", "[6, 1]", 4, "");
+  EXPECT_LT(e.force, 0.03);
+  EXPECT_LT(e.interface, 0.03);
+  EXPECT_LT(e.largest_gap, e.engage_gap);
+}
+
+TEST(PlyPullOut, MoltenPliesHeldByThePlatensPressureGiveTheClosedForm) {
+  // The study's molten law (E_f / E_T = 25000, G_L = 0.5 MPa). The resin drag acts on the
+  // inner face of each outer ply only: about its mid-plane a couple of c_f v h / 2 per unit
+  // area, which a clamped ply this soft in transverse shear answers by bowing out of plane
+  // (about 9 um, beyond the 5 um engage gap; docs/forming.md "Ply pull-out"). Without the
+  // rig's platen pressure half of each interface opened and F came out at half the closed
+  // form. A 0.001 MPa platen pressure on the outer faces (the pull-out rig's clamping
+  // pressure, present from the start) keeps the plies together.
+  const PullOutErrors e = pull_out("transversely_isotropic: {E_f: 25000, E_T: 1, G_L: 0.5, G_T: 0.4}", "[6, 1]", 4,
+                                   R"(loads:
+  - pressure: {ply: stack.3, face: top, value: 0.001, follower: false, ramp: constant}
+  - pressure: {ply: stack.1, face: bottom, value: 0.001, follower: false, ramp: constant})");
+  EXPECT_LT(e.force, 0.04);
+  EXPECT_LT(e.interface, 0.04);
+  EXPECT_LT(e.largest_gap, e.engage_gap);
 }
 
 }  // namespace

@@ -103,5 +103,20 @@ TEST(ProcessCase, QuickMatchedDieBendPressesTheLaminateIntoTheDie) {
   std::filesystem::remove_all(dir);
 }
 
+// Every process case of data/forming/processes/ passes `simform check` (the README's
+// commands start from these files; the isotropic dome's gravity needs each material's
+// density, which check demands).
+TEST(ProcessCase, CaseFilesCheckClean) {
+  int n = 0;
+  const std::filesystem::path dir = std::filesystem::path(SF_SOURCE_DIR) / "data/forming/processes";
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    const CaseCheck c = check_case_file(entry.path().string());
+    EXPECT_TRUE(c.ok()) << entry.path().filename() << ": " << (c.ok() ? "" : c.located(0));
+    ++n;
+  }
+  EXPECT_GE(n, 9);
+}
+
 }  // namespace
 }  // namespace sf::forming

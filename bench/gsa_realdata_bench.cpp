@@ -212,11 +212,14 @@ int main(int argc, char** argv) {
       if (std::getenv("PERSEED"))
         std::printf(
             "  seed %d: lg %.2f gauge %.2f auto %.2e peak %.3f/%.3f sc/t %.2f L/h %.2f sw/t %.2f relaxed %ld mesh %s "
-            "rounds %d\n",
+            "rounds %d; blank sc/t %.2f L/h %.2f sw/t %.2f\n",
             seed, ra.log10_delta_optimum, ra.gauge_length / h, ea.interior, ea.peak, ea.peak_exact,
             ra.noise.sigma_correlated / std::max(1e-12, opt.deformed_noise.sigma_correlated * std::sqrt(2.0)),
             ra.noise.correlation_length / h, ra.noise.sigma_white / (opt.deformed_noise.sigma_white * std::sqrt(2.0)),
-            static_cast<long>(ra.relaxed_elements), mesh.c_str(), ra.refinement_rounds);
+            static_cast<long>(ra.relaxed_elements), mesh.c_str(), ra.refinement_rounds,
+            ra.noise_undeformed.sigma_correlated / std::max(1e-12, opt.undeformed_noise.sigma_correlated),
+            ra.noise_undeformed.correlation_length / h,
+            ra.noise_undeformed.sigma_white / std::max(1e-12, opt.undeformed_noise.sigma_white));
     }
     const double k = 1.0 / seeds;
     std::printf(

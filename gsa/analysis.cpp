@@ -68,8 +68,11 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       // Noise correlated over less than a spacing is independent as far as the smoother
       // can tell: there cross-validation, which needs no noise level, is as good and
       // does not inherit the estimate's error (measured: Cp on the wavy part with
-      // 0.03 mm independent noise smoothed 1.6 x worse). Cp where the correlation counts.
-      const bool correlated = undeformed_noise.effective_length() >= d;
+      // 0.03 mm independent noise smoothed 1.6 x worse). Cp where the correlation counts:
+      // over a spacing or more, or neighbouring marks correlated by 0.3 or more (a length
+      // estimated just under the spacing: GCV there chose a gauge of 0.6 spacings and
+      // 3.3 x the 24-neighbour fit's error on the rubber strip, gsa_realdata_bench).
+      const bool correlated = undeformed_noise.correlated_over(d);
       const MatX probes = correlated ? noise_probes(out.noise, marks.undeformed, kCpNoiseProbes) : MatX();
       const double noise_s = seconds_since(tn);
       times.noise += noise_s;

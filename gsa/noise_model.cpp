@@ -21,6 +21,18 @@ double NoiseEstimate::effective_length() const {
   return sigma_correlated > 0.3 * sigma_total() ? correlation_length : 0.0;
 }
 
+double NoiseEstimate::correlation_at(double r) const {
+  const double total = sigma_total();
+  if (!(total > 0.0) || !(sigma_correlated > 0.0) || !(correlation_length > 0.0)) return 0.0;
+  return sigma_correlated * sigma_correlated * std::exp(-r * r / (2.0 * correlation_length * correlation_length)) /
+         (total * total);
+}
+
+bool NoiseEstimate::correlated_over(double d) const {
+  const double length = effective_length();
+  return length > 0.0 && (length >= d || correlation_at(d) >= kCorrelatedAtSpacing);
+}
+
 double NoiseEstimate::mean_variance(const Points3& p) const {
   const double n = static_cast<double>(p.rows());
   if (n < 1) return 0.0;

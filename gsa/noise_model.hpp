@@ -27,6 +27,8 @@
 
 namespace sf::gsa {
 
+inline constexpr double kCorrelatedAtSpacing = 0.3;
+
 struct NoiseEstimate {
   double sigma_correlated = 0.0;    // mm, per coordinate
   double correlation_length = 0.0;  // mm (0: no correlated part found)
@@ -36,6 +38,16 @@ struct NoiseEstimate {
   // The correlation length when the correlated part matters (> 30 % of the total
   // sigma), else 0: the noise counts as independent.
   double effective_length() const;
+  // Correlation of the noise of two points r apart (mm) as a fraction of its total
+  // variance: sigma_c^2 exp(-r^2 / (2 L^2)) / sigma_total^2 (0 without noise).
+  double correlation_at(double r) const;
+  // Whether the smoothing must treat the noise as correlated on marks d apart: the
+  // effective length reaches d, or the noise of neighbouring marks is correlated by
+  // kCorrelatedAtSpacing or more (a length just under d, as DIC points a subset step
+  // apart give). Independent noise on a grid has no pairs closer than d and fits as a
+  // length of 0.5-0.7 d with a correlation at d of 0.08-0.16 (measured: the 21 x 21 grid
+  // of gsa_accuracy_bench); noise correlated over one spacing, 0.5-0.6.
+  bool correlated_over(double d) const;
   // Variance of the mean of the noise at `positions` (k x 3) per component, mm^2.
   double mean_variance(const Points3& positions) const;
   // Variogram bins used: mean distance, estimate, pairs.

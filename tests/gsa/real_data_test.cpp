@@ -112,6 +112,87 @@ TEST(GsaRealData, CorrelatedNoiseIsModelledAndSmoothedAsItShouldBe) {
   EXPECT_EQ(noise_model.smoothing_criterion, "Cp");
 }
 
+// RMS strain error of the 24-nearest-neighbour local fit of F (the issue's yardstick).
+double local_fit_rms(const SyntheticMeasurement& m, double spacing) {
+  const auto local = local_fit_stretches(m.grid, 24);
+  return interior_rms(m, spacing, [&](Index p, double& l1, double& l2) {
+    if (!local[static_cast<std::size_t>(p)]) return false;
+    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
+    return true;
+  });
+}
+
+// Noise correlated over 5 spacings (12.5 mm) on the 100 mm plate, seed 1: the light pilots
+// of the deformed estimate take most of it up themselves and found 0.15 x its amplitude, so
+// Cp under-smoothed to 1.1 x the 24-neighbour fit's error. The blank's heavy pilots see it
+// (0.76 x): its amplitude, sqrt(2) x for both states, is the floor of the deformed one.
+// Measured (seed 1): sigma_c 0.76 x the truth, error 0.68 x the local fit's (the issue's
+// 0.5 is not reached here; the oracle, the best fixed smoothing, gets 0.56 on two seeds).
+TEST(GsaRealData, LongCorrelatedNoiseIsSeenFromTheBlank) {
+  const PointLayout layout = plate();
+  const SyntheticMeasurement m = make_measurement(deformation_of(synthetic_case("stretch")), dic_like(layout, 5.0, 1));
+  const AnalysisResult r = analyse(m.grid, {});
+  const double d = layout.spacing;
+  const double sc = 0.004 * d * std::sqrt(2.0);
+  EXPECT_GT(r.noise.sigma_correlated / sc, 0.5);
+  EXPECT_LT(r.noise.sigma_correlated / sc, 2.0);
+  EXPECT_EQ(r.smoothing_criterion, "Cp");
+  const double e = analysis_rms(m, d, r), e_local = local_fit_rms(m, d);
+  EXPECT_LT(e, 0.8 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
+  EXPECT_EQ(flagged(r), 0);
+  EXPECT_EQ(without_strain(r), 0);
+}
+
+// The MatchID-like rubber strip (20 x 10 mm, about 450 jittered points 0.7 mm apart, 23 %
+// strain) with noise correlated over one spacing, seed 1: the blank's estimate of the
+// length is 0.85 spacings, which the old rule (length >= one spacing) took for independent
+// noise, so GCV chose a gauge of 0.6 spacings and 3.3 x the 24-neighbour fit's error
+// (the issue's "chose a gauge length of about one point spacing"). Neighbouring points'
+// noise is correlated by 0.5 there: Cp. Measured: gauge 5.7 spacings, 0.20 x the local fit.
+TEST(GsaRealData, RubberStripWithNoiseCorrelatedOverASpacingIsSmoothed) {
+  PointLayout layout;
+  layout.kind = PointLayout::Kind::kJittered;
+  layout.length_x = 20.0;
+  layout.length_y = 10.0;
+  layout.spacing = 0.7;
+  SyntheticMeasurementOptions o;
+  o.layout = layout;
+  const double sigma = 0.005 * layout.spacing;
+  o.undeformed_noise = o.deformed_noise = NoiseModel{sigma, layout.spacing, 0.3 * sigma};
+  o.seed = 1;
+  const SyntheticMeasurement m = make_measurement(neck_deformation(0.23, 0.23, 1.0), o);
+  const AnalysisResult r = analyse(m.grid, {});
+  EXPECT_EQ(r.smoothing_criterion, "Cp");
+  EXPECT_GT(r.gauge_length, 2.0 * r.mark_spacing);
+  const double e = analysis_rms(m, layout.spacing, r), e_local = local_fit_rms(m, layout.spacing);
+  EXPECT_LT(e, 0.5 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
+  EXPECT_EQ(without_strain(r), 0);
+}
+
+// The rule that picks Cp over GCV: independent noise on a grid fits as a short length
+// (0.5-0.7 spacings, correlation at one spacing 0.08-0.16, gsa_accuracy_bench's grid) and
+// stays with GCV; a length just under a spacing with the noise mostly correlated counts.
+TEST(GsaRealData, CorrelationAtOneSpacingDecidesTheRule) {
+  const double d = 1.0;
+  auto estimate = [](double sigma_c, double length, double sigma_w) {
+    NoiseEstimate e;
+    e.sigma_correlated = sigma_c, e.correlation_length = length, e.sigma_white = sigma_w;
+    return e;
+  };
+  const NoiseEstimate none;
+  EXPECT_FALSE(none.correlated_over(d));
+  const NoiseEstimate white_on_grid = estimate(0.0065, 0.707, 0.0076);  // 21 x 21 marks, 0.01 white noise
+  EXPECT_LT(white_on_grid.correlation_at(d), 0.2);
+  EXPECT_FALSE(white_on_grid.correlated_over(d));
+  const NoiseEstimate short_length = estimate(0.0035, 0.85, 0.0003);  // the rubber strip's blank, seed 1
+  EXPECT_GT(short_length.correlation_at(d), 0.45);
+  EXPECT_TRUE(short_length.correlated_over(d));
+  const NoiseEstimate long_length = estimate(0.01, 5.0, 0.003);
+  EXPECT_TRUE(long_length.correlated_over(d));
+  const NoiseEstimate mostly_white = estimate(0.001, 5.0, 0.01);  // correlated part below 30 %: independent
+  EXPECT_FALSE(mostly_white.correlated_over(d));
+}
+
 // A neck from 20 % to 100 % engineering strain, about 7 spacings wide, under DIC-like
 // noise: no point is flagged, every point gets a strain, the peak is kept (the issue:
 // an earlier rule flagged the whole neck and reported a fifth of its peak).

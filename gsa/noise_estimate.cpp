@@ -3,9 +3,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <map>
+#include <memory>
 #include <optional>
+#include <thread>
 #include <vector>
 
+#include "common/core/parallel.hpp"
 #include "common/fe/surface_field.hpp"
 #include "common/mesh/neighbours.hpp"
 #include "gsa/deformed_fit.hpp"
@@ -94,24 +99,61 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
     normal.row(k) = t.col(0).cross(t.col(1)).normalized().transpose();
   }
   FitSystem system(mesh, setup.penalties, und.location, und.weight);
+  // A second system, the same bits, for the pilot fitted beside (below).
+  std::unique_ptr<FitSystem> beside;
   std::vector<bool> usable(static_cast<std::size_t>(m));
   for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = und.weight[k] > 0;
   VariogramOptions vo;
   vo.max_lag = kUndeformedMaxLag * d;
   const VariogramPairs pairs(marks.undeformed, usable, d, vo);
-  MatX residual(m, 1);
   const ProbeBank bank = make_probe_bank(marks.undeformed, d);
   system.set_values(marks.undeformed);
-  const Unconfirmed lightest = Unconfirmed::kLightest;
-  NoiseEstimate e = pilot_ladder(8, 1, vo.max_lag, d, true, lightest, [&](int k) -> std::optional<NoiseEstimate> {
+  // One pilot's estimate, fitted in `sys`.
+  auto estimate = [&](int k, FitSystem& sys) -> std::optional<NoiseEstimate> {
     const Penalty pilot = jumps_penalty(k, d);
-    const FitResult f = system.solve(pilot, mesh.geometry(), 0, 1);
+    const FitResult f = sys.solve(pilot, mesh.geometry(), 0, 1);
     if (!f.ok) return std::nullopt;
+    MatX residual(m, 1);
     for (Index i = 0; i < m; ++i) residual(i, 0) = (marks.undeformed.row(i) - f.fitted.row(i)).dot(normal.row(i));
     // The probes' residuals without copies of them (the same factorisation as the data's).
     // (The data's fit with the same matrix succeeded: so does theirs.)
-    auto shrink = [&](const MatX& probes) { return *system.smoothing_residual(probes, pilot, 1); };
+    auto shrink = [&](const MatX& probes) { return *sys.smoothing_residual(probes, pilot, 1); };
     return fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink);
+  };
+  // With two cores the next lighter pilot is fitted beside each one the ladder asks for
+  // (it asks for it next unless it stops there): the ladder's wall time about halves and
+  // it takes the same estimates in the same order, each the same bits in either system
+  // (built alike from the same marks, each with its own factorisation).
+  const bool two = default_threads() >= 2;
+  std::map<int, std::optional<NoiseEstimate>> ahead;
+  const Unconfirmed lightest = Unconfirmed::kLightest;
+  NoiseEstimate e = pilot_ladder(8, 1, vo.max_lag, d, true, lightest, [&](int k) -> std::optional<NoiseEstimate> {
+    if (const auto it = ahead.find(k); it != ahead.end()) return it->second;
+    if (!two || k - 1 < 1) return estimate(k, system);
+    if (!beside) {
+      beside = std::make_unique<FitSystem>(mesh, setup.penalties, und.location, und.weight);
+      beside->set_values(marks.undeformed);
+    }
+    std::optional<NoiseEstimate> lighter;
+    std::exception_ptr error;
+    std::thread other([&] {
+      try {
+        lighter = estimate(k - 1, *beside);
+      } catch (...) {
+        error = std::current_exception();
+      }
+    });
+    std::optional<NoiseEstimate> out;
+    try {
+      out = estimate(k, system);
+    } catch (...) {
+      other.join();
+      throw;
+    }
+    other.join();
+    if (error) std::rethrow_exception(error);
+    ahead.emplace(k - 1, std::move(lighter));
+    return out;
   });
   // Noise-free data (synthetic or computed marks): the residuals are round-off, and a
   // model fitted to them has no meaning, least of all its correlation length (measured:

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -15,11 +16,33 @@
 
 namespace sf {
 
-// fn(i) for i in [0, n); `block` items at a time; `threads` 0 = one per core.
+namespace detail {
+inline std::atomic<int>& thread_setting() {
+  static std::atomic<int> setting{0};
+  return setting;
+}
+}  // namespace detail
+
+// Threads a parallel loop uses by default: set_default_threads(n) when called with n >= 1
+// (e.g. from a command-line option), else the environment variable SF_THREADS when it is a
+// whole number >= 1, else one per core. Results never depend on it (see above): 1 and 2
+// threads give the same numbers to the last bit (tests: gsa.analysis.thread_count_*).
+inline void set_default_threads(int threads) { detail::thread_setting().store(threads > 0 ? threads : 0); }
+inline int default_threads() {
+  if (const int set = detail::thread_setting().load(); set > 0) return set;
+  if (const char* env = std::getenv("SF_THREADS")) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (end != env && *end == '\0' && v >= 1 && v <= 1024) return static_cast<int>(v);
+  }
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// fn(i) for i in [0, n); `block` items at a time; `threads` 0 = default_threads().
 template <class Fn>
 void parallel_for(Index n, const Fn& fn, Index block = 256, int threads = 0) {
   if (n <= 0) return;
-  int n_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int n_threads = threads > 0 ? threads : default_threads();
   n_threads = static_cast<int>(std::min<Index>(n_threads, (n + block - 1) / block));
   if (n_threads <= 1) {
     for (Index i = 0; i < n; ++i) fn(i);

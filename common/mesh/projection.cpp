@@ -22,6 +22,7 @@
 
 #include "common/basis/hermite.hpp"
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
 
 namespace sf::mesh {
 
@@ -550,7 +551,7 @@ template <class Fn>
 void for_each_point(Index n, const std::vector<Index>& order, int threads, const Fn& fn) {
   constexpr Index kBlock = 256;
   int n_threads = threads;
-  if (n_threads == 0) n_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (n_threads == 0) n_threads = default_threads();
   n_threads = static_cast<int>(std::min<Index>(n_threads, (n + kBlock - 1) / kBlock));
   std::atomic<Index> next{0};
   std::exception_ptr error;

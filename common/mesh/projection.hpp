@@ -69,7 +69,7 @@ struct ProjectionOptions {
   int samples_per_edge = 6;     // kd-tree samples per element: samples x samples (>= 1)
   int max_iterations = 30;      // Newton iterations per candidate, over all hops (>= 1)
   double xi_tolerance = 1e-10;  // convergence: xi step below this (> 0, < 0.1)
-  int threads = 0;              // project_all(): 0 = std::thread::hardware_concurrency()
+  int threads = 0;              // project_all(): 0 = sf::default_threads() (common/core/parallel.hpp)
 
   // Throws sf::InputError naming the option, what was expected and what was found.
   void validate() const;

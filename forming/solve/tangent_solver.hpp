@@ -61,11 +61,11 @@ struct FreeDofs {
 // (20: at the dome's sizes about half a factorisation's time; counts, not seconds, so the
 // run does not depend on the machine's load) and whenever the pattern changes;
 // a solve whose stale preconditioner has not converged within kRefactorIterations
-// refactorises it at once and continues from the iterate reached. A solve that does not converge is retried with a fresh
-// preconditioner and then done by the direct LU of the whole K_ff (counted in the solve
-// profile). The preconditioner's UMFPACK solves skip iterative refinement.
-// kAuto: kIterative from kIterativeFrom free unknowns, else direct (measured: docs/
-// forming.md, "Linear solver of the Newton tangent").
+// refactorises it at once and continues from the iterate reached; one that a fresh
+// preconditioner does not bring to the tolerance in kMaxIterations is done by the direct
+// LU of the whole K_ff (counted in the solve profile). The preconditioner's UMFPACK solves skip iterative refinement.
+// kAuto: direct (measured: data/forming/processes/README.md, "Iterative solves of the
+// tangent"; the iterative mode did not pay clearly at any size measured).
 enum class LinearMode { kAuto, kDirect, kIterative, kIterativePly };
 // "auto", "direct", "iterative", "iterative-ply".
 std::string to_string(LinearMode mode);
@@ -84,8 +84,6 @@ class TangentSolver {
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
   // True when the last factorize() set up the iterative path (not the direct one).
   bool iterative() const { return use_iterative_; }
-  // From this many free unknowns up LinearMode::kAuto solves iteratively (several plies).
-  static constexpr Index kIterativeFrom = 20000;
   // Factorisations that fell back to the indefinite solver so far.
   int n_indefinite() const { return n_indefinite_; }
   // The back end that did the last successful factorisation (null before one).

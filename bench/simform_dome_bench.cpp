@@ -10,7 +10,9 @@
 //     factorise  numeric (and symbolic, when the pattern grows) factorisation
 //     solve      triangular solves
 //     other      the rest (line search bookkeeping, outputs, set-up)
-//   peak resident memory (getrusage high-water mark).
+//   peak resident memory (getrusage high-water mark), the threads (element loop, BLAS),
+//   pattern growths (each a new symbolic analysis) and, for the iterative solver, the
+//   GMRES iterations and residuals.
 // A program that prints figures, not a timed test.
 //   build/bin/simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE]
 //                                [--ordering amd|metis|nesdis|default] [--factor-only] [--time-limit S]
@@ -23,14 +25,23 @@
 //   --time-limit S  after S seconds print the figures so far (a snapshot taken while the
 //                 solve runs) and stop with status 3: a size that does not finish a step
 //                 still reports where its time went
+//   --linear M    the Newton tangent's linear solver: direct, iterative, iterative-ply or
+//                 auto (the case key solver: {linear: M}; forming/solve/tangent_solver.hpp)
+//   --iterative   no run: the start tangent solved by the direct path and by GMRES with
+//                 the per-ply preconditioner (iterations, residuals, times)
+//   --no-band-pattern  a growing tangent pattern takes only the contact entries present
+//                 (the old behaviour), not every pair within the search band
 //   --factor-only no run: the tangent of the flat start (contact pattern included: the
 //                 plies touch and the die and holder touch the stack) factorised by each
 //                 direct solver and ordering, printing nnz, fill, flops and seconds (the
 //                 numeric factorisation is repeated with the analysis kept)
+#include <omp.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
@@ -40,6 +51,8 @@
 
 #include "common/core/error.hpp"
 #include "common/io/csv.hpp"
+#include "common/core/memory.hpp"
+#include "common/linalg/krylov.hpp"
 #include "common/linalg/solver.hpp"
 #include "forming/case/build.hpp"
 #include "forming/case/reader.hpp"
@@ -90,11 +103,95 @@ static void print_split(const SolveProfile& p, double total, double cpu, long it
       p.contact_eval_s / n_it, p.contact_merge_s / n_it,
       static_cast<double>(p.contact_entries) / static_cast<double>(std::max(1L, p.assemblies)));
   std::printf("linear: %s\n", solve_profile_linear_summary(p).c_str());
+  std::printf("pattern: %ld growths (each a new symbolic analysis), %.3f s laying out the search band (%s)\n",
+              p.pattern_growths, p.band_layout_s, Model::band_pattern() ? "band pattern on" : "--no-band-pattern");
   std::printf("peak memory %.0f MB\n", peak_mb());
 }
 
+// Random numbers in [-1, 1], the same on every run.
+static Eigen::VectorXd fixed_random(Index n) {
+  Eigen::VectorXd v(n);
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL;
+  for (Index i = 0; i < n; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    v(i) = static_cast<double>(state >> 11) / static_cast<double>(1ULL << 52) - 1.0;
+  }
+  return v;
+}
+
+// --iterative: the start tangent solved by the direct path and by GMRES with the per-ply
+// preconditioner (forming/solve/tangent_solver.hpp), both storages, for a random
+// right-hand side and for K times a smooth field; prints times, iterations, residuals and
+// the difference of the solutions.
+static void compare_iterative(const Model& model, linalg::PatternAssembler& pa, bool unsymmetric) {
+  const linalg::SparseMatrix& k = pa.matrix();
+  const Index n = k.rows();
+  const std::vector<int> group = ply_groups(model, pa.active_dofs());
+  const linalg::Storage storage = pa.storage();
+  Eigen::MatrixXd b(n, 2);
+  b.col(0) = fixed_random(n);
+  {
+    // K u for u a smooth field: each unknown's value a slow sine of its index.
+    Eigen::VectorXd u(n), ku(n);
+    for (Index i = 0; i < n; ++i) u(i) = std::sin(6.0 * static_cast<double>(i) / static_cast<double>(n));
+    linalg::multiply(k, storage, u, ku);
+    b.col(1) = ku;
+  }
+  const char* label = storage == linalg::Storage::kLower ? "lower (symmetric)" : "full (unsymmetric)";
+  std::vector<Eigen::MatrixXd> solutions;
+  for (LinearMode mode : {LinearMode::kDirect, LinearMode::kIterativePly}) {
+    solve_profile().reset();
+    TangentSolver solver(linalg::SolverKind::kAuto, unsymmetric, mode, group);
+    const double w0 = thread_cpu_seconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    const linalg::SolveReport r = solver.factorize(k);
+    const double f_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double f_cpu = thread_cpu_seconds() - w0;
+    const double factor_nnz = solve_profile().factor_nnz, factor_flops = solve_profile().factor_flops;
+    if (!r.ok()) {
+      std::printf("%-20s %-10s factorisation failed: %s\n", label, to_string(mode).c_str(), r.brief().c_str());
+      return;
+    }
+    // The numeric factorisation again with the analysis kept (a Newton iteration's cost).
+    const auto t1 = std::chrono::steady_clock::now();
+    const double w1 = thread_cpu_seconds();
+    if (mode == LinearMode::kDirect) solver.factorize(k);
+    const double f2_wall = mode == LinearMode::kDirect
+                               ? std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count()
+                               : f_wall;
+    const double f2_cpu = mode == LinearMode::kDirect ? thread_cpu_seconds() - w1 : f_cpu;
+    const auto t2 = std::chrono::steady_clock::now();
+    const double w2 = thread_cpu_seconds();
+    const Eigen::MatrixXd x = solver.solve(b);
+    const double s_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+    const double s_cpu = thread_cpu_seconds() - w2;
+    double worst = 0.0;
+    for (Index c = 0; c < b.cols(); ++c) {
+      Eigen::VectorXd kx(n);
+      linalg::multiply(k, storage, x.col(c), kx);
+      worst = std::max(worst, (kx - b.col(c)).norm() / b.col(c).norm());
+    }
+    const SolveProfile& p = solve_profile();
+    std::printf(
+        "%-20s %-10s first factorise %.3f s (%.3f cpu), again %.3f s (%.3f cpu), 2 solves %.3f s (%.3f cpu), "
+        "|Kx-b|/|b| %.2g",
+        label, to_string(mode).c_str(), f_wall, f_cpu, f2_wall, f2_cpu, s_wall, s_cpu, worst);
+    if (mode == LinearMode::kIterativePly)
+      std::printf(", GMRES iterations %ld (%ld solves), fallbacks %ld, preconditioner nnz(factor) %.4g (%.3g Gflop)",
+                  p.krylov_iterations, p.krylov_solves, p.direct_fallbacks, factor_nnz, factor_flops * 1e-9);
+    else
+      std::printf(", nnz(factor) %.4g (%.3g Gflop, %s)", factor_nnz, factor_flops * 1e-9, p.solver.c_str());
+    solutions.push_back(x);
+    if (solutions.size() == 2)
+      std::printf(", |x_it - x_direct|/|x_direct| %.2g",
+                  (solutions[1] - solutions[0]).norm() / std::max(1e-300, solutions[0].norm()));
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+}
+
 // --factor-only: the start tangent through each solver and ordering.
-static int factor_only(const FormingCase& spec) {
+static int factor_only(const FormingCase& spec, bool iterative) {
   const Problem problem = build_problem(spec);
   const Model& model = problem.model;
   const VecX x = model.reference_positions();
@@ -116,6 +213,15 @@ static int factor_only(const FormingCase& spec) {
   std::printf("start tangent: n %ld, nnz %ld (both triangles), %ld (lower); %s\n", static_cast<long>(full.n_active()),
               static_cast<long>(full.matrix().nonZeros()), static_cast<long>(lower.matrix().nonZeros()),
               linalg::blas_description().c_str());
+  if (iterative) {
+    // How unsymmetric the tangent is (viscous slip, two-pass contact): |K - K^T| / |K|.
+    const linalg::SparseMatrix kt = full.matrix().transpose();
+    std::printf("asymmetry |K - K^T|_F / |K|_F = %.3g\n",
+                linalg::SparseMatrix(full.matrix() - kt).norm() / full.matrix().norm());
+    compare_iterative(model, full, true);
+    compare_iterative(model, lower, false);
+    return 0;
+  }
   std::printf("%-20s %-8s %-30s %12s %7s %9s %10s %10s %10s %s\n", "solver", "ordering", "ordering used", "nnz(factor)",
               "fill", "Gflop", "analyse_s", "factor_s", "factor_cpu", "status");
   using linalg::Ordering;
@@ -156,11 +262,16 @@ static int factor_only(const FormingCase& spec) {
 }
 
 int main(int argc, char** argv) {
+  // Freed factorisation memory kept for reuse (common/linalg/solver.hpp), at start-up as in
+  // every program that factorises; GLIBC_TUNABLES=glibc.malloc... restores glibc's default.
+  const bool kept = linalg::keep_freed_memory();
   std::string file = std::string(SF_SOURCE_DIR) + "/data/forming/processes/dome_0_90s.yaml";
   bool quick = false;
   int max_steps = 0;
   int n_elements = 0;
   bool only_factor = false;
+  bool iterative = false;
+  std::string linear;
   double time_limit = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -189,12 +300,20 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--factor-only") {
       only_factor = true;
+    } else if (a == "--iterative") {
+      only_factor = true;
+      iterative = true;
+    } else if (a == "--no-band-pattern") {
+      Model::set_band_pattern(false);
+    } else if (a == "--linear" && i + 1 < argc) {
+      linear = argv[++i];
     } else if (a == "--case" && i + 1 < argc) {
       file = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
-                   "[--factor-only]\n");
+                   "[--factor-only | --iterative] [--linear direct|iterative|iterative-ply|auto] [--no-band-pattern] "
+                   "[--time-limit S]\n");
       return 2;
     }
   }
@@ -218,8 +337,12 @@ int main(int argc, char** argv) {
                 quick ? " (--quick: at most 4 x 4 bricks a ply)" : "", spec.plies.size(), elements,
                 spec.contacts.size(), spec.solver.steps,
                 max_steps > 0 ? (", stopping after " + std::to_string(max_steps)).c_str() : "");
+    std::printf("threads: %d for the element loop (OpenMP), factorisation BLAS: %s; freed memory %s\n",
+                omp_get_max_threads(), linalg::blas_description().c_str(),
+                kept ? "kept for reuse (mallopt)" : "returned to the system (malloc tuned by the environment)");
     std::fflush(stdout);
-    if (only_factor) return factor_only(spec);
+    if (!linear.empty()) spec.solver.linear = to_string(parse_linear_mode(linear, "--linear"));
+    if (only_factor) return factor_only(spec, iterative);
     // One folder per process: runs side by side (sizes, orderings) do not collide.
     const std::filesystem::path dir =
         std::filesystem::temp_directory_path() / ("sf_simform_dome_bench_" + std::to_string(getpid()));

@@ -87,6 +87,8 @@ class PatternAssembler {
   // Grows the pattern by the entries add() kept aside (values are kept) and adds them;
   // false when there were none. Call after the last add() of an assembly.
   bool flush();
+  // True when add() has kept entries aside since the last flush() (the pattern will grow).
+  bool has_pending() const { return !pending_.empty(); }
   // Positions in matrix().valuePtr() of the entries of m (n_dofs x n_dofs) as add()
   // would place them, -1 for dropped entries and for entries outside the pattern.
   std::vector<std::int64_t> positions_of(const SparseMatrix& m) const;

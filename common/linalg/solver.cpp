@@ -77,6 +77,8 @@ class Backend {
   virtual std::string ordering_used() const { return {}; }
   // Fill-reducing ordering of the next analysis (back ends with a choice).
   virtual void set_ordering(Ordering) {}
+  // Iterative refinement of solves (back ends that do it: UMFPACK, 2 steps by default).
+  virtual void set_refinement(bool) {}
 };
 
 // OpenBLAS's thread control, looked up at run time (any BLAS may be installed as
@@ -245,6 +247,8 @@ class UmfpackBackend final : public Backend {
     lu_.umfpackControl()(UMFPACK_ORDERING) =
         ordering == Ordering::kMetis || ordering == Ordering::kNesdis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
   }
+
+  void set_refinement(bool on) override { lu_.umfpackControl()(UMFPACK_IRSTEP) = on ? 2 : 0; }
 
   Outcome analyze(const SparseMatrix& a) override {
     lu_.analyzePattern(a);
@@ -585,7 +589,6 @@ struct LinearSolver::Impl {
 };
 
 LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property) : impl_(std::make_unique<Impl>()) {
-  keep_freed_memory();
   const bool needs_symmetry = reads_lower_triangle(kind);
   if (needs_symmetry && property == MatrixProperty::kUnsymmetric) {
     throw InputError(
@@ -633,6 +636,11 @@ void LinearSolver::set_ordering(Ordering ordering) {
   impl_->report = SolveReport{};
   impl_->report.used = impl_->kind;
   impl_->report.message = "nothing factorised yet";
+}
+
+void LinearSolver::set_refinement(bool on) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  impl_->backend->set_refinement(on);
 }
 
 Ordering LinearSolver::ordering() const {

@@ -88,10 +88,13 @@ std::string blas_description();
 // time (UMFPACK's numeric object, tens to hundreds of MB); glibc hands blocks that large
 // out by mmap and returns them on free, so every factorisation page-faults its memory in
 // again (measured on the quick dome: 175 k page faults and 60 % of the processor time,
-// against 17 k with the memory kept). The first LinearSolver made therefore raises glibc's
-// mmap threshold to 1 GiB and its trim threshold to 2 GiB (mallopt), so freed blocks stay
+// against 17 k with the memory kept). Programs that factorise large matrices call this at
+// start-up, before large allocations (simform calls sf::keep_freed_memory of common/core/
+// memory.hpp, which goes further; the benches call this one): it raises glibc's mmap
+// threshold to 1 GiB and its trim threshold to 2 GiB (mallopt), so freed blocks stay
 // in the heap and the next factorisation reuses them: peak memory is unchanged, resident
-// memory stays near the peak between factorisations. Left alone when the user tunes malloc
+// memory stays near the peak between factorisations. Libraries (LinearSolver) do not call
+// it: a process-wide malloc setting is the program's choice. Left alone when the user tunes malloc
 // (GLIBC_TUNABLES naming glibc.malloc, or MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_
 // set). Returns true when it changed the settings (once per process).
 bool keep_freed_memory();
@@ -164,6 +167,10 @@ class LinearSolver {
   // the Eigen ones). Drops the current analysis when it changes.
   void set_ordering(Ordering ordering);
   Ordering ordering() const;
+  // Iterative refinement of solve() (UMFPACK: up to 2 steps by default, each a product
+  // with A and another pair of triangular solves; ignored by the other back ends). Off
+  // for a preconditioner, whose solves need not be exact: a third of the solve's cost.
+  void set_refinement(bool on);
 
   // Numeric factorisation of a. Analyses first when no analysis exists or when
   // a's pattern (size, column pointers, row indices) differs from the analysed

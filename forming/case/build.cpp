@@ -15,6 +15,7 @@
 #include "forming/material/transversely_isotropic.hpp"
 #include "forming/model/ply_grid.hpp"
 #include "forming/model/tied_faces.hpp"
+#include "forming/solve/tangent_solver.hpp"
 
 namespace sf::forming {
 namespace {
@@ -178,6 +179,12 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.statics.min_increment = s.min_increment;
   out.statics.extrapolate = s.extrapolate;
   out.statics.validate();
+  // The run's tangent workspaces, made here to carry the linear-solver choice.
+  const LinearMode linear = parse_linear_mode(s.linear, "solver linear");
+  out.statics.workspace = std::make_shared<TangentWorkspace>();
+  out.statics.workspace->linear = linear;
+  out.dynamics.workspace = std::make_shared<TangentWorkspace>();
+  out.dynamics.workspace->linear = linear;
   out.uzawa.tolerance = s.constraint_tolerance;
   out.process_time = s.process_time;
 

@@ -460,7 +460,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver",
                  {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
                   "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
-                  "stop_displacement", "process_time", "predictor"}))
+                  "stop_displacement", "process_time", "predictor", "linear"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -561,6 +561,16 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                 "solver predictor: expected tangent (default) or extrapolate (start each step from the last "
                 "step's increment), found " +
                     describe(pr));
+  }
+  if (const YAML::Node li = n["linear"]; li.IsDefined()) {
+    if (case_yaml::is_scalar(li) && (li.Scalar() == "direct" || li.Scalar() == "iterative" ||
+                                     li.Scalar() == "iterative-ply" || li.Scalar() == "auto"))
+      s.linear = li.Scalar();
+    else
+      r.problem(ProblemKind::kWrongType, li,
+                "solver linear: expected direct (sparse LU / Cholesky), iterative (GMRES preconditioned by an earlier "
+                "tangent's factorisation), iterative-ply (GMRES preconditioned per ply) or auto (by size), found " +
+                    describe(li));
   }
   if (n["line_search"].IsDefined())
     if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;

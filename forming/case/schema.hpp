@@ -166,7 +166,11 @@ struct CaseSolver {
   // predictor: extrapolate (load control): each step's first iterate starts from the
   // last step's increment (forming/solve/static_solver.hpp StaticOptions::extrapolate).
   bool extrapolate = false;
-  double process_time = 1.0;   // s
+  double process_time = 1.0;  // s
+  // linear: how the Newton tangent is solved: direct (sparse LU / Cholesky), iterative
+  // (GMRES preconditioned by an earlier tangent's factorisation), iterative-ply (GMRES
+  // preconditioned per ply) or auto (by size); forming/solve/tangent_solver.hpp.
+  std::string linear = "auto";
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given
 };

@@ -233,6 +233,40 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
   }
 }
 
+void SurfaceContact::pattern_blocks(
+    const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+    const std::function<void(const std::vector<Index>& rows, const std::vector<Index>& cols)>& block) const {
+  const std::unique_ptr<Prepared> prepared = prepare(x, context, nullptr, nullptr);
+  std::vector<Index> masters;
+  std::vector<Index> rows, cols;
+  for (Index f = 0; f < slave_.n_faces(); ++f) {
+    const SurfaceFace& sf = slave_.face(f);
+    const int ns = slave_.basis(f).n_active();
+    const MatX pos = slave_.positions(f, x);
+    masters.clear();
+    for (int q = 0; q < points_per_face(); ++q) {
+      const FaceBasisValues& v = point_basis_[static_cast<std::size_t>(f)][static_cast<std::size_t>(q)];
+      PointKinematics k;
+      k.n = k.n_slave = ns;
+      Vec3 xs = Vec3::Zero();
+      for (int a = 0; a < ns; ++a) {
+        k.phi[static_cast<std::size_t>(a)] = v.value[static_cast<std::size_t>(a)];
+        xs += v.value[static_cast<std::size_t>(a)] * pos.row(a).transpose();
+      }
+      Partner partner;
+      if (!find_partner(*prepared, xs, k, partner)) continue;
+      if (std::find(masters.begin(), masters.end(), partner.master_face) != masters.end()) continue;
+      masters.push_back(partner.master_face);
+      rows = sf.dofs.dofs;  // as scatter(): the slave's rows (a half pass: only those)
+      cols = rows;
+      if (partner.master_dofs)
+        cols.insert(cols.end(), partner.master_dofs->dofs.begin(), partner.master_dofs->dofs.end());
+      if (!options_.half_pass) rows = cols;
+      block(rows, cols);
+    }
+  }
+}
+
 void SurfaceContact::add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
                             InteractionSums& sums) const {
   evaluate(x, context, &sums, nullptr);

@@ -96,6 +96,11 @@ class SurfaceContact : public Interaction {
   void add_to(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums& sums) const override;
   void commit(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
   MultiplierUpdate update_multipliers(const Eigen::Ref<const VecX>& x, const InteractionContext& context) override;
+  // Each slave face with each partner face (or the tool: its own dofs) that any of its
+  // points finds within the search distance at x (Interaction::pattern_blocks).
+  void pattern_blocks(
+      const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+      const std::function<void(const std::vector<Index>& rows, const std::vector<Index>& cols)>& block) const override;
 
   // Every contact point at state x, in order (face-major, then the Gauss grid).
   std::vector<ContactPointRecord> sample(const Eigen::Ref<const VecX>& x, const InteractionContext& context) const;

@@ -41,6 +41,7 @@
 //
 // Units: mm, N, s.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,6 +98,18 @@ class Interaction {
   virtual bool symmetric() const { return true; }
   // True when its force depends on the velocities.
   virtual bool needs_velocity() const { return false; }
+  // The blocks (rows x columns, global dofs) its stiffness may fill at states near x, for
+  // the tangent's pattern: contact gives every slave face and partner face within its
+  // search distance, touching or not, so a pair closing later inside that band finds its
+  // entries laid out and needs no new symbolic analysis (Model::assemble_into asks when
+  // the pattern has to grow anyway). Default: none.
+  virtual void pattern_blocks(
+      const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+      const std::function<void(const std::vector<Index>& rows, const std::vector<Index>& cols)>& block) const {
+    (void)x;
+    (void)context;
+    (void)block;
+  }
   // Reactions on the tools it drives at positions x (none for a body-body interaction).
   virtual std::vector<ToolReaction> reactions(const Eigen::Ref<const VecX>& x,
                                               const InteractionContext& context) const {

@@ -27,6 +27,13 @@ std::string short_number(double v) {
 
 Model::Model(ElementRule rule) : rule_(rule), brick_rule_(rule.brick()), kernel_(brick_rule_) {}
 
+namespace {
+std::atomic<bool> g_band_pattern{true};
+}  // namespace
+
+void Model::set_band_pattern(bool on) { g_band_pattern.store(on); }
+bool Model::band_pattern() { return g_band_pattern.load(); }
+
 int Model::threads() const { return threads_ > 0 ? threads_ : omp_get_max_threads(); }
 
 int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
@@ -294,20 +301,33 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
   if (need_k) triplet_hint = stiffness.n_triplets();
   const auto t_merge = std::chrono::steady_clock::now();
   profile.contact_eval_s += std::chrono::duration<double>(t_merge - t_elements).count();
-  if (added && need_k) merge_interactions(stiffness, tangent, direction, out);
+  if (added && need_k) merge_interactions(x, context, stiffness, tangent, direction, out);
   const auto t_end = std::chrono::steady_clock::now();
   profile.contact_merge_s += std::chrono::duration<double>(t_end - t_merge).count();
   profile.contact_s += std::chrono::duration<double>(t_end - t_elements).count();
   return out;
 }
 
-void Model::merge_interactions(const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
+void Model::merge_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                               const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
                                const VecX* direction, Assembly& out) const {
   for (const Eigen::Triplet<double, int>& t : stiffness.triplets()) {
     if (tangent) tangent->add(t.row(), t.col(), t.value());
     if (direction) out.tangent_times(t.row()) += t.value() * (*direction)(t.col());
   }
   SolveProfile& profile = solve_profile();
+  if (tangent && tangent->has_pending() && band_pattern()) {
+    // The pattern grows (a new symbolic analysis follows): lay it out for every pair
+    // within the interactions' bands at once, adding explicit zeros.
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& interaction : interactions_)
+      interaction->pattern_blocks(x, context,
+                                  [tangent](const std::vector<Index>& rows, const std::vector<Index>& cols) {
+                                    for (Index c : cols)
+                                      for (Index r : rows) tangent->add(r, c, 0.0);
+                                  });
+    profile.band_layout_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   profile.contact_entries += static_cast<long>(stiffness.triplets().size());
   if (tangent && tangent->flush()) ++profile.pattern_growths;
 }

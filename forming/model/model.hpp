@@ -144,6 +144,11 @@ class Model {
   // or the cores); results do not depend on it.
   void set_threads(int threads) { threads_ = threads; }
   int threads() const;
+  // Whether a growing tangent pattern is laid out for every interaction pair within the
+  // search band (merge_interactions; default on). Process-wide: for benchmarks comparing
+  // re-analyses with and without it (bench/simform_dome_bench.cpp --no-band-pattern).
+  static void set_band_pattern(bool on);
+  static bool band_pattern();
   // The brick kernel the assembly uses (its flop counts, for benchmarks).
   const BrickKernel& kernel() const { return kernel_; }
   // The straightforward assembly (triplets, full n_dofs x n_dofs tangent) that
@@ -168,7 +173,11 @@ class Model {
   bool add_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent,
                         linalg::TripletAssembler& stiffness, Assembly& out) const;
   // Interactions' stiffness (and direction product) into the fast assembly.
-  void merge_interactions(const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
+  // When the pattern must grow it grows for every interaction's pattern_blocks at x as
+  // well (contact: every pair within the search band), so pairs closing later inside the
+  // band need no new growth.
+  void merge_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context,
+                          const linalg::TripletAssembler& stiffness, linalg::PatternAssembler* tangent,
                           const VecX* direction, Assembly& out) const;
   ElementRule rule_;
   quadrature::TensorRule<3> brick_rule_;

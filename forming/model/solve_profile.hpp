@@ -22,8 +22,9 @@ struct SolveProfile {
   // growth when a contact entry falls outside it).
   double contact_eval_s = 0.0;
   double contact_merge_s = 0.0;
-  long contact_entries = 0;  // triplets merged (summed over assemblies)
-  long pattern_growths = 0;  // merges that grew the pattern (the next factorisation re-analyses)
+  long contact_entries = 0;    // triplets merged (summed over assemblies)
+  long pattern_growths = 0;    // merges that grew the pattern (the next factorisation re-analyses)
+  double band_layout_s = 0.0;  // part of contact_merge_s: laying the grown pattern out for the search band
   // Symbolic analyses (fill-reducing ordering) and their seconds, part of factorize_s.
   long analyses = 0;
   double analyse_s = 0.0;
@@ -35,6 +36,15 @@ struct SolveProfile {
   double factor_flops = 0.0;
   std::string solver;
   std::string ordering;
+  // Iterative solves of the tangent (forming/solve/tangent_solver.hpp, linear: iterative):
+  // GMRES solves, their iterations in all, the largest relative residual |K dx + r| / |r|
+  // they ended with, factorisations of the per-ply preconditioner, and solves that fell
+  // back to the direct LU (GMRES did not converge).
+  long krylov_solves = 0;
+  long krylov_iterations = 0;
+  double krylov_worst_residual = 0.0;
+  long preconditioner_factorizations = 0;
+  long direct_fallbacks = 0;
   void reset() { *this = SolveProfile{}; }
 };
 

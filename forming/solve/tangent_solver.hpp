@@ -3,6 +3,7 @@
 // the free dofs of a solve (and the selection matrix that restricts a vector or a
 // matrix to them) and the linear solver of the Newton tangent.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "common/core/types.hpp"
@@ -42,13 +43,47 @@ struct FreeDofs {
 // one.
 // Each back end keeps its symbolic analysis while the pattern stays the same (across
 // iterations and, with a solver kept between solves, load steps).
+//
+// Iterative modes (the case key `solver: {linear: iterative | iterative-ply}`): solve()
+// runs restarted GMRES (common/linalg/krylov.hpp) on the whole K_ff, preconditioned by a
+// factorisation made by the direct path above and kept over Newton iterations (and load
+// steps) while it still works:
+//   kIterative     the factorisation of an earlier tangent of the run (K_ff as it was at
+//                  the last refactorisation): near the current one, so GMRES needs a few
+//                  iterations while Newton's tangents change little;
+//   kIterativePly  the block-diagonal part of K_ff, one block per ply (body): each ply's
+//                  own stiffness and the diagonal part of its contact, much smaller
+//                  factors than the laminate's, the contact coupling between plies left
+//                  to the iteration (measured: slow under stiff penalty contact, see docs).
+// Tolerance: |K dx + r| <= kTolerance |r| (1e-10, below the Newton tolerances of the cases,
+// so Newton converges as with the direct solve). The preconditioner is refactorised by the
+// next factorize() when the last solve needed more than kRefactorAfter GMRES iterations
+// (20: at the dome's sizes about half a factorisation's time; counts, not seconds, so the
+// run does not depend on the machine's load) and whenever the pattern changes;
+// a solve whose stale preconditioner has not converged within kRefactorIterations
+// refactorises it at once and continues from the iterate reached; one that a fresh
+// preconditioner does not bring to the tolerance in kMaxIterations is done by the direct
+// LU of the whole K_ff (counted in the solve profile). The preconditioner's UMFPACK solves skip iterative refinement.
+// kAuto: direct (measured: data/forming/processes/README.md, "Iterative solves of the
+// tangent"; the iterative mode did not pay clearly at any size measured).
+enum class LinearMode { kAuto, kDirect, kIterative, kIterativePly };
+// "auto", "direct", "iterative", "iterative-ply".
+std::string to_string(LinearMode mode);
+// Inverse of to_string(LinearMode); sf::InputError otherwise (message starts with `where`).
+LinearMode parse_linear_mode(const std::string& name, const std::string& where = "");
+
 class TangentSolver {
  public:
-  TangentSolver(linalg::SolverKind kind, bool unsymmetric);
+  // group: the ply (any small integer) of each free unknown (the order of K_ff): kAuto
+  // reads its size, kIterativePly its values (a single group: kIterative).
+  TangentSolver(linalg::SolverKind kind, bool unsymmetric, LinearMode mode = LinearMode::kDirect,
+                std::vector<int> group = {});
   // True when factorize() expects the lower triangle only.
   bool lower() const { return lower_; }
   const linalg::SolveReport& factorize(const linalg::SparseMatrix& k);
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+  // True when the last factorize() set up the iterative path (not the direct one).
+  bool iterative() const { return use_iterative_; }
   // Factorisations that fell back to the indefinite solver so far.
   int n_indefinite() const { return n_indefinite_; }
   // The back end that did the last successful factorisation (null before one).
@@ -60,7 +95,27 @@ class TangentSolver {
   static linalg::Ordering default_ordering();
 
  private:
+  const linalg::SolveReport& factorize_direct(const linalg::SparseMatrix& k);
+  bool factorize_preconditioner(const linalg::SparseMatrix& k) const;
+  Eigen::MatrixXd solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+  linalg::SolverKind fallback_kind_ = linalg::SolverKind::kAuto;
+  bool fallback_unsymmetric_ = false;
   std::unique_ptr<linalg::LinearSolver> spd_, general_;
+  // Iterative mode: the tangent (a copy: the caller reassembles in place), the groups, the
+  // preconditioner's state and a direct solver for the fallback (made when first needed).
+  LinearMode mode_ = LinearMode::kDirect;
+  std::vector<int> group_;
+  bool use_iterative_ = false;
+  linalg::SparseMatrix k_;
+  linalg::SolveReport iterative_report_;
+  mutable bool preconditioner_ok_ = false;           // the block factorisation is usable
+  mutable bool preconditioner_fresh_ = false;        // it was made from the current k_
+  mutable bool refactor_next_ = false;               // the next factorize() refactorises it
+  mutable std::unique_ptr<TangentSolver> fallback_;  // direct solver of the whole K_ff
+  static constexpr int kRefactorIterations = 40;     // GMRES iterations allowed a stale preconditioner
+  static constexpr int kRefactorAfter = 20;          // more in a solve: refactorise for the next
+  static constexpr int kMaxIterations = 400;         // and a fresh one
+  static constexpr double kTolerance = 1e-10;        // GMRES: |K dx + r| <= kTolerance |r|
   const linalg::LinearSolver* active_ = nullptr;
   bool lower_ = false;
   // From this many unknowns up the LU orders by METIS (nested dissection) rather than
@@ -71,6 +126,10 @@ class TangentSolver {
   int skip_cholesky_ = 0;          // after a breakdown, the next few factorisations go to general_
   int n_indefinite_ = 0;
 };
+
+// The body (ply) of each of the unknowns `active_dofs` (global dofs, the order of K_ff):
+// the groups of TangentSolver's iterative mode.
+std::vector<int> ply_groups(const Model& model, const std::vector<Index>& active_dofs);
 
 // The Newton tangent's pattern (scatter tables) and its solver (symbolic analysis)
 // kept between solves of one model: the load steps of a run (forming/solve/stepper.hpp),
@@ -97,6 +156,9 @@ class TangentWorkspace {
   // (StaticOptions::extrapolate); empty: none yet.
   VecX last_increment;
   double last_span = 0.0;
+  // Direct or iterative solves of the tangent (the case key `solver: {linear: ...}`); read
+  // by the next prepare() that lays out anew.
+  LinearMode linear = LinearMode::kAuto;
   // How many times prepare() laid the pattern out (1 for a run whose structure stays).
   int layouts() const { return layouts_; }
   // Seconds spent laying patterns out, in total.
@@ -111,6 +173,7 @@ class TangentWorkspace {
   linalg::SolverKind kind_ = linalg::SolverKind::kAuto;
   bool unsymmetric_ = false;
   std::unique_ptr<TangentSolver> solver_;
+  void make_solver(const Model& model);
   std::unique_ptr<linalg::PatternAssembler> pattern_;
   int layouts_ = 0;
   double layout_seconds_ = 0.0;

@@ -347,7 +347,7 @@ TEST(LinalgSolver, UmfpackOrderingsSolveAndFactorSizesAreReported) {
   expect_solves(chol, spd, "cholmod sizes");
   EXPECT_EQ(chol.last_report().ordering, "amd");
   EXPECT_GE(chol.last_report().factor_nonzeros, static_cast<double>(spd.rows()));
-  // The freed-memory setting is made once, by the first solver (or left to the user).
+  // The freed-memory setting is made once per process, by the program at start-up (or left to the user).
   EXPECT_EQ(keep_freed_memory(), keep_freed_memory());
 }
 

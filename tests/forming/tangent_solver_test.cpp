@@ -1,0 +1,215 @@
+// The Newton tangent's iterative solves (forming/solve/tangent_solver.hpp) against the
+// direct one on a contact laminate: the [0,90]s dome case at 3 x 3 bricks a ply (four
+// plies touching each other, the die and the holder; viscous inter-ply slip, so the
+// tangent is unsymmetric).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/linalg/krylov.hpp"
+#include "forming/case/build.hpp"
+#include "forming/case/reader.hpp"
+#include "forming/model/solve_profile.hpp"
+#include "forming/solve/tangent_solver.hpp"
+
+namespace sf::forming {
+namespace {
+
+struct SmallDome {
+  FormingCase spec;
+  Problem problem;
+  std::vector<bool> is_free;
+  VecX x0, x1;  // the flat start and a state moved a little (the free z coordinates lowered)
+  VecX previous;
+  InteractionContext context;
+
+  SmallDome() : spec(small_spec()), problem(build_problem(spec)) {
+    const Model& model = problem.model;
+    x0 = model.reference_positions();
+    is_free = model.used_dofs();
+    for (const PrescribedDof& p : problem.prescriptions.at(1.0 / spec.solver.steps))
+      is_free[static_cast<std::size_t>(p.dof)] = false;
+    // x1: every free coordinate moved by up to 0.01 um, so the contact gaps,
+    // pressures and slip rates all change.
+    x1 = x0;
+    for (Index i = 0; i < x1.size(); ++i)
+      if (is_free[static_cast<std::size_t>(i)]) x1(i) -= 1e-5 * std::sin(0.37 * static_cast<double>(i));
+    previous = x0;
+    context.previous = &previous;
+    context.time = spec.solver.process_time / spec.solver.steps;
+  }
+  SmallDome(const SmallDome&) = delete;
+  SmallDome& operator=(const SmallDome&) = delete;
+
+  static FormingCase small_spec() {
+    FormingCase s = load_case(std::string(SF_SOURCE_DIR) + "/data/forming/processes/dome_0_90s.yaml");
+    for (CasePly& p : s.plies) p.n1 = p.n2 = 3;
+    return s;
+  }
+};
+
+linalg::SparseMatrix tangent_at(const SmallDome& d, const VecX& x, linalg::PatternAssembler& pa) {
+  const Assembly a = d.problem.model.assemble_into(x, d.context, &pa);
+  EXPECT_TRUE(a.ok) << a.message;
+  return pa.matrix();
+}
+
+Eigen::VectorXd smooth_rhs(Index n) {
+  Eigen::VectorXd b(n);
+  for (Index i = 0; i < n; ++i) b(i) = std::cos(0.013 * static_cast<double>(i)) + 0.1 * std::sin(1.7 * i);
+  return b;
+}
+
+double relative_residual(const linalg::SparseMatrix& k, linalg::Storage storage, const Eigen::VectorXd& x,
+                         const Eigen::VectorXd& b) {
+  Eigen::VectorXd kx(b.size());
+  linalg::multiply(k, storage, x, kx);
+  return (kx - b).norm() / b.norm();
+}
+
+// Both storages: the unsymmetric tangent (both triangles, UMFPACK) and its lower triangle
+// as the symmetric path stores it (Cholesky, falling back to LU where indefinite).
+class IterativeTangent : public ::testing::TestWithParam<bool> {};
+
+TEST_P(IterativeTangent, AgreesWithTheDirectSolveWithAPreconditionerFromAnEarlierTangent) {
+  const bool unsymmetric = GetParam();
+  const SmallDome d;
+  linalg::PatternAssembler pa = d.problem.model.make_pattern(d.is_free, !unsymmetric);
+  const linalg::SparseMatrix k0 = tangent_at(d, d.x0, pa);
+  const linalg::SparseMatrix k1 = tangent_at(d, d.x1, pa);
+  ASSERT_EQ(k0.nonZeros(), k1.nonZeros()) << "the small move should keep the contact pattern";
+  ASSERT_GT((k1 - k0).norm(), 1e-6 * k0.norm()) << "the two tangents should differ";
+  const Index n = k1.rows();
+  const std::vector<int> group = ply_groups(d.problem.model, pa.active_dofs());
+  const Eigen::VectorXd b = smooth_rhs(n);
+
+  TangentSolver direct(linalg::SolverKind::kAuto, unsymmetric, LinearMode::kDirect);
+  ASSERT_TRUE(direct.factorize(k1).ok());
+  const Eigen::VectorXd x_direct = direct.solve(b);
+
+  solve_profile().reset();
+  TangentSolver iterative(linalg::SolverKind::kAuto, unsymmetric, LinearMode::kIterative, group);
+  ASSERT_TRUE(iterative.iterative());
+  ASSERT_TRUE(iterative.factorize(k0).ok());
+  const Eigen::VectorXd x0 = iterative.solve(b);  // preconditioner = k0 itself
+  EXPECT_LE(solve_profile().krylov_iterations, 3);
+  const long after_first = solve_profile().krylov_iterations;
+  ASSERT_TRUE(iterative.factorize(k1).ok());  // keeps k0's factorisation
+  const Eigen::VectorXd x_iterative = iterative.solve(b);
+  const SolveProfile& p = solve_profile();
+  EXPECT_EQ(p.preconditioner_factorizations, 1) << "k0's factorisation should have served for k1";
+  EXPECT_EQ(p.direct_fallbacks, 0);
+  EXPECT_GT(p.krylov_iterations - after_first, 1) << "a stale preconditioner needs some iterations";
+  const linalg::Storage storage = unsymmetric ? linalg::Storage::kFull : linalg::Storage::kLower;
+  EXPECT_LT(relative_residual(k1, storage, x_iterative, b), 1e-9);
+  EXPECT_LT((x_iterative - x_direct).norm(), 1e-8 * x_direct.norm());
+  EXPECT_GT((x0 - x_direct).norm(), 1e-6 * x_direct.norm()) << "k0's solution differs: the test can fail";
+}
+
+TEST_P(IterativeTangent, PerPlyPreconditionerAgreesWithTheDirectSolve) {
+  // Per-ply blocks converge slowly under the stiff penalty coupling between plies; the
+  // answer must still agree (GMRES, or its direct fallback, both counted).
+  const bool unsymmetric = GetParam();
+  const SmallDome d;
+  linalg::PatternAssembler pa = d.problem.model.make_pattern(d.is_free, !unsymmetric);
+  const linalg::SparseMatrix k1 = tangent_at(d, d.x1, pa);
+  const std::vector<int> group = ply_groups(d.problem.model, pa.active_dofs());
+  int n_groups = 0;
+  for (int g : group) n_groups = std::max(n_groups, g + 1);
+  EXPECT_EQ(n_groups, 4) << "one group per ply";
+  const Eigen::VectorXd b = smooth_rhs(k1.rows());
+  TangentSolver direct(linalg::SolverKind::kAuto, unsymmetric, LinearMode::kDirect);
+  ASSERT_TRUE(direct.factorize(k1).ok());
+  const Eigen::VectorXd x_direct = direct.solve(b);
+  solve_profile().reset();
+  TangentSolver ply(linalg::SolverKind::kAuto, unsymmetric, LinearMode::kIterativePly, group);
+  ASSERT_TRUE(ply.factorize(k1).ok());
+  const Eigen::VectorXd x = ply.solve(b);
+  EXPECT_GT(solve_profile().krylov_iterations, 0);
+  EXPECT_LT((x - x_direct).norm(), 1e-8 * x_direct.norm());
+}
+
+INSTANTIATE_TEST_SUITE_P(Storages, IterativeTangent, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return p.param ? std::string("Unsymmetric") : std::string("LowerTriangle");
+                         });
+
+TEST(LinearMode, NamesRoundTripAndBadNamesSayWhatIsExpected) {
+  for (LinearMode m : {LinearMode::kAuto, LinearMode::kDirect, LinearMode::kIterative, LinearMode::kIterativePly})
+    EXPECT_EQ(parse_linear_mode(to_string(m)), m);
+  try {
+    parse_linear_mode("krylov", "--linear");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--linear"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("iterative"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("krylov"), std::string::npos);
+  }
+}
+
+TEST(LinearMode, AutoIsDirectForSmallModels) {
+  TangentSolver s(linalg::SolverKind::kAuto, true, LinearMode::kAuto, std::vector<int>(100, 0));
+  EXPECT_FALSE(s.iterative());
+}
+
+}  // namespace
+}  // namespace sf::forming
+
+namespace sf::forming {
+namespace {
+
+// The top ply raised by 0.05 mm: its contact with the ply below opens (gap 0.05 mm, beyond
+// the 0.005 mm engage gap and band of the case: no pressure, no viscous slip) but stays
+// within the search distance.
+VecX top_ply_raised(const SmallDome& d) {
+  const Model& model = d.problem.model;
+  VecX x = d.x0;
+  const int top = model.n_bodies() - 1;
+  for (Index node = 0; node < model.ply(top).n_nodes(); ++node) x(model.dof(top, node, 0, 2)) += 0.05;
+  return x;
+}
+
+class BandPattern : public ::testing::TestWithParam<bool> {
+ protected:
+  void TearDown() override { Model::set_band_pattern(true); }
+};
+
+TEST_P(BandPattern, AContactClosingInsideTheSearchBandNeedsNoNewAnalysis) {
+  const bool band = GetParam();
+  Model::set_band_pattern(band);
+  const SmallDome d;
+  const VecX x_open = top_ply_raised(d);
+  linalg::PatternAssembler pa = d.problem.model.make_pattern(d.is_free, false);
+  TangentSolver solver(linalg::SolverKind::kAuto, true, LinearMode::kDirect);
+  ASSERT_TRUE(d.problem.model.assemble_into(x_open, d.context, &pa).ok);
+  const int open_generation = pa.generation();
+  EXPECT_GE(open_generation, 1) << "the die and holder contacts grow the elements' pattern";
+  const long open_nnz = pa.matrix().nonZeros();
+  ASSERT_TRUE(solver.factorize(pa.matrix()).ok());
+  // The ply closes on the one below: new contact entries between them.
+  ASSERT_TRUE(d.problem.model.assemble_into(d.x0, d.context, &pa).ok);
+  const linalg::SolveReport& r = solver.factorize(pa.matrix());
+  ASSERT_TRUE(r.ok());
+  if (band) {
+    EXPECT_EQ(pa.generation(), open_generation) << "the closed pair was laid out while open";
+    EXPECT_EQ(pa.matrix().nonZeros(), open_nnz);
+    EXPECT_TRUE(r.reused_analysis);
+  } else {
+    EXPECT_GT(pa.generation(), open_generation) << "without the band the closing pair grows the pattern";
+    EXPECT_FALSE(r.reused_analysis);
+  }
+  // The values do not depend on the layout: the same tangent as from a pattern made at x0.
+  linalg::PatternAssembler fresh = d.problem.model.make_pattern(d.is_free, false);
+  ASSERT_TRUE(d.problem.model.assemble_into(d.x0, d.context, &fresh).ok);
+  EXPECT_EQ((linalg::SparseMatrix(pa.matrix() - fresh.matrix())).norm(), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(OnOff, BandPattern, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return p.param ? std::string("BandLaidOut") : std::string("OnlyPresentEntries");
+                         });
+
+}  // namespace
+}  // namespace sf::forming

@@ -262,9 +262,9 @@ static int factor_only(const FormingCase& spec, bool iterative) {
 }
 
 int main(int argc, char** argv) {
-  // Freed factorisation memory kept for reuse (common/linalg/solver.hpp), at start-up as in
+  // Freed factorisation memory kept for reuse (common/core/memory.hpp), at start-up as in
   // every program that factorises; GLIBC_TUNABLES=glibc.malloc... restores glibc's default.
-  const bool kept = linalg::keep_freed_memory();
+  const bool kept = keep_freed_memory();
   std::string file = std::string(SF_SOURCE_DIR) + "/data/forming/processes/dome_0_90s.yaml";
   bool quick = false;
   int max_steps = 0;

@@ -497,23 +497,6 @@ std::string blas_description() {
   return out;
 }
 
-bool keep_freed_memory() {
-  static const bool changed = [] {
-    const char* tunables = std::getenv("GLIBC_TUNABLES");
-    if ((tunables && std::string(tunables).find("glibc.malloc") != std::string::npos) ||
-        std::getenv("MALLOC_MMAP_THRESHOLD_") || std::getenv("MALLOC_TRIM_THRESHOLD_"))
-      return false;
-#ifdef M_MMAP_THRESHOLD
-    const bool mmap_ok = mallopt(M_MMAP_THRESHOLD, 1 << 30) == 1;
-    const bool trim_ok = mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max()) == 1;
-    return mmap_ok && trim_ok;
-#else
-    return false;
-#endif
-  }();
-  return changed;
-}
-
 std::string to_string(MatrixProperty property) {
   switch (property) {
     case MatrixProperty::kSymmetricPositiveDefinite:

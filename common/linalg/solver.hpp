@@ -84,20 +84,8 @@ int factorisation_threads();
 // "OpenBLAS 0.3.21 DYNAMIC_ARCH NO_AFFINITY SkylakeX MAX_THREADS=64 (pthreads, 2 threads per factorisation)".
 std::string blas_description();
 
-// Freed memory kept for reuse. A factorisation allocates its working memory afresh each
-// time (UMFPACK's numeric object, tens to hundreds of MB); glibc hands blocks that large
-// out by mmap and returns them on free, so every factorisation page-faults its memory in
-// again (measured on the quick dome: 175 k page faults and 60 % of the processor time,
-// against 17 k with the memory kept). Programs that factorise large matrices call this at
-// start-up, before large allocations (simform calls sf::keep_freed_memory of common/core/
-// memory.hpp, which goes further; the benches call this one): it raises glibc's mmap
-// threshold to 1 GiB and its trim threshold to 2 GiB (mallopt), so freed blocks stay
-// in the heap and the next factorisation reuses them: peak memory is unchanged, resident
-// memory stays near the peak between factorisations. Libraries (LinearSolver) do not call
-// it: a process-wide malloc setting is the program's choice. Left alone when the user tunes malloc
-// (GLIBC_TUNABLES naming glibc.malloc, or MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_
-// set). Returns true when it changed the settings (once per process).
-bool keep_freed_memory();
+// Freed factorisation memory kept for reuse between Newton iterations: the program calls
+// sf::keep_freed_memory() (common/core/memory.hpp) at start-up; this library never does.
 
 // What the caller knows about A. It selects the kAuto back end and is checked
 // against explicit back ends (kCholmod and kEigenLDLT need symmetry).

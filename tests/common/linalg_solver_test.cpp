@@ -8,13 +8,18 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "common/core/error.hpp"
+#include "common/core/memory.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
 
@@ -347,8 +352,24 @@ TEST(LinalgSolver, UmfpackOrderingsSolveAndFactorSizesAreReported) {
   expect_solves(chol, spd, "cholmod sizes");
   EXPECT_EQ(chol.last_report().ordering, "amd");
   EXPECT_GE(chol.last_report().factor_nonzeros, static_cast<double>(spd.rows()));
-  // The freed-memory setting is made once per process, by the program at start-up (or left to the user).
-  EXPECT_EQ(keep_freed_memory(), keep_freed_memory());
+}
+
+// The program's start-up setting (common/core/memory.hpp): once in force, a block of the
+// size of a factorisation's working memory comes from the heap, not from a fresh mapping
+// that would be page-faulted in again at every Newton iteration.
+TEST(LinalgSolver, FreedMemoryIsKeptWhenTheProgramAsks) {
+  const bool kept = sf::keep_freed_memory();
+  EXPECT_EQ(kept, sf::keep_freed_memory());
+#if defined(__GLIBC__)
+  const bool user_tuned = std::getenv("GLIBC_TUNABLES") || std::getenv("MALLOC_MMAP_MAX_") ||
+                          std::getenv("MALLOC_MMAP_THRESHOLD_") || std::getenv("MALLOC_TRIM_THRESHOLD_");
+  if (user_tuned) GTEST_SKIP() << "malloc is tuned by the environment: the setting is left alone";
+  ASSERT_TRUE(kept);
+  const std::size_t mapped_before = mallinfo2().hblkhd;
+  std::vector<char> block(std::size_t{64} << 20, 1);
+  EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "a 64 MB block was mapped separately";
+  EXPECT_EQ(block[12345], 1);
+#endif
 }
 
 TEST(LinalgSolver, AnalyzePatternThenFactorizeReusesIt) {

@@ -80,6 +80,16 @@ PointLayout tensile_strip() {  // a gauge section at the density of a stereo-DIC
   return p;
 }
 
+// RMS strain error of the 24-nearest-neighbour local fit of F (the yardstick).
+double local_fit_rms(const SyntheticMeasurement& m, double spacing) {
+  const auto local = local_fit_stretches(m.grid, 24);
+  return interior_rms(m, spacing, [&](Index p, double& l1, double& l2) {
+    if (!local[static_cast<std::size_t>(p)]) return false;
+    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
+    return true;
+  });
+}
+
 // Correlated noise over 2.5 spacings: the noise model finds its length and amplitudes,
 // and the smoothing it chooses is far better than cross-validation's (which takes the
 // correlated error for signal) and than the local 24-neighbour fit of F.
@@ -99,27 +109,12 @@ TEST(GsaRealData, CorrelatedNoiseIsModelledAndSmoothedAsItShouldBe) {
   AnalyseOptions gcv_options;
   gcv_options.smoothing.rule = SmoothingRule::kGcv;
   const AnalysisResult gcv = analyse(m.grid, gcv_options);
-  const auto local = local_fit_stretches(m.grid, 24);
   const double e_model = analysis_rms(m, d, noise_model), e_gcv = analysis_rms(m, d, gcv);
-  const double e_local = interior_rms(m, d, [&](Index p, double& l1, double& l2) {
-    if (!local[static_cast<std::size_t>(p)]) return false;
-    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
-    return true;
-  });
+  const double e_local = local_fit_rms(m, d);
   EXPECT_LT(e_model, 0.5 * e_gcv) << "noise model " << e_model << ", GCV " << e_gcv;
   EXPECT_LT(e_model, 0.5 * e_local) << "noise model " << e_model << ", 24-neighbour fit " << e_local;
   EXPECT_EQ(flagged(noise_model), 0);
   EXPECT_EQ(noise_model.smoothing_criterion, "Cp");
-}
-
-// RMS strain error of the 24-nearest-neighbour local fit of F (the yardstick).
-double local_fit_rms(const SyntheticMeasurement& m, double spacing) {
-  const auto local = local_fit_stretches(m.grid, 24);
-  return interior_rms(m, spacing, [&](Index p, double& l1, double& l2) {
-    if (!local[static_cast<std::size_t>(p)]) return false;
-    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
-    return true;
-  });
 }
 
 // Noise correlated over 5 spacings (12.5 mm) on the 100 mm plate, seed 1: the light pilots
@@ -235,12 +230,7 @@ TEST(GsaRealData, NeckNarrowerThanAnElementIsRefined) {
     if (r.points[p].strain) peak = std::max(peak, green(r.points[p].strain->lambda1));
   }
   EXPECT_NEAR(peak / peak_exact, 1.0, 0.05) << "peak " << peak << " of " << peak_exact;
-  const auto local = local_fit_stretches(m.grid, 24);
-  const double e_local = interior_rms(m, layout.spacing, [&](Index p, double& l1, double& l2) {
-    if (!local[static_cast<std::size_t>(p)]) return false;
-    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
-    return true;
-  });
+  const double e_local = local_fit_rms(m, layout.spacing);
   const double e = analysis_rms(m, layout.spacing, r);
   EXPECT_LT(e, 0.55 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
   // Switched off with the local smoothing: the uniform mesh.
@@ -310,12 +300,7 @@ TEST(GsaRealData, NeckUnderLongCorrelatedNoiseIsNotTakenForNoise) {
   EXPECT_EQ(without_strain(r), 0);
   EXPECT_LE(flagged(r), m.grid.n_points() / 1000);
   EXPECT_NEAR(peak_of(r) / peak_exact, 1.0, 0.05);
-  const auto local = local_fit_stretches(m.grid, 24);
-  const double e_local = interior_rms(m, layout.spacing, [&](Index p, double& l1, double& l2) {
-    if (!local[static_cast<std::size_t>(p)]) return false;
-    l1 = local[static_cast<std::size_t>(p)]->lambda1, l2 = local[static_cast<std::size_t>(p)]->lambda2;
-    return true;
-  });
+  const double e_local = local_fit_rms(m, layout.spacing);
   EXPECT_LT(analysis_rms(m, layout.spacing, r), 0.75 * e_local);
 }
 

@@ -10,32 +10,6 @@
 namespace sf::forming {
 namespace {
 
-// Face parameterisation: which xi direction is fixed (at 0 or 1), and which are s and t
-// (the same as forming/model/loads.cpp, whose outward orientation it keeps).
-struct FaceAxes {
-  int fixed_dir;
-  double fixed_at;
-  int s_dir, t_dir;
-};
-
-FaceAxes face_axes(BrickFace f) {
-  switch (f) {
-    case BrickFace::kBottom:
-      return {2, 0.0, 1, 0};
-    case BrickFace::kTop:
-      return {2, 1.0, 0, 1};
-    case BrickFace::kXi1Min:
-      return {0, 0.0, 2, 1};
-    case BrickFace::kXi1Max:
-      return {0, 1.0, 1, 2};
-    case BrickFace::kXi2Min:
-      return {1, 0.0, 0, 2};
-    case BrickFace::kXi2Max:
-      return {1, 1.0, 2, 0};
-  }
-  return {2, 1.0, 0, 1};
-}
-
 // 1-D functions of a face direction at u: values and first, second derivatives
 // (4 cubic Hermite functions, or 2 linear Lagrange ones padded with zeros).
 struct Line1D {
@@ -68,7 +42,7 @@ double to_bezier(bool linear, int j, int i) {
 }  // namespace
 
 FaceBasis::FaceBasis(BrickFace face) : face_(face) {
-  const FaceAxes ax = face_axes(face);
+  const FaceMap ax = face_map(face);  // forming/model/loads.hpp: the faces pressure loads use
   s_linear_ = ax.s_dir == 2;
   t_linear_ = ax.t_dir == 2;
   for (int k = 0; k < kBrickFunctions; ++k) {
@@ -101,14 +75,7 @@ FaceBasis::FaceBasis(BrickFace face) : face_(face) {
   }
 }
 
-Vec3 FaceBasis::xi(double s, double t) const {
-  const FaceAxes ax = face_axes(face_);
-  Vec3 x;
-  x[ax.fixed_dir] = ax.fixed_at;
-  x[ax.s_dir] = s;
-  x[ax.t_dir] = t;
-  return x;
-}
+Vec3 FaceBasis::xi(double s, double t) const { return face_point(face_map(face_), s, t); }
 
 FaceBasisValues FaceBasis::evaluate(double s, double t, bool second) const {
   const Line1D fs = line_functions(s, s_linear_, second), ft = line_functions(t, t_linear_, second);

@@ -11,31 +11,6 @@
 #include "common/quadrature/gauss.hpp"
 
 namespace sf::forming {
-namespace {
-
-constexpr int kFacePoints = 4;  // Gauss points per face direction
-
-Mat3 cross_matrix(const Vec3& a) {
-  Mat3 m;
-  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return m;
-}
-
-// Face parameterisation: xi as a function of (s, t) and which xi directions s and t are.
-struct FaceMap {
-  int fixed_dir;    // xi direction held fixed
-  double fixed_at;  // its value (0 or 1)
-  int s_dir, t_dir;
-};
-
-// The brick point of face parameters (s, t).
-Vec3 face_point(const FaceMap& fm, double s, double t) {
-  Vec3 xi;
-  xi[fm.fixed_dir] = fm.fixed_at;
-  xi[fm.s_dir] = s;
-  xi[fm.t_dir] = t;
-  return xi;
-}
 
 FaceMap face_map(BrickFace f) {
   switch (f) {
@@ -53,6 +28,24 @@ FaceMap face_map(BrickFace f) {
       return {1, 1.0, 2, 0};
   }
   return {2, 1.0, 0, 1};
+}
+
+Vec3 face_point(const FaceMap& fm, double s, double t) {
+  Vec3 xi;
+  xi[fm.fixed_dir] = fm.fixed_at;
+  xi[fm.s_dir] = s;
+  xi[fm.t_dir] = t;
+  return xi;
+}
+
+namespace {
+
+constexpr int kFacePoints = 4;  // Gauss points per face direction
+
+Mat3 cross_matrix(const Vec3& a) {
+  Mat3 m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
 }
 
 using BrickPositions = Eigen::Matrix<double, kBrickFunctions, 3>;

@@ -50,6 +50,18 @@ using LoadFunction = std::function<ExternalLoad(double lambda, const VecX& x, bo
 
 enum class BrickFace { kBottom, kTop, kXi1Min, kXi1Max, kXi2Min, kXi2Max };
 
+// A brick face as a parameterised surface: the xi direction held fixed (at 0 or 1) and
+// the directions of the face parameters (s, t), ordered so that d/ds x d/dt points out
+// of the brick (pressure loads and contact surfaces rely on that orientation).
+struct FaceMap {
+  int fixed_dir;    // xi direction held fixed
+  double fixed_at;  // its value (0 or 1)
+  int s_dir, t_dir;
+};
+FaceMap face_map(BrickFace f);
+// The brick point (xi) of face parameters (s, t).
+Vec3 face_point(const FaceMap& fm, double s, double t);
+
 struct FaceRef {
   int body = 0;
   Index element = 0;

@@ -126,6 +126,15 @@ MatX DeformedProblem::smoothing_residual(const MatX& values, const Penalty& pena
   return std::move(*out);
 }
 
+MatX DeformedProblem::weighted_values(const MatX& values) { return system().weighted_values(values); }
+
+MatX DeformedProblem::smoothing_residual(const MatX& values, const MatX& weighted, const Penalty& penalty, int passes,
+                                         int slot) {
+  std::optional<MatX> out = system().smoothing_residual(values, weighted, penalty, passes, slot);
+  if (!out) throw InputError(marks_.source + ": surface fit: the smoothed least-squares system is singular");
+  return std::move(*out);
+}
+
 void DeformedProblem::set_probes(MatX probes) {
   probes_ = std::move(probes);
   if (system_) system_->set_probes(probes_);
@@ -141,8 +150,8 @@ void DeformedProblem::set_element_multipliers(std::vector<double> multipliers) {
   rebuild_ = true;
 }
 
-FitResult DeformedProblem::fit(const Penalty& penalty, int passes) {
-  FitResult f = system().solve(penalty, reference_, 0, passes);
+FitResult DeformedProblem::fit(const Penalty& penalty, int passes, int slot) {
+  FitResult f = system().solve(penalty, reference_, 0, passes, slot);
   if (!f.ok) throw InputError(marks_.source + ": " + f.message);
   return f;
 }

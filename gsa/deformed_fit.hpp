@@ -64,7 +64,9 @@ class DeformedProblem {
   void set_weight(Index k, double weight);
   double base_weight(Index k) const { return deformed_.weight[k]; }
   // Fits the current data; throws sf::InputError naming the file when the system is singular.
-  FitResult fit(const Penalty& penalty, int passes);
+  // `slot`: the system's workspace (FitSystem::solve); fits in different slots may run at
+  // once on two threads once the system is built (weighted_values() builds it).
+  FitResult fit(const Penalty& penalty, int passes, int slot = 0);
   // Two penalties at once (on two threads), with trace_probes Hutchinson probes for the
   // degrees of freedom; failures are reported in the results, not thrown.
   std::array<FitResult, 2> fit_pair(const std::array<Penalty, 2>& penalties, int trace_probes, int passes);
@@ -75,6 +77,10 @@ class DeformedProblem {
   MatX smooth(const MatX& values, const Penalty& penalty, int passes);
   // values - smooth(values, penalty, passes), without the copies (FitSystem::smoothing_residual).
   MatX smoothing_residual(const MatX& values, const Penalty& penalty, int passes);
+  // Phi^T W values for the current weights (FitSystem::weighted_values), and the same
+  // residuals from it in workspace `slot`: data smoothed with several penalties need it once.
+  MatX weighted_values(const MatX& values);
+  MatX smoothing_residual(const MatX& values, const MatX& weighted, const Penalty& penalty, int passes, int slot);
   // Probes for the trace estimates of later fit_pair() calls (FitSystem::set_probes),
   // kept when the system is rebuilt; their column count is the trace_probes to pass.
   void set_probes(MatX probes);

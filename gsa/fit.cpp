@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "common/basis/hermite.hpp"
+#include "common/core/error.hpp"
 #include "common/core/parallel.hpp"
 #include "common/fe/surface_field.hpp"
 #include "common/linalg/solver.hpp"
@@ -285,6 +286,26 @@ void rows_times(const RowMatrix& phi, const MatX& params, MatX& out, bool subtra
                1);
 }
 
+// The rows `rows` of `phi`, in that order.
+RowMatrix rows_of(const RowMatrix& phi, const std::vector<Index>& rows) {
+  const Index n = static_cast<Index>(rows.size());
+  RowMatrix out(n, phi.cols());
+  int* outer = out.outerIndexPtr();
+  outer[0] = 0;
+  for (Index i = 0; i < n; ++i) {
+    const Index r = rows[static_cast<std::size_t>(i)];
+    outer[i + 1] = outer[i] + (phi.outerIndexPtr()[r + 1] - phi.outerIndexPtr()[r]);
+  }
+  out.resizeNonZeros(outer[n]);
+  for (Index i = 0; i < n; ++i) {
+    const int from = phi.outerIndexPtr()[rows[static_cast<std::size_t>(i)]];
+    const int count = outer[i + 1] - outer[i];
+    std::copy(phi.innerIndexPtr() + from, phi.innerIndexPtr() + from + count, out.innerIndexPtr() + outer[i]);
+    std::copy(phi.valuePtr() + from, phi.valuePtr() + from + count, out.valuePtr() + outer[i]);
+  }
+  return out;
+}
+
 }  // namespace
 
 // What one solve changes: K and the penalty on the common pattern, the
@@ -314,6 +335,7 @@ struct FitSystem::Impl {
   MatX probes, probes_plain, probes_weighted;
 
   FitWorkspace& workspace(int i) {
+    SF_ASSERT(i == 0 || i == 1, "a fit system has two workspaces");
     if (!work[i]) {
       work[i] = std::make_unique<FitWorkspace>();
       work[i]->k = work[i]->pen = penalties->pattern;
@@ -408,12 +430,27 @@ void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
 
 std::optional<MatX> FitSystem::smoothing_residual(const Eigen::Ref<const MatX>& values, const Penalty& penalty,
                                                   int passes) {
+  return smoothing_residual(values, impl_->weighted_rhs(values), penalty, passes, 0);
+}
+
+MatX FitSystem::weighted_values(const Eigen::Ref<const MatX>& values) const { return impl_->weighted_rhs(values); }
+
+std::optional<MatX> FitSystem::smoothing_residual(const Eigen::Ref<const MatX>& values, const MatX& weighted,
+                                                  const Penalty& penalty, int passes, int slot,
+                                                  const std::vector<Index>* rows) {
   const Impl& s = *impl_;
   std::vector<Index> pinned;
   std::string message;
   const MatX zero = MatX::Zero(s.mesh->n_dofs(), values.cols());
-  const MatX params = s.parameters(impl_->workspace(0), penalty, zero, s.weighted_rhs(values), passes, pinned, message);
+  const MatX params = s.parameters(impl_->workspace(slot), penalty, zero, weighted, passes, pinned, message);
   if (params.size() == 0) return std::nullopt;
+  if (rows) {
+    // The rows of Phi asked for, gathered: each row's product is the same sum as in the whole.
+    MatX out(static_cast<Index>(rows->size()), values.cols());
+    for (std::size_t i = 0; i < rows->size(); ++i) out.row(static_cast<Index>(i)) = values.row((*rows)[i]);
+    rows_times(rows_of(s.phi, *rows), params, out, true);
+    return out;
+  }
   MatX out = values;
   rows_times(s.phi, params, out, true);
   return out;
@@ -520,9 +557,9 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
 }
 
 FitResult FitSystem::solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes,
-                           int passes) {
+                           int passes, int slot) {
   if (trace_probes > 0) impl_->draw_probes(trace_probes);
-  return impl_->solve(impl_->workspace(0), penalty, reference, trace_probes, passes);
+  return impl_->solve(impl_->workspace(slot), penalty, reference, trace_probes, passes);
 }
 
 std::array<FitResult, 2> FitSystem::solve_pair(const std::array<Penalty, 2>& penalties,

@@ -125,14 +125,26 @@ class FitSystem {
   // deviation from the previous pass's solution instead of from the reference, so
   // the bias (I - A)(U - U_ref) of one pass becomes (I - A)^passes (U - U_ref); the
   // degrees of freedom are those of the iterated smoother.
+  // `slot` (0 or 1) is the workspace (factorisation) used: solves in different slots, with
+  // trace_probes = 0, may run at once on two threads (the noise ladders fit two pilots
+  // at a time); each slot keeps its own last factorisation.
   FitResult solve(const Penalty& penalty, const Eigen::Ref<const MatX>& reference, int trace_probes = 0,
-                  int passes = 1);
+                  int passes = 1, int slot = 0);
   // values - H values: the residuals of fitting other data at the same points with the
   // same weights (e.g. noise probes, n_points x k) with `penalty` and a zero reference.
   // The system's own data stay as they are; no copy of `values` is kept and no fitted
   // values or residual norms are stored (with 1e5 points and 42 probe columns each such
   // temporary is 34 MB). Nothing when the system is singular.
   std::optional<MatX> smoothing_residual(const Eigen::Ref<const MatX>& values, const Penalty& penalty, int passes = 1);
+  // Phi^T W values (n_dofs x k), what the fit of `values` starts from. Data smoothed with
+  // several penalties (the noise ladders' probe fields, at every pilot) need it once.
+  MatX weighted_values(const Eigen::Ref<const MatX>& values) const;
+  // The same with `weighted` = weighted_values(values) given, in workspace `slot` (see
+  // solve()), at the points `rows` only when given (rows->size() x k, in its order; each
+  // the same bits as in the whole).
+  std::optional<MatX> smoothing_residual(const Eigen::Ref<const MatX>& values, const MatX& weighted,
+                                         const Penalty& penalty, int passes = 1, int slot = 0,
+                                         const std::vector<Index>* rows = nullptr);
   // Probes of the trace estimate given by the caller (n_points x count) instead of
   // Rademacher ones: with probes drawn from the noise N(0, Sigma) the estimate is
   // tr(H Sigma) (gsa/noise_model.hpp). Later solves with trace_probes = count use them.

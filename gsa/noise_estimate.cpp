@@ -99,8 +99,6 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
     normal.row(k) = t.col(0).cross(t.col(1)).normalized().transpose();
   }
   FitSystem system(mesh, setup.penalties, und.location, und.weight);
-  // A second system, the same bits, for the pilot fitted beside (below).
-  std::unique_ptr<FitSystem> beside;
   std::vector<bool> usable(static_cast<std::size_t>(m));
   for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = und.weight[k] > 0;
   VariogramOptions vo;
@@ -108,44 +106,45 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
   const VariogramPairs pairs(marks.undeformed, usable, d, vo);
   const ProbeBank bank = make_probe_bank(marks.undeformed, d);
   system.set_values(marks.undeformed);
-  // One pilot's estimate, fitted in `sys`.
-  auto estimate = [&](int k, FitSystem& sys) -> std::optional<NoiseEstimate> {
+  // Phi^T W of the probe fields: the same for every pilot, formed once.
+  const MatX bank_weighted = system.weighted_values(bank.probes);
+  // One pilot's estimate, fitted in the system's workspace `slot`.
+  auto estimate = [&](int k, int slot) -> std::optional<NoiseEstimate> {
     const Penalty pilot = jumps_penalty(k, d);
-    const FitResult f = sys.solve(pilot, mesh.geometry(), 0, 1);
+    const FitResult f = system.solve(pilot, mesh.geometry(), 0, 1, slot);
     if (!f.ok) return std::nullopt;
     MatX residual(m, 1);
     for (Index i = 0; i < m; ++i) residual(i, 0) = (marks.undeformed.row(i) - f.fitted.row(i)).dot(normal.row(i));
     // The probes' residuals without copies of them (the same factorisation as the data's).
-    // (The data's fit with the same matrix succeeded: so does theirs.)
-    auto shrink = [&](const MatX& probes) { return *sys.smoothing_residual(probes, pilot, 1); };
+    // (The data's fit with the same matrix succeeded: so does theirs.) fit_noise_model
+    // smooths the bank's probes, whose Phi^T W is bank_weighted.
+    auto shrink = [&](const MatX& probes, const std::vector<Index>& rows) {
+      return *system.smoothing_residual(probes, bank_weighted, pilot, 1, slot, &rows);
+    };
     return fit_noise_model(pairs, pairs.gamma(residual, 1), bank, shrink);
   };
   // With two cores the next lighter pilot is fitted beside each one the ladder asks for
-  // (it asks for it next unless it stops there): the ladder's wall time about halves and
-  // it takes the same estimates in the same order, each the same bits in either system
-  // (built alike from the same marks, each with its own factorisation).
+  // (it asks for it next unless it stops there), in the system's second workspace (its
+  // own factorisation): the ladder's wall time about halves and it takes the same
+  // estimates in the same order, each the same bits in either workspace.
   const bool two = default_threads() >= 2;
   std::map<int, std::optional<NoiseEstimate>> ahead;
   const Unconfirmed lightest = Unconfirmed::kLightest;
   NoiseEstimate e = pilot_ladder(8, 1, vo.max_lag, d, true, lightest, [&](int k) -> std::optional<NoiseEstimate> {
     if (const auto it = ahead.find(k); it != ahead.end()) return it->second;
-    if (!two || k - 1 < 1) return estimate(k, system);
-    if (!beside) {
-      beside = std::make_unique<FitSystem>(mesh, setup.penalties, und.location, und.weight);
-      beside->set_values(marks.undeformed);
-    }
+    if (!two || k - 1 < 1) return estimate(k, 0);
     std::optional<NoiseEstimate> lighter;
     std::exception_ptr error;
     std::thread other([&] {
       try {
-        lighter = estimate(k - 1, *beside);
+        lighter = estimate(k - 1, 1);
       } catch (...) {
         error = std::current_exception();
       }
     });
     std::optional<NoiseEstimate> out;
     try {
-      out = estimate(k, system);
+      out = estimate(k, 0);
     } catch (...) {
       other.join();
       throw;
@@ -194,9 +193,51 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
   // noise at k = 4, 23 x at k = -1, the lightest, which was taken); true noise gives the
   // same estimate at every pilot, the heaviest one with the least correction.
   const Unconfirmed heaviest_unbiased = Unconfirmed::kHeaviestUnbiased;
+  // A pilot's fits: the data's and the probe fields' residuals, from one factorisation in
+  // the problem's workspace `slot`. Phi^T W of the probe fields is the same for every
+  // pilot (the weights do not change here), formed once; forming it builds the system.
+  const MatX bank_weighted = problem.weighted_values(bank.probes);
+  struct PilotFits {
+    FitResult fit;
+    MatX shrunk;  // (I - H) of the bank's probes
+    std::exception_ptr error;
+  };
+  auto pilot_fits = [&](int k, int slot) {
+    PilotFits p;
+    try {
+      const Penalty pilot = jumps_penalty(k, d);
+      p.fit = problem.fit(pilot, 1, slot);
+      // (The data's fit with the same matrix succeeded: so does theirs.)
+      p.shrunk = problem.smoothing_residual(bank.probes, bank_weighted, pilot, 1, slot);
+    } catch (...) {
+      p.error = std::current_exception();
+    }
+    return p;
+  };
+  // With two cores the next lighter pilot's fits run beside each one the ladder asks for,
+  // in the second workspace, as in the blank's ladder; the estimates themselves (the
+  // variogram pairs are kept from one pilot to the next) are taken in the ladder's order.
+  // A failure of the pilot beside counts only if the ladder asks for it.
+  const bool two = default_threads() >= 2;
+  std::map<int, PilotFits> ahead;
+  auto fits_of = [&](int k) {
+    if (const auto it = ahead.find(k); it != ahead.end()) {
+      PilotFits p = std::move(it->second);
+      ahead.erase(it);
+      return p;
+    }
+    if (!two || k - 1 < -1) return pilot_fits(k, 0);
+    PilotFits lighter;
+    std::thread other([&] { lighter = pilot_fits(k - 1, 1); });
+    PilotFits p = pilot_fits(k, 0);
+    other.join();
+    ahead.emplace(k - 1, std::move(lighter));
+    return p;
+  };
   return pilot_ladder(4, -1, vo.max_lag, d, false, heaviest_unbiased, [&](int k) -> std::optional<NoiseEstimate> {
-    const Penalty pilot = jumps_penalty(k, d);
-    const FitResult f = problem.fit(pilot, 1);
+    PilotFits p = fits_of(k);
+    if (p.error) std::rethrow_exception(p.error);
+    const FitResult& f = p.fit;
     if (!f.ok) return std::nullopt;
     const MatX residual = MatX(problem.data()) - f.fitted;
     // Misfit exclusion: neighbourhood mean square residual far above the median.
@@ -219,7 +260,13 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
       pairs.emplace(marks.undeformed, usable, d, vo);
       paired = usable;
     }
-    auto shrink = [&](const MatX& probes) { return problem.smoothing_residual(probes, pilot, 1); };
+    // fit_noise_model smooths the bank's probes: their residuals are p.shrunk (at every
+    // point: the pairs are only known after the pilot's fit; the bank has 6 columns).
+    auto shrink = [&](const MatX&, const std::vector<Index>& rows) {
+      MatX at(static_cast<Index>(rows.size()), p.shrunk.cols());
+      for (std::size_t i = 0; i < rows.size(); ++i) at.row(static_cast<Index>(i)) = p.shrunk.row(rows[i]);
+      return at;
+    };
     NoiseEstimate e = fit_noise_model(*pairs, pairs->gamma(residual, 3), bank, shrink);
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;

@@ -9,6 +9,8 @@
 
 #include "common/core/error.hpp"
 #include "common/core/parallel.hpp"
+#include "common/linalg/dense_kernels.hpp"
+#include "common/linalg/simd.hpp"
 #include "common/mesh/neighbours.hpp"
 
 namespace sf::gsa {
@@ -93,7 +95,7 @@ ModelFit nonnegative_fit(const MatX& A, const VecX& y, const VecX& w) {
 // cos in y^2 to y^18 (Horner). Random probe fields need no more, and the plain loop
 // it allows vectorises where glibc's cos does not (the cosines were most of the cost
 // of the noise estimate on 1e5 points).
-inline double probe_cos(double x) {
+[[gnu::always_inline]] inline double probe_cos(double x) {
   constexpr double kInvTwoPi = 0.15915494309189535, kTwoPi = 6.283185307179586;
   // Round to nearest by the 1.5 x 2^52 trick (plain additions, so the loop vectorises).
   constexpr double kRound = 6755399441055744.0;
@@ -152,28 +154,73 @@ Vec3 CorrelatedField::at(const Vec3& p) const {
   return out;
 }
 
+namespace {
+
+// The body of CorrelatedField::at_rows: each point's modes summed in order, the kBlock
+// points side by side, which the compiler vectorises at the width of the instruction set
+// it compiles for. It is compiled for three (below) and chosen at run time: no fused
+// multiply-add anywhere (this file is compiled with -ffp-contract=off), so every set
+// gives the same bits, those of at() (test GsaNoiseModel.ProbeFieldRowsAreAtBitForBit).
+constexpr int kFieldBlock = CorrelatedField::kBlock;
+[[gnu::always_inline]] inline void field_rows(const double* k0, const double* k1, const double* k2,
+                                              const double* phase, Index modes, const double* x, const double* y,
+                                              const double* z, double* sum) {
+  for (Index m = 0; m < modes; ++m) {
+    const double a = k0[m], b = k1[m], e = k2[m], ph = phase[m];
+    for (int i = 0; i < kFieldBlock; ++i) sum[i] += probe_cos(a * x[i] + b * y[i] + e * z[i] + ph);
+  }
+}
+#if SF_SIMD_X86
+// Wider registers only: no "fma" in the target, so no multiply-add is fused.
+__attribute__((target("avx512f"))) void field_rows_avx512(const double* k0, const double* k1, const double* k2,
+                                                          const double* phase, Index modes, const double* x,
+                                                          const double* y, const double* z, double* sum) {
+  field_rows(k0, k1, k2, phase, modes, x, y, z, sum);
+}
+__attribute__((target("avx2"))) void field_rows_avx2(const double* k0, const double* k1, const double* k2,
+                                                     const double* phase, Index modes, const double* x,
+                                                     const double* y, const double* z, double* sum) {
+  field_rows(k0, k1, k2, phase, modes, x, y, z, sum);
+}
+#endif
+void field_rows_generic(const double* k0, const double* k1, const double* k2, const double* phase, Index modes,
+                        const double* x, const double* y, const double* z, double* sum) {
+  field_rows(k0, k1, k2, phase, modes, x, y, z, sum);
+}
+using FieldRows = void (*)(const double*, const double*, const double*, const double*, Index, const double*,
+                           const double*, const double*, double*);
+FieldRows field_rows_kernel() {
+#if SF_SIMD_X86
+  switch (linalg::kernel_isa()) {
+    case linalg::KernelIsa::kAvx512:
+      return field_rows_avx512;
+    case linalg::KernelIsa::kAvx2:
+      return field_rows_avx2;
+    case linalg::KernelIsa::kGeneric:
+      break;
+  }
+#endif
+  return field_rows_generic;
+}
+
+}  // namespace
+
 void CorrelatedField::at_rows(const Points3& positions, Index first, int count,
                               Eigen::Matrix<double, kBlock, 3>& out) const {
   out.setZero();
   if (amplitude_ == 0.0) return;
-  alignas(16) double x[kBlock] = {}, y[kBlock] = {}, z[kBlock] = {};
+  alignas(64) double x[kBlock] = {}, y[kBlock] = {}, z[kBlock] = {};
   for (int i = 0; i < count; ++i) {
     x[i] = positions(first + i, 0);
     y[i] = positions(first + i, 1);
     z[i] = positions(first + i, 2);
   }
+  const FieldRows rows = field_rows_kernel();
   for (int c = 0; c < 3; ++c) {
-    const Index modes = k_[c].rows();
-    const double* k0 = k_[c].col(0).data();
-    const double* k1 = k_[c].col(1).data();
-    const double* k2 = k_[c].col(2).data();
-    const double* phase = phase_[c].data();
-    alignas(16) double sum[kBlock] = {};
+    alignas(64) double sum[kBlock] = {};
     // Each point's modes in order, as in at(): the same sums to the last bit.
-    for (Index m = 0; m < modes; ++m) {
-      const double a = k0[m], b = k1[m], e = k2[m], ph = phase[m];
-      for (int i = 0; i < kBlock; ++i) sum[i] += probe_cos(a * x[i] + b * y[i] + e * z[i] + ph);
-    }
+    rows(k_[c].col(0).data(), k_[c].col(1).data(), k_[c].col(2).data(), phase_[c].data(), k_[c].rows(), x, y, z,
+         sum);
     for (int i = 0; i < count; ++i) out(i, c) = amplitude_ * sum[i];
   }
 }
@@ -199,18 +246,18 @@ VariogramPairs::VariogramPairs(const Points3& positions, const std::vector<bool>
   }
   const std::vector<std::vector<Index>> nb = mesh::neighbours_within(pts, max_lag, query);
   const int n_bins = std::max(1, static_cast<int>(std::ceil(max_lag / width)));
-  bins_.resize(static_cast<std::size_t>(n_bins));
+  std::vector<std::vector<std::pair<Index, Index>>> bins_of(static_cast<std::size_t>(n_bins));
   for (std::size_t i = 0; i < query.size(); ++i)
     for (Index q : nb[i]) {
       const double r = (pts.row(query[i]) - pts.row(q)).norm();
       const int b = std::min(n_bins - 1, static_cast<int>(r / width));
-      bins_[static_cast<std::size_t>(b)].emplace_back(query[i], q);
+      bins_of[static_cast<std::size_t>(b)].emplace_back(query[i], q);
     }
   // A bin's median needs a few thousand pairs, not the hundreds of thousands the outer
   // bins of a dense grid hold: a random subset (fixed seed) keeps each call cheap.
   std::vector<std::vector<std::pair<Index, Index>>> kept;
   for (int b = 0; b < n_bins; ++b) {
-    auto& v = bins_[static_cast<std::size_t>(b)];
+    auto& v = bins_of[static_cast<std::size_t>(b)];
     if (v.size() < 20) continue;
     if (static_cast<int>(v.size()) > o.max_pairs_per_bin) {
       std::shuffle(v.begin(), v.end(), rng);
@@ -222,10 +269,31 @@ VariogramPairs::VariogramPairs(const Points3& positions, const std::vector<bool>
     count_.push_back(static_cast<int>(v.size()));
     kept.push_back(std::move(v));
   }
-  bins_ = std::move(kept);
+  // The points the kept pairs use, and the pairs as positions among them.
+  std::vector<int> slot(static_cast<std::size_t>(n), -1);
+  for (const auto& v : kept)
+    for (const auto& [p, q] : v) slot[static_cast<std::size_t>(p)] = slot[static_cast<std::size_t>(q)] = 0;
+  for (Index p = 0; p < n; ++p)
+    if (slot[static_cast<std::size_t>(p)] == 0) {
+      slot[static_cast<std::size_t>(p)] = static_cast<int>(rows_.size());
+      rows_.push_back(p);
+    }
+  bins_.resize(kept.size());
+  for (std::size_t b = 0; b < kept.size(); ++b) {
+    bins_[b].reserve(kept[b].size());
+    for (const auto& [p, q] : kept[b])
+      bins_[b].emplace_back(slot[static_cast<std::size_t>(p)], slot[static_cast<std::size_t>(q)]);
+  }
 }
 
 std::vector<double> VariogramPairs::gamma(const MatX& values, int components) const {
+  const int comps = std::min<int>(components, static_cast<int>(values.cols()));
+  MatX at(static_cast<Index>(rows_.size()), comps);
+  for (std::size_t i = 0; i < rows_.size(); ++i) at.row(static_cast<Index>(i)) = values.row(rows_[i]).leftCols(comps);
+  return gamma_at_rows(at, comps);
+}
+
+std::vector<double> VariogramPairs::gamma_at_rows(const MatX& values, int components) const {
   const int comps = std::min<int>(components, static_cast<int>(values.cols()));
   // Row-major copy of the columns used: each pair reads two short contiguous rows.
   const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = values.leftCols(comps);
@@ -274,7 +342,7 @@ ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed
 }
 
 NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed, const ProbeBank& bank,
-                              const std::function<MatX(const MatX&)>& smooth_residual) {
+                              const std::function<MatX(const MatX&, const std::vector<Index>&)>& smooth_residual) {
   NoiseEstimate out;
   out.lag = pairs.lag();
   out.gamma = observed;
@@ -283,15 +351,16 @@ NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<dou
   if (nb < 3) return out;
   const std::vector<double>& lengths = bank.lengths;
   const int nl = static_cast<int>(lengths.size());
-  const MatX shrunk = smooth_residual(bank.probes);
-  const std::vector<double> vw = pairs.gamma(shrunk.rightCols(3), 3);
+  const MatX shrunk = smooth_residual(bank.probes, pairs.rows());  // at pairs.rows() only
+  const std::vector<double> vw = pairs.gamma_at_rows(shrunk.rightCols(3), 3);
   VecX y(nb), w(nb);
   for (Index b = 0; b < nb; ++b) {
     y[b] = observed[static_cast<std::size_t>(b)];
     w[b] = pairs.count()[static_cast<std::size_t>(b)] / std::max(y[b] * y[b], 1e-300);
   }
   std::vector<std::vector<double>> v_of_length(static_cast<std::size_t>(nl));
-  for (int l = 0; l < nl; ++l) v_of_length[static_cast<std::size_t>(l)] = pairs.gamma(shrunk.middleCols(3 * l, 3), 3);
+  for (int l = 0; l < nl; ++l)
+    v_of_length[static_cast<std::size_t>(l)] = pairs.gamma_at_rows(shrunk.middleCols(3 * l, 3), 3);
   // Between two trial lengths the variogram is interpolated (in log L, quarter steps):
   // the bank's lengths are a factor 1.26 apart, too coarse for the estimate itself.
   ModelFit best;

@@ -93,12 +93,19 @@ class VariogramPairs {
   // Robust variogram of `values` (n x k, the first min(k, components) columns count):
   // per bin, the median of |v_p - v_q|^2 / 2 over chi-square's median.
   std::vector<double> gamma(const MatX& values, int components) const;
+  // The points any pair uses, ascending: a variogram needs values there only (on a grid
+  // of 1e6 points the pairs use about a sixth of them).
+  const std::vector<Index>& rows() const { return rows_; }
+  // The same variogram from the values at rows() only (rows().size() x k, in its order).
+  std::vector<double> gamma_at_rows(const MatX& values, int components) const;
   const std::vector<double>& lag() const { return lag_; }
   const std::vector<int>& count() const { return count_; }
   double spacing() const { return spacing_; }
 
  private:
-  std::vector<std::vector<std::pair<Index, Index>>> bins_;
+  // Pairs as positions in rows_.
+  std::vector<std::vector<std::pair<int, int>>> bins_;
+  std::vector<Index> rows_;
   std::vector<double> lag_;
   std::vector<int> count_;
   double spacing_ = 0.0;
@@ -115,13 +122,14 @@ struct ProbeBank {
 ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length = 0.0);
 
 // The noise model whose residuals under a smoother match the residuals' variogram:
-// `smooth_residual(w)` returns (I - H) w for probe data w (n x k). Fits
+// `smooth_residual(w, rows)` returns (I - H) w for probe data w (n x k) at the points
+// `rows` (pairs.rows(): rows.size() x k, in its order). Fits
 //   gamma(r) = s_c V_L(r) + s_w V_w(r) + b r^2
 // where V_L, V_w are the variograms of (I - H) applied to the bank's unit correlated
 // (length L) and white probes; L the best of the bank's lengths. Accounts for the noise
 // the smoother itself takes up.
 NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed, const ProbeBank& bank,
-                              const std::function<MatX(const MatX&)>& smooth_residual);
+                              const std::function<MatX(const MatX&, const std::vector<Index>&)>& smooth_residual);
 
 // Probes for a trace estimate tr(H Sigma): `count` columns, each a draw of the
 // noise at the points (n x count; three independent columns per random field,

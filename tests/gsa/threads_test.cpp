@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,7 +16,9 @@
 
 #include "common/core/parallel.hpp"
 #include "common/io/atomic_file.hpp"
+#include "common/linalg/dense_kernels.hpp"
 #include "gsa/analysis.hpp"
+#include "gsa/noise_model.hpp"
 #include "gsa/output.hpp"
 #include "gsa/synthetic.hpp"
 #include "gsa/synthetic_measurement.hpp"
@@ -134,6 +137,33 @@ TEST(GsaThreads, WrittenStrainsAreTheSameBytesOnOneAndThreeThreads) {
   ASSERT_GT(text[0].size(), 1000000u);
   EXPECT_TRUE(text[0] == text[1]) << "strains.csv differs between 1 and 3 threads";
   EXPECT_EQ(file_text(root / "threads1" / "deformed.vtp"), file_text(root / "threads3" / "deformed.vtp"));
+}
+
+// The probe fields' cosines run on the widest vector registers the processor has
+// (chosen at run time): every instruction set gives the bits of the one-point sum at(),
+// so the noise estimate does not depend on the machine either.
+TEST(GsaThreads, ProbeFieldRowsAreTheSameBitsOnEveryInstructionSet) {
+  Points3 p(29, 3);
+  for (Index i = 0; i < p.rows(); ++i) p.row(i) << 0.37 * i - 3.0, 1.3 * std::sin(0.7 * i), 0.05 * i * i;
+  const CorrelatedField field(0.7, 2.3, 11u, 48);
+  const linalg::KernelIsa best = linalg::kernel_isa();
+  int compared = 0;
+  for (linalg::KernelIsa isa : {linalg::KernelIsa::kGeneric, linalg::KernelIsa::kAvx2, linalg::KernelIsa::kAvx512}) {
+    if (linalg::set_kernel_isa(isa) != isa) continue;  // the processor lacks it
+    ++compared;
+    for (Index first = 0; first < p.rows(); first += CorrelatedField::kBlock) {
+      const int count = static_cast<int>(std::min<Index>(CorrelatedField::kBlock, p.rows() - first));
+      Eigen::Matrix<double, CorrelatedField::kBlock, 3> v;
+      field.at_rows(p, first, count, v);
+      for (int i = 0; i < count; ++i) {
+        const Vec3 one = field.at(p.row(first + i).transpose());
+        for (int c = 0; c < 3; ++c)
+          EXPECT_TRUE(same_bits(v(i, c), one[c])) << linalg::to_string(isa) << " row " << first + i << " comp " << c;
+      }
+    }
+  }
+  linalg::set_kernel_isa(best);
+  EXPECT_GE(compared, 1);
 }
 
 }  // namespace

@@ -82,6 +82,11 @@ struct StaticOptions {
   double divergence_factor = 1e8;   // |r| growing past this times the step's first |r| fails
   bool line_search = true;
   int max_line_search = 8;  // halvings of the corrector step
+  // With the line search (watchdog): a corrector's full step that the line search would
+  // damp is taken when |r_f| grows at most 100 times; if |r_f| is not below its value
+  // before that step within 3 iterations, Newton returns there and damps, without the
+  // watchdog for the rest of the load step (static_solver.cpp, LoadStepping::correct).
+  bool watchdog = true;
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
   ProcessClock clock;  // time and rates the interactions see
   // Tangent pattern and factorisation kept between solves of the same model (a run's

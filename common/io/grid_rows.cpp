@@ -626,10 +626,12 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       case InvalidRule::kNone:
         break;
       case InvalidRule::kEmptyCells:
-        // The neutral nodemap export (x_undef.. with u, v, w) writes a facet it could not
-        // measure as reference position 0, 0, 0 with nan displacements: that position is
-        // not a measurement either.
-        if (tri[kReference] && tri[kDisplacement] && !v[kDisplacement].allFinite() && all_zero[kReference])
+        // ARAMIS's neutral nodemap export (x_undef.. with u, v, w) writes a facet it could
+        // not measure as reference position 0, 0, 0 with nan displacements: that position
+        // is not a measurement either. (Elsewhere, e.g. MatchID, a point at the origin
+        // whose displacement failed keeps its reference position.)
+        if (spec.format == MeasurementFormat::kGom && tri[kReference] && tri[kDisplacement] &&
+            !v[kDisplacement].allFinite() && all_zero[kReference])
           row.reference.setConstant(kNaN);
         row.flagged_reference = out.has_reference && !row.reference.allFinite();
         row.flagged_current = !row.current.allFinite();

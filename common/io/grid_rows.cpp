@@ -310,18 +310,30 @@ std::string candidate_text(const Candidate& c) {
       path, line, 0, fmt::format("missing required column '{}' ({}found: {})", best.missing, detail, join(h.names()))));
 }
 
-// "# units: U" in the comment lines before the header (as the grid writer puts it).
+// "# units: U" in the comment lines before the header (as the grid writer puts it), or
+// the length entry of GOM/ZEISS's "# Units: length:mm angle:deg time:s" (the first line
+// of a GOM Correlate / ARAMIS surface-component CSV export).
 std::string file_unit(const CsvTable& t) {
   std::string unit;
+  auto trimmed = [](std::string_view v) {
+    const auto a = v.find_first_not_of(" \t\r"), b = v.find_last_not_of(" \t\r");
+    return a == std::string_view::npos ? std::string() : std::string(v.substr(a, b - a + 1));
+  };
   for (const auto& [line, text] : t.preamble()) {
     std::string_view s(text);
     const auto p = s.find_first_not_of(" \t#");
     if (p == std::string_view::npos || s.find('#') > p) continue;
     s.remove_prefix(p);
-    if (s.substr(0, 6) != "units:") continue;
-    s.remove_prefix(6);
-    const auto a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
-    if (a != std::string_view::npos) unit = std::string(s.substr(a, b - a + 1));
+    if (s.substr(0, 6) == "units:") {
+      unit = trimmed(s.substr(6));
+    } else if (s.substr(0, 6) == "Units:") {
+      // Only its "length:" entry is a length unit; without one the line says nothing here.
+      const auto at = s.find("length:", 6);
+      if (at == std::string_view::npos) continue;
+      std::string_view v = s.substr(at + 7);
+      v = v.substr(0, v.find_first_of(" \t\r"));
+      unit = trimmed(v);
+    }
   }
   return unit;
 }
@@ -614,6 +626,13 @@ GridRows read_grid_rows(const std::string& path, const GridReadOptions& options,
       case InvalidRule::kNone:
         break;
       case InvalidRule::kEmptyCells:
+        // ARAMIS's neutral nodemap export (x_undef.. with u, v, w) writes a facet it could
+        // not measure as reference position 0, 0, 0 with nan displacements: that position
+        // is not a measurement either. (Elsewhere, e.g. MatchID, a point at the origin
+        // whose displacement failed keeps its reference position.)
+        if (spec.format == MeasurementFormat::kGom && tri[kReference] && tri[kDisplacement] &&
+            !v[kDisplacement].allFinite() && all_zero[kReference])
+          row.reference.setConstant(kNaN);
         row.flagged_reference = out.has_reference && !row.reference.allFinite();
         row.flagged_current = !row.current.allFinite();
         break;

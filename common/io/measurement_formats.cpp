@@ -30,16 +30,21 @@ std::vector<FormatSpec> make_specs() {
   // GOM Correlate / ARAMIS Professional surface-component CSV (one file per stage):
   // x, y, z are the positions in the stage, displacement_* from the reference stage, so
   // X = x - displacement. The neutral "nodemap" export of dlr-wf/aramis-data-exporter
-  // writes undeformed positions x_undef.. with u, v, w instead.
+  // writes undeformed positions x_undef.. with u, v, w instead, under a commented header
+  // ("#        ID;  x_undef [mm]; ..."; an older version of it writes "#ID,ID; x_undef
+  // [mm]; ..."), and a facet it could not measure as 0, 0, 0 with nan displacements
+  // (data/real/README.md: real exports of both versions).
   FormatSpec gom;
   gom.format = MeasurementFormat::kGom;
   gom.name = "gom";
   gom.title = "GOM/ZEISS ARAMIS, GOM Correlate, ZEISS INSPECT Correlate point export";
   gom.layouts = {{{}, {"x", "y", "z"}, {"displacement_x", "displacement_y", "displacement_z"}, false},
                  {{"x_undef", "y_undef", "z_undef"}, {}, {"u", "v", "w"}, false}};
-  gom.ids = {{"id"}, {"ID"}};
+  gom.ids = {{"id"}, {"ID"}, {"ID,ID"}};
   gom.invalid = InvalidRule::kEmptyCells;
-  gom.invalid_text = "an empty or nan position or displacement cell (a point left out of a stage file is absent)";
+  gom.invalid_text =
+      "an empty or nan position or displacement cell, and a reference position of exactly 0, 0, 0 with nan "
+      "displacements (a point left out of a stage file is absent)";
   gom.planar = true;
   gom.brackets = true;
   specs.push_back(gom);

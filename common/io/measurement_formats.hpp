@@ -40,7 +40,9 @@ enum class Positions {
 // absent from a file is simply absent from that state).
 enum class InvalidRule {
   kNone,        // plain: an empty or nan cell means "not digitised" (status missing_*)
-  kEmptyCells,  // an empty or nan position or displacement cell: not measured in that state
+  kEmptyCells,  // an empty or nan position or displacement cell: not measured in that state;
+                // gom only: reference positions of exactly 0, 0, 0 beside nan displacements
+                // are not measured in either (the neutral ARAMIS nodemap's failed facet)
   kVicSigma,    // sigma < 0 (VIC-3D writes such a row as zeros); without a sigma column, a
                 // row whose positions and displacements are all exactly 0
   kDiceMatch,   // MATCH != 0, or without MATCH, SIGMA < 0; the reference position (the subset

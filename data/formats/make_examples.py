@@ -107,7 +107,41 @@ def gom_file(t, skip=(), empty=()):
     ] + gom_rows(t, skip, empty)) + "\n"
 
 
+def gom_correlate_file(t, skip=()):
+    """The layout of a real GOM Correlate / ARAMIS surface-component CSV export, line for
+    line as one was seen (a DP800 tensile test, data/real/README.md): a units line, the
+    stage as a comment and as a one-row table, the component's name, then ids from 0 and
+    columns without units, 4 decimals. Its German installation wrote 'Stufe' and
+    'Flächenkomponente'; strains in %, mises_strain and thickness_strain from the true
+    strains (made up like the rest)."""
+    l1, l2 = 1.0 + 0.010 * t, 1.0 - 0.005 * t
+    p1, p2 = math.log(l1), math.log(l2)
+    p3 = -(p1 + p2)
+    mises = math.sqrt(2.0 / 3.0 * (p1 * p1 + p2 * p2 + p3 * p3))
+    rows = []
+    for i, j, X in points():
+        pid = i * N + j
+        if pid in skip:
+            continue
+        x = deform(X, t)
+        u = [x[k] - X[k] for k in range(3)]
+        strains = [100 * (l1 - 1), 100 * (l2 - 1), 100 * mises, 100 * p3]
+        rows.append(";".join([str(pid)] + [f"{v:.4f}" for v in x + u + strains]))
+    return "\n".join([
+        "# Units: length:mm angle:deg time:s ",
+        "# Stage: Stufe 11",
+        "stage;index;relative_time;date",
+        f'"Stufe 11";11;{t:.4f};"2023-02-10T13:54:06.849"',
+        "# Name : Flächenkomponente 1",
+        "id;x;y;z;displacement_x;displacement_y;displacement_z;epsilon_x;epsilon_y;mises_strain;thickness_strain",
+    ] + rows) + "\n"
+
+
 def main():
+    # The layout of a real GOM Correlate surface-component export (units line, no units
+    # in the names, ids from 0); points 8 and 32 are left out of the stage.
+    write("gom_correlate_stage.csv", gom_correlate_file(10.0, skip=(8, 32)))
+
     # GOM/ZEISS: ';', a comment and a second table before the header, current positions
     # plus displacements, percent strains with a comma inside the unit brackets. Points 9
     # and 33 are left out of the stage (lost by the system), 17 and 41 have empty cells.

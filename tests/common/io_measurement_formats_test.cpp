@@ -91,6 +91,57 @@ TEST(IoFormats, GomStageExport) {
   EXPECT_TRUE(any_note(g, "displacement_x, displacement_y, displacement_z = displacements")) << g.notes.front();
 }
 
+// The layout of a real GOM Correlate surface-component export (data/real/README.md):
+// "# Units: length:mm angle:deg time:s", the stage as a comment and a one-row table
+// "stage;index;relative_time;date" with quoted cells, "# Name : Flächenkomponente 1",
+// names without units, ids from 0, 4 decimals. Points 8 and 32 are left out.
+TEST(IoFormats, GomCorrelateStageExportAsWritten) {
+  const std::string path = formats_dir() + "gom_correlate_stage.csv";
+  GridReadOptions o;
+  o.format = MeasurementFormat::kAuto;
+  const GridData g = read_grid_file(path, o);
+  ASSERT_EQ(g.n_points(), 47);
+  EXPECT_TRUE(any_note(g, "format found from the header: gom")) << g.notes.front();
+  EXPECT_EQ(std::count(g.ids.begin(), g.ids.end(), "8"), 0);
+  EXPECT_EQ(std::count(g.ids.begin(), g.ids.end(), "32"), 0);
+  constexpr double kFourDecimals = 2e-4;  // x and u rounded apart: X = x - u within 1e-4
+  for (Index p = 0; p < g.n_points(); ++p) {
+    const int pid = std::stoi(g.ids[p]);
+    const Vec3 X = example_reference(pid / 7, pid % 7);
+    EXPECT_LT((row(g.undeformed, p) - X).norm(), kFourDecimals) << g.ids[p];
+    EXPECT_LT((row(g.deformed, p) - example_current(X)).norm(), kFourDecimals) << g.ids[p];
+  }
+  EXPECT_EQ(g.where[0], path + ":7");  // the header is line 6
+}
+
+// The length unit of GOM's units line converts the unit-less columns; its other
+// entries (angle, time) say nothing about lengths. Without a length entry the line is
+// not a unit at all.
+TEST(IoFormats, GomUnitsLineGivesTheLengthUnit) {
+  ScratchDir dir;
+  const std::string head =
+      "# Stage: Stufe 1\n"
+      "stage;index;relative_time;date\n"
+      "\"Stufe 1\";1;0.0000;\"2023-02-10T13:53:56.849\"\n"
+      "# Name : Surface component 1\n"
+      "id;x;y;z;displacement_x;displacement_y;displacement_z;epsilon_x\n"
+      "0;1.5000;2.0000;0.0000;0.5000;0.0000;0.0000;0.0000\n"
+      "1;2.5000;2.0000;0.0000;0.5000;0.0000;0.0000;0.0000\n";
+  const std::string cm = dir.file("cm.csv");
+  write_text(cm, "# Units: length:cm angle:deg time:s \n" + head);
+  const GridData g = read_grid_file(cm, preset(MeasurementFormat::kGom));
+  EXPECT_NEAR(g.undeformed(0, 0), 10.0, 1e-12);  // (1.5 - 0.5) cm
+  EXPECT_NEAR(g.deformed(1, 0), 25.0, 1e-12);
+  EXPECT_TRUE(any_note(g, "converted to mm")) << g.notes.back();
+  const std::string no_length = dir.file("angles.csv");
+  write_text(no_length, "# Units: angle:deg time:s\n" + head);
+  EXPECT_NEAR(read_grid_file(no_length, preset(MeasurementFormat::kGom)).undeformed(0, 0), 1.0, 1e-12);
+  const std::string degrees = dir.file("deg.csv");
+  write_text(degrees, "# Units: length:deg\n" + head);
+  EXPECT_THAT(message_of<InputError>([&] { read_grid_file(degrees, preset(MeasurementFormat::kGom)); }),
+              HasSubstr("is in 'deg', which is not a length unit"));
+}
+
 // MatchID 2024.1: the key is the subset's image position, coor.* reference positions,
 // 3-digit exponents, stats.Sigma in mm. Point 25 (image 875, 825) has nan displacements.
 TEST(IoFormats, MatchIdImageExport) {

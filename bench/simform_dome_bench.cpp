@@ -20,6 +20,7 @@
 //   --elements N  N x N bricks a ply (the mid size: 10)
 //   --max-steps N stop cleanly after N steps (the full run can take long)
 //   --case FILE   another case (default: the [0,90]s dome)
+//   --stabilise F solver: {stabilise: {fraction: F}} (viscous stabilisation, calibrated from step 1)
 //   --ordering O  fill-reducing ordering of the Newton tangent's solver (default: the
 //                 solvers' own choice; forming/solve/tangent_solver.hpp)
 //   --time-limit S  after S seconds print the figures so far (a snapshot taken while the
@@ -273,6 +274,7 @@ int main(int argc, char** argv) {
   bool iterative = false;
   std::string linear;
   double time_limit = 0.0;
+  double stabilise = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -309,11 +311,17 @@ int main(int argc, char** argv) {
       linear = argv[++i];
     } else if (a == "--case" && i + 1 < argc) {
       file = argv[++i];
+    } else if (a == "--stabilise" && i + 1 < argc) {
+      stabilise = std::atof(argv[++i]);
+      if (!(stabilise > 0.0 && stabilise < 1.0)) {
+        std::fprintf(stderr, "simform_dome_bench: --stabilise: expected a fraction in (0, 1), found '%s'\n", argv[i]);
+        return 2;
+      }
     } else {
       std::fprintf(stderr,
                    "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
                    "[--factor-only | --iterative] [--linear direct|iterative|iterative-ply|auto] [--no-band-pattern] "
-                   "[--time-limit S]\n");
+                   "[--time-limit S] [--stabilise FRACTION]\n");
       return 2;
     }
   }
@@ -342,6 +350,10 @@ int main(int argc, char** argv) {
                 kept ? "kept for reuse (mallopt)" : "returned to the system (malloc tuned by the environment)");
     std::fflush(stdout);
     if (!linear.empty()) spec.solver.linear = to_string(parse_linear_mode(linear, "--linear"));
+    if (stabilise > 0.0) {  // solver: {stabilise: {fraction: F}} (forming/solve/stabilisation.hpp)
+      spec.solver.stabilise_fraction = stabilise;
+      spec.solver.stabilise_damping = 0.0;
+    }
     if (only_factor) return factor_only(spec, iterative);
     // One folder per process: runs side by side (sizes, orderings) do not collide.
     const std::filesystem::path dir =
@@ -374,12 +386,15 @@ int main(int argc, char** argv) {
 
     const io::CsvTable h = io::read_csv((dir / "history.csv").string());
     const auto col = [&](const char* name) { return h.column_index(name); };
-    std::printf("%5s %10s %18s %7s %9s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks");
+    const bool stabilised = h.has_column("stabilisation_ratio");
+    std::printf("%5s %10s %18s %7s %9s%s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks",
+                stabilised ? "  stabilisation_ratio" : "");
     for (std::size_t row = 1; row < h.n_rows(); ++row)
-      std::printf("%5zu %10.4f %18.12g %7s %9s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
+      std::printf("%5zu %10.4f %18.12g %7s %9s%s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
                   std::stod(std::string(h.cell(row, col("punch_fz")))),
                   std::string(h.cell(row, col("newton_iterations"))).c_str(),
-                  std::string(h.cell(row, col("cutbacks"))).c_str());
+                  std::string(h.cell(row, col("cutbacks"))).c_str(),
+                  stabilised ? ("  " + std::string(h.cell(row, col("stabilisation_ratio")))).c_str() : "");
     std::printf("status %s: %d steps, %d Newton iterations, %ld assemblies, %ld factorisations, %ld solves\n",
                 r.ok() ? "ok" : "not converged", r.steps_converged, r.total_iterations, p.assemblies, p.factorizations,
                 p.solves);

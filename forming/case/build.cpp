@@ -187,6 +187,10 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.dynamics.workspace->linear = linear;
   out.uzawa.tolerance = s.constraint_tolerance;
   out.process_time = s.process_time;
+  out.stabilise.fraction = s.stabilise_fraction;
+  out.stabilise.damping = s.stabilise_damping;
+  out.stabilise.warn_ratio = s.stabilise_warn_ratio;
+  out.stabilise.validate();
 
   if (s.dynamic) {
     DynamicOptions& d = out.dynamics;

@@ -30,6 +30,14 @@ void check_solver_rules(const FormingCase& spec, std::vector<CaseProblem>& probl
                 "' is incompressible/inextensible; exact constraints need load control for now");
     if (spec.loads.empty()) add(ProblemKind::kMissing, at, "solver control arc_length: there is no load to scale");
   }
+  if (spec.solver.stabilise_fraction > 0.0 || spec.solver.stabilise_damping > 0.0) {
+    if (spec.solver.dynamic)
+      add(ProblemKind::kUnsupported, spec.solver.stabilise_place,
+          "solver stabilise: load control only (analysis: dynamic has inertia instead)");
+    if (spec.solver.arc_length > 0.0)
+      add(ProblemKind::kUnsupported, spec.solver.stabilise_place,
+          "solver stabilise: load control only (not with control: arc_length)");
+  }
   if (spec.solver.dynamic) {
     const SourcePlace at = spec.solver.analysis_place;
     for (const CaseMaterial& m : spec.materials) {

@@ -460,7 +460,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver",
                  {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
                   "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
-                  "stop_displacement", "process_time", "predictor", "linear"}))
+                  "stop_displacement", "process_time", "predictor", "linear", "stabilise"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -571,6 +571,36 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
                 "solver linear: expected direct (sparse LU / Cholesky), iterative (GMRES preconditioned by an earlier "
                 "tangent's factorisation), iterative-ply (GMRES preconditioned per ply) or auto (by size), found " +
                     describe(li));
+  }
+  if (const YAML::Node st = n["stabilise"]; st.IsDefined()) {
+    s.stabilise_place = place_of(st);
+    if (r.mapping(st, "solver stabilise", {"fraction", "damping", "warn_ratio"})) {
+      if (st["fraction"].IsDefined() && st["damping"].IsDefined())
+        r.problem(ProblemKind::kUnsupported, st["damping"],
+                  "solver stabilise: give fraction (c calibrated from the first step) or damping (c in N s/mm^4), "
+                  "not both");
+      else if (!st["fraction"].IsDefined() && !st["damping"].IsDefined())
+        r.problem(ProblemKind::kMissing, st,
+                  "solver stabilise: give fraction (of the strain energy the first step may dissipate, e.g. 2e-4) "
+                  "or damping (c, N s/mm^4)");
+      if (st["fraction"].IsDefined()) {
+        const auto v = r.number(st["fraction"], "solver stabilise fraction");
+        if (v && !(*v > 0.0 && *v < 1.0))
+          r.problem(ProblemKind::kOutOfRange, st["fraction"],
+                    "solver stabilise fraction: expected a fraction of the strain energy in (0, 1), e.g. 2e-4, "
+                    "found " +
+                        st["fraction"].Scalar());
+        else if (v)
+          s.stabilise_fraction = *v;
+      }
+      if (st["damping"].IsDefined())
+        if (const auto v = r.positive(st["damping"], "solver stabilise damping", "N s/mm^4"))
+          s.stabilise_damping = *v;
+      if (st["warn_ratio"].IsDefined())
+        if (const auto v = r.positive(st["warn_ratio"], "solver stabilise warn_ratio",
+                                      "dissipated over strain energy, e.g. 0.05"))
+          s.stabilise_warn_ratio = *v;
+    }
   }
   if (n["line_search"].IsDefined())
     if (const auto v = r.boolean(n["line_search"], "solver line_search")) s.line_search = *v;

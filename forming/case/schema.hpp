@@ -171,6 +171,15 @@ struct CaseSolver {
   // (GMRES preconditioned by an earlier tangent's factorisation), iterative-ply (GMRES
   // preconditioned per ply) or auto (by size); forming/solve/tangent_solver.hpp.
   std::string linear = "auto";
+  // stabilise (load control): viscous stabilisation F_v = c M* v
+  // (forming/solve/stabilisation.hpp): {fraction: f} calibrates c from the first step so
+  // that it dissipates the fraction f of the strain energy it stores (2e-4 is Abaqus'
+  // default), {damping: c} gives c (N s/mm^4); warn_ratio: dissipated / strain energy
+  // above which the run warns (default 0.05). Both 0: off (the default).
+  double stabilise_fraction = 0.0;
+  double stabilise_damping = 0.0;    // N s/mm^4
+  double stabilise_warn_ratio = 0.05;
+  SourcePlace stabilise_place;  // of the "stabilise" key's value; 0: not given
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given
 };

@@ -39,7 +39,7 @@ ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX
 
 namespace {
 
-std::vector<std::string> history_columns(const Model& model) {
+std::vector<std::string> history_columns(const Model& model, bool stabilised) {
   std::vector<std::string> cols = {"step",          "load_factor",       "tool_ux",  "tool_uy",
                                    "tool_uz",       "tool_fx",           "tool_fy",  "tool_fz",
                                    "strain_energy", "newton_iterations", "cutbacks", "residual"};
@@ -47,28 +47,44 @@ std::vector<std::string> history_columns(const Model& model) {
   const VecX X = model.reference_positions();
   for (int i = 0; i < model.n_interactions(); ++i)
     for (const ToolReaction& r : model.interaction(i).reactions(X, {})) tools.push_back(r);
-  if (tools.empty()) return cols;
-  cols.push_back("time");
-  for (const ToolReaction& r : tools)
-    for (const char* c : {"_ux", "_uy", "_uz", "_fx", "_fy", "_fz"}) cols.push_back(r.tool + c);
+  if (!tools.empty()) {
+    cols.push_back("time");
+    for (const ToolReaction& r : tools)
+      for (const char* c : {"_ux", "_uy", "_uz", "_fx", "_fy", "_fz"}) cols.push_back(r.tool + c);
+  }
+  if (stabilised) {
+    cols.push_back("stabilisation_energy");
+    cols.push_back("stabilisation_ratio");
+  }
   return cols;
 }
 
 }  // namespace
 
-HistoryTable::HistoryTable(const Model& model, ToolEdge tool)
+HistoryTable::HistoryTable(const Model& model, ToolEdge tool, bool stabilised)
     : model_(model),
       tool_(std::move(tool)),
       X_(model.reference_positions()),
-      writer_(out_, history_columns(model)),
-      header_size_(out_.str().size()) {
+      writer_(out_, history_columns(model, stabilised)),
+      header_size_(out_.str().size()),
+      stabilised_(stabilised) {
   for (int i = 0; i < model.n_interactions(); ++i) tools_ = tools_ || !model.interaction(i).reactions(X_, {}).empty();
 }
 
 ToolState HistoryTable::add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations,
-                                int cutbacks, double residual, const InteractionContext& context) {
-  const ToolState ts = measure(tool_, x, X_, reactions);
+                                int cutbacks, double residual, const InteractionContext& context,
+                                double stabilisation_energy) {
+  return write_row(k, load_factor, x, reactions, iterations, cutbacks, residual, context, stabilisation_energy, true);
+}
+
+void HistoryTable::add_start_row(const VecX& x) { write_row(0, 0.0, x, VecX(), 0, 0, 0.0, {}, 0.0, false); }
+
+ToolState HistoryTable::write_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations,
+                                  int cutbacks, double residual, const InteractionContext& context,
+                                  double stabilisation_energy, bool forces) {
+  const ToolState ts = measure(tool_, x, X_, forces ? reactions : VecX());
   const Assembly a = model_.assemble(x, context, false);
+  last_strain_energy_ = a.strain_energy;
   writer_.begin_row().add(k).add(load_factor);
   for (int c = 0; c < 3; ++c) writer_.add(ts.displacement[c]);
   for (int c = 0; c < 3; ++c) writer_.add(ts.force[c]);
@@ -78,9 +94,11 @@ ToolState HistoryTable::add_row(int k, double load_factor, const VecX& x, const 
     for (int i = 0; i < model_.n_interactions(); ++i)
       for (const ToolReaction& r : model_.interaction(i).reactions(x, context)) {
         for (int c = 0; c < 3; ++c) writer_.add(r.displacement[c]);
-        for (int c = 0; c < 3; ++c) writer_.add(r.force[c]);
+        for (int c = 0; c < 3; ++c) writer_.add(forces ? r.force[c] : 0.0);
       }
   }
+  if (stabilised_)
+    writer_.add(stabilisation_energy).add(a.strain_energy > 0.0 ? stabilisation_energy / a.strain_energy : 0.0);
   writer_.end_row();
   return ts;
 }

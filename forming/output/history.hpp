@@ -18,7 +18,18 @@
 //
 // time (s): the process time (load control) or the time (dynamics); <tool>_u*: the
 // tool's displacement (mm); <tool>_f*: the force the plies exert on it (N; a punch
-// pressing down on a ply sees f_z > 0).
+// pressing down on a ply sees f_z > 0). Row 0 is the start state as given, before any
+// solve: it reports zero forces (tool edge and tools), since its contact pressures
+// (e.g. a sheet laid on a die at gap 0 inside the contact band) are not balanced by
+// anything yet and would read as a load the process never applied.
+//
+// A run with viscous stabilisation (solver stabilise, forming/solve/stabilisation.hpp)
+// adds, last,
+//
+//   stabilisation_energy, stabilisation_ratio
+//
+// the energy the stabilisation dissipated from the start to the step (N mm) and its
+// ratio to the strain energy of the step (dimensionless; 0 where that is 0).
 #include <sstream>
 #include <string>
 #include <vector>
@@ -45,13 +56,19 @@ ToolState measure(const ToolEdge& tool, const VecX& x, const VecX& X, const VecX
 
 class HistoryTable {
  public:
-  HistoryTable(const Model& model, ToolEdge tool);
+  // `stabilised`: the stabilisation columns are added.
+  HistoryTable(const Model& model, ToolEdge tool, bool stabilised = false);
   // The rows of an earlier run (restart.json), appended after the header.
   void append_rows(const std::string& rows) { out_ << rows; }
   // A row for step k; returns the tool's state in it. `context`: the time and rates of
   // the step (rigid tools' reactions include friction).
+  // `stabilisation_energy`: dissipated from the start to this step, N mm (stabilised tables).
   ToolState add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
-                    double residual, const InteractionContext& context = {});
+                    double residual, const InteractionContext& context = {}, double stabilisation_energy = 0.0);
+  // Row 0: the start state x, nothing solved: zero forces (see above), the tools where they are.
+  void add_start_row(const VecX& x);
+  // The strain energy (N mm) of the last row added.
+  double last_strain_energy() const { return last_strain_energy_; }
   const ToolEdge& tool() const { return tool_; }
   std::string text() const { return out_.str(); }
   std::string rows() const { return out_.str().substr(header_size_); }
@@ -64,6 +81,11 @@ class HistoryTable {
   io::CsvWriter writer_;
   std::size_t header_size_ = 0;
   bool tools_ = false;  // some interaction reports tool reactions
+  bool stabilised_ = false;
+  double last_strain_energy_ = 0.0;
+  // Writes one row; `forces`: false writes 0 for every force (the unsolved start row).
+  ToolState write_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations, int cutbacks,
+                      double residual, const InteractionContext& context, double stabilisation_energy, bool forces);
 };
 
 }  // namespace sf::forming

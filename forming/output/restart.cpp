@@ -67,6 +67,7 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   nlohmann::json parts = nlohmann::json::array();
   for (const io::PvdDataSet& p : s.parts) parts.push_back({p.time, p.file, p.part});
   j["parts"] = parts;
+  j["stabilisation"] = {{"damping", s.stabilisation_damping}, {"energy", s.stabilisation_energy}};
   io::write_file_atomic(path, j.dump());
 }
 
@@ -115,6 +116,10 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
     if (j.contains("parts"))
       for (const auto& p : j.at("parts"))
         s.parts.push_back({p.at(0).get<double>(), p.at(1).get<std::string>(), p.at(2).get<int>()});
+    if (j.contains("stabilisation")) {
+      s.stabilisation_damping = j.at("stabilisation").at("damping").get<double>();
+      s.stabilisation_energy = j.at("stabilisation").at("energy").get<double>();
+    }
   } catch (const std::exception& e) {
     throw InputError(path + ": not a readable restart file (" + e.what() + ")");
   }

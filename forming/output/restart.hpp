@@ -16,6 +16,7 @@
 //   history_rows   the rows of history.csv so far (without the header)
 //   frames         [load factor, file name] of every frame written so far
 //   parts          [load factor, file name, part] of the tool and contact parts so far
+//   stabilisation  {damping (N s/mm^4), energy (N mm)}: stabilised runs (optional)
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +36,10 @@ struct RestartState {
   std::string history_rows;
   std::vector<std::pair<double, std::string>> frames;
   std::vector<io::PvdDataSet> parts;  // tool and contact parts (part >= 1)
+  // Stabilised runs (forming/solve/stabilisation.hpp): the damping factor in use
+  // (N s/mm^4; 0: not yet calibrated) and the energy dissipated so far (N mm).
+  double stabilisation_damping = 0.0;
+  double stabilisation_energy = 0.0;
 };
 
 // The multipliers come from `model`.

@@ -95,6 +95,10 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
                  {"tolerance", spec.solver.tolerance},
                  {"line_search", spec.solver.line_search},
                  {"min_increment", spec.solver.min_increment}};
+  if (spec.solver.stabilise_fraction > 0.0 || spec.solver.stabilise_damping > 0.0)
+    j["solver"]["stabilise"] = {{"fraction", spec.solver.stabilise_fraction},
+                                {"damping", spec.solver.stabilise_damping},
+                                {"warn_ratio", spec.solver.stabilise_warn_ratio}};
   j["output"] = {{"every", spec.output.every},
                  {"samples", {spec.output.samples_inplane, spec.output.samples_thickness}}};
   j["model"] = {{"dofs", model.n_dofs()},
@@ -136,6 +140,14 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
   for (const auto& f : run.frames) outputs.push_back(f.second);
   j["outputs"] = outputs;
   j["grid_out"] = run.grid_out.empty() ? nlohmann::json() : nlohmann::json(run.grid_out);
+  if (run.stabilised)
+    j["stabilisation"] = {{"fraction", spec.solver.stabilise_fraction},
+                          {"damping", run.stabilisation_damping},
+                          {"energy", run.stabilisation_energy},
+                          {"ratio", run.stabilisation_ratio},
+                          {"max_ratio", run.stabilisation_max_ratio},
+                          {"warn_ratio", spec.solver.stabilise_warn_ratio},
+                          {"quasi_static", run.stabilisation_max_ratio <= spec.solver.stabilise_warn_ratio}};
   j["units"] = {{"length", "mm"}, {"force", "N"}, {"stress", "MPa"}, {"energy", "N mm"}, {"note", spec.units}};
   return j;
 }

@@ -14,6 +14,9 @@
 //   load_factor, final_residual (N), newton_iterations, multiplier_updates
 //   tool_edge    {edge, displacement (mm), force (N)}, max_displacement (mm)
 //   timings_s    {build, solve, write, total}; outputs; grid_out; units
+//   stabilisation  stabilised runs: {fraction, damping (N s/mm^4, in use), energy (N mm,
+//                dissipated to the last step), ratio (to the strain energy there),
+//                max_ratio (over the steps), warn_ratio, quasi_static (max_ratio <= warn_ratio)}
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +49,11 @@ struct RunSummary {
   std::vector<std::pair<double, std::string>> frames;  // written frames (load factor, file)
   double seconds_build = 0.0, seconds_solve = 0.0, seconds_write = 0.0, seconds_total = 0.0;
   std::string grid_out;  // the grid file written, or empty
+  // Viscous stabilisation (solver stabilise): dissipated energy to the last step (N mm),
+  // damping factor c (N s/mm^4), its ratio to the strain energy there and the largest.
+  bool stabilised = false;
+  double stabilisation_energy = 0.0, stabilisation_damping = 0.0;
+  double stabilisation_ratio = 0.0, stabilisation_max_ratio = 0.0;
 };
 
 // The "parameters" block.

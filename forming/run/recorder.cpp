@@ -1,5 +1,6 @@
 #include "forming/run/recorder.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -52,10 +53,12 @@ RunRecorder::RunRecorder(const FormingCase& spec, Problem& problem, const RunOpt
       X_(problem.model.reference_positions()),
       out_(options.out_dir, folder_options(options)),
       frames_(problem.model, spec.output.samples_inplane, spec.output.samples_thickness),
-      history_(problem.model, tool_edge(spec, problem.model)),
+      history_(problem.model, tool_edge(spec, problem.model),
+               spec.solver.stabilise_fraction > 0.0 || spec.solver.stabilise_damping > 0.0),
       restart_path_((out_.temp_dir() / "restart.json").string()),
       created_(Clock::now()) {
   report_.status = RunReport::Status::kConverged;
+  stabilised_ = spec.solver.stabilise_fraction > 0.0 || spec.solver.stabilise_damping > 0.0;
 }
 
 SteppingState RunRecorder::start() {
@@ -84,6 +87,8 @@ SteppingState RunRecorder::start() {
         ++missing;
     }
     history_.append_rows(restart_.history_rows);
+    stabilisation_energy_ = restart_.stabilisation_energy;
+    damping_ = restart_.stabilisation_damping;
     cli::status(options_.quiet, "simform: restarting from load factor " + std::to_string(state.load_factor) +
                                     " (step " + std::to_string(restart_.step) + " of the earlier run" +
                                     (killed_run ? ", from the folder of the interrupted run" : "") + ")");
@@ -91,7 +96,8 @@ SteppingState RunRecorder::start() {
       cli::status(options_.quiet, "simform: warning: " + std::to_string(missing) +
                                       " earlier frame files are missing; the series lists the others");
   } else {
-    history_.add_row(0, 0.0, state.x, VecX::Zero(problem_.model.n_dofs()), 0, 0, 0.0);
+    // The start state as given, nothing solved: no forces (history.hpp).
+    history_.add_start_row(state.x);
     const Clock::time_point t0 = Clock::now();
     const InteractionContext at_rest{};
     frames_.write(out_, 0, 0.0, state.x, &at_rest);
@@ -122,7 +128,22 @@ StepAction RunRecorder::on_step(const StepInfo& step, const SteppingState& state
   last_ = state;
   last_time_ = step.time;
   const ToolState tool = history_.add_row(step.index, step.load_factor, state.x, reactions, step.iterations,
-                                          step.cutbacks, step.residual, context());
+                                          step.cutbacks, step.residual, context(), step.stabilisation_energy);
+  if (step.stabilised) {
+    stabilisation_energy_ = step.stabilisation_energy;
+    damping_ = step.damping;
+    const double strain = history_.last_strain_energy();
+    ratio_ = strain > 0.0 ? stabilisation_energy_ / strain : 0.0;
+    max_ratio_ = std::max(max_ratio_, ratio_);
+    if (!warned_ && ratio_ > spec_.solver.stabilise_warn_ratio) {
+      warned_ = true;
+      cli::status(options_.quiet, "simform: warning: step " + std::to_string(step.index) +
+                                      ": the stabilisation has dissipated " + sci(100.0 * ratio_) +
+                                      " % of the strain energy (above warn_ratio " +
+                                      sci(spec_.solver.stabilise_warn_ratio) +
+                                      "): the results are not quasi-static; give a smaller fraction or damping");
+    }
+  }
   report_.max_displacement = largest_displacement(problem_.model, state.x, X_);
   report_.steps_converged = step.index;
   report_.load_factor = step.load_factor;
@@ -176,6 +197,8 @@ void RunRecorder::write_step(int k, double load_factor) {
   restart_.history_rows = history_.rows();
   restart_.frames = frames_.frames();
   restart_.parts = frames_.parts();
+  restart_.stabilisation_damping = damping_;
+  restart_.stabilisation_energy = stabilisation_energy_;
   write_restart(restart_path_, spec_, problem_.model, restart_);
   seconds_write_ += seconds_since(t0);
 }
@@ -237,6 +260,11 @@ RunReport RunRecorder::finish(const SteppingReport& stepping, double seconds_bui
   s.seconds_write = seconds_write_;
   s.seconds_total = report_.seconds;
   s.grid_out = write_grid_file ? options_.grid_out : std::string();
+  s.stabilised = stabilised_;
+  s.stabilisation_energy = stabilisation_energy_;
+  s.stabilisation_damping = damping_;
+  s.stabilisation_ratio = ratio_;
+  s.stabilisation_max_ratio = max_ratio_;
   nlohmann::json summary = summary_json(spec_, problem_.model, s);
   summary["forming"] = forming_summary(spec_, problem_.model, last_.x, spec_.output.samples_inplane);
   io::write_json(out_.path("summary.json"), summary);

@@ -42,6 +42,8 @@ class RunRecorder final : public StepObserver {
   // seconds_build: time spent building the problem before the recorder was made
   // (summary.json timings).
   RunReport finish(const SteppingReport& stepping, double seconds_build);
+  // The state read from restart.json (a restart; empty otherwise).
+  const RestartState& restart_state() const { return restart_; }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -73,6 +75,11 @@ class RunRecorder final : public StepObserver {
   Clock::time_point created_;
   Clock::time_point stepping_started_;
   double seconds_write_ = 0.0;
+  // Stabilised runs: the last step's dissipated energy (N mm), damping factor
+  // (N s/mm^4), ratio to the strain energy, the largest ratio and whether the run warned.
+  bool stabilised_ = false;
+  double stabilisation_energy_ = 0.0, damping_ = 0.0, ratio_ = 0.0, max_ratio_ = 0.0;
+  bool warned_ = false;
 };
 
 }  // namespace sf::forming

@@ -60,7 +60,7 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   cli::status(options.quiet, fmt::format("simform: setting up {} unknowns (about {:.0f} MB to solve)", size.unknowns,
                                          size.total_bytes() / 1e6));
   Problem problem = build_problem(spec);
-  const StepperSettings settings = stepper_settings(spec);
+  StepperSettings settings = stepper_settings(spec);
   const double seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   cli::status(options.quiet, fmt::format("simform: model set up in {:.1f} s; the first step also analyses the "
                                          "matrix pattern",
@@ -71,6 +71,13 @@ RunReport run_case(const FormingCase& spec, const RunOptions& options) {
   SteppingState state = recorder.start();
   if (options.restart && settings.control == Control::kArcLength)
     throw UsageError("--restart: not available with solver control arc_length");
+  // A stabilised run restarts with the damping factor it had (calibrated or given) and
+  // the energy dissipated so far.
+  if (options.restart && settings.stabilise.active() && recorder.restart_state().stabilisation_damping > 0.0) {
+    settings.stabilise.fraction = 0.0;
+    settings.stabilise.damping = recorder.restart_state().stabilisation_damping;
+    settings.stabilise.start_energy = recorder.restart_state().stabilisation_energy;
+  }
 
   // Step with the chosen stepper, the recorder observing every converged step.
   const std::unique_ptr<Stepper> stepper = make_stepper(problem, settings);

@@ -200,6 +200,7 @@ Residual LoadStepping::final_residual(double lambda, const VecX& x) {
 
 void LoadStepping::converged(double lambda, const VecX& x) {
   if (!(options_.clock.end > options_.clock.start)) return;  // the time stands still
+  if (options_.on_substep) options_.on_substep(rates_from_, rates_time_, x, options_.clock.at(lambda));
   last_rates_from_ = rates_from_;
   last_rates_time_ = rates_time_;
   rates_from_ = x;

@@ -33,6 +33,7 @@
 //
 // Units: positions mm, forces N, stiffness N/mm (any consistent set).
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,6 +90,10 @@ struct StaticOptions {
   bool watchdog = true;
   linalg::SolverKind linear_solver = linalg::SolverKind::kAuto;
   ProcessClock clock;  // time and rates the interactions see
+  // Called after every converged sub-step while the clock runs, with the state the
+  // interactions' rates started from and its time, and the state reached and its time
+  // (s): the stepper sums the stabilisation's dissipation (forming/solve/stabilisation.hpp).
+  std::function<void(const VecX& from, double from_time, const VecX& to, double to_time)> on_substep;
   // Tangent pattern and factorisation kept between solves of the same model (a run's
   // load steps, forming/solve/tangent_solver.hpp); null: laid out for this solve only.
   std::shared_ptr<TangentWorkspace> workspace;

@@ -58,6 +58,19 @@ class LoadStepper final : public Stepper {
   LoadStepper(Problem& problem, const StepperSettings& settings) : problem_(problem), settings_(settings) {
     // One tangent pattern and symbolic factorisation for all the steps (and repeats).
     if (!settings_.statics.workspace) settings_.statics.workspace = std::make_shared<TangentWorkspace>();
+    if (settings_.stabilise.active()) {
+      settings_.stabilise.validate();
+      for (int i = 0; i < problem_.model.n_interactions() && !stabilisation_; ++i)
+        stabilisation_ = dynamic_cast<ViscousStabilisation*>(&problem_.model.interaction(i));
+      if (!stabilisation_) {
+        auto s = std::make_shared<ViscousStabilisation>(problem_.model);
+        stabilisation_ = s.get();
+        problem_.model.add_interaction(std::move(s));
+      }
+      // Given c from the start; calibrated c after the first step (0 until then).
+      stabilisation_->set_damping(settings_.stabilise.damping);
+      dissipated_ = settings_.stabilise.start_energy;
+    }
   }
 
   SteppingReport run(SteppingState& state, StepObserver& observer) override {
@@ -79,12 +92,36 @@ class LoadStepper final : public Stepper {
       StaticOptions statics = settings_.statics;
       statics.clock = {lambda_prev * T, lambda * T, nullptr, 0.0};
       const std::vector<PrescribedDof> targets = problem_.prescriptions.at(lambda);
+      // Stabilised: the converged sub-steps, for the energy they dissipate.
+      std::vector<SubStep> substeps;
+      if (stabilisation_)
+        statics.on_substep = [&substeps](const VecX& from, double t0, const VecX& to, double t1) {
+          substeps.push_back({from, to, t1 - t0});
+        };
       UzawaReport uzawa;
       StaticResult r = solve_static_constrained(problem_.model, state.x, targets, step_load, problem_.loads.follower,
                                                 statics, settings_.uzawa, &uzawa);
       out.multiplier_updates += uzawa.updates;
       out.total_iterations += r.report.total_iterations;
-      if (!r.report.ok()) return failed(std::move(out), k, n, lambda, r.report.message);
+      // fraction: a first step that fails unstabilised calibrates c from the part of it
+      // that converged and is solved again, stabilised, from its start.
+      if (!r.report.ok() && needs_calibration() && r.report.load_factor > 0.0) {
+        calibrate(state.x, r.positions, r.report.load_factor * (lambda - lambda_prev) * T);
+        if (stabilisation_->damping() > 0.0) {
+          substeps.clear();
+          statics.workspace->next_increment = 0.0;
+          r = solve_static_constrained(problem_.model, state.x, targets, step_load, problem_.loads.follower, statics,
+                                       settings_.uzawa, &uzawa);
+          out.multiplier_updates += uzawa.updates;
+          out.total_iterations += r.report.total_iterations;
+        }
+      }
+      if (!r.report.ok()) {
+        if (needs_calibration() && r.report.load_factor <= 0.0)
+          r.report.message += "; stabilise fraction: no part of the step converged to calibrate the damping from: "
+                              "give solver stabilise damping (N s/mm^4) instead";
+        return failed(std::move(out), k, n, lambda, r.report.message);
+      }
       // Augmented-Lagrangian interactions: update and solve the step again at its end
       // (the time standing still, rates still from the step's start) until all are met.
       const InteractionContext at_end{lambda * T, nullptr, &state.x, lambda_prev * T};
@@ -111,12 +148,23 @@ class LoadStepper final : public Stepper {
         r.positions = again.positions;
         r.reactions = again.reactions;
       }
+      if (stabilisation_) {
+        // The repeats moved the end of the last sub-step to the final state.
+        if (!substeps.empty()) substeps.back().to = r.positions;
+        for (const SubStep& s : substeps) dissipated_ += stabilisation_->dissipation(s.from, s.to, s.dt);
+        if (needs_calibration()) calibrate(state.x, r.positions, (lambda - lambda_prev) * T);
+      }
       commit_interactions(problem_.model, r.positions, at_end);
       state.x = r.positions;
       state.load_factor = lambda;
-      const StepInfo info{
+      StepInfo info{
           Control::kLoad,          k, n, lambda, lambda * T, r.report.total_iterations, r.report.n_cutbacks,
           r.report.last_residual()};
+      if (stabilisation_) {
+        info.stabilised = true;
+        info.stabilisation_energy = dissipated_;
+        info.damping = stabilisation_->damping();
+      }
       if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
         out.status = SteppingReport::Status::kStopped;
         return out;
@@ -126,8 +174,27 @@ class LoadStepper final : public Stepper {
   }
 
  private:
+  struct SubStep {
+    VecX from, to;
+    double dt = 0.0;  // s
+  };
+  // fraction given and c not yet calibrated.
+  bool needs_calibration() const {
+    return stabilisation_ && settings_.stabilise.fraction > 0.0 && !(stabilisation_->damping() > 0.0);
+  }
+  // c = fraction dE_s dt / (dx^T M* dx) over the increment from x0 to x1 taking dt (s);
+  // stays 0 when the increment stored no strain energy or did not move.
+  void calibrate(const VecX& x0, const VecX& x1, double dt) {
+    const Assembly a0 = problem_.model.assemble(x0, false), a1 = problem_.model.assemble(x1, false);
+    if (!(a0.ok && a1.ok)) return;
+    stabilisation_->set_damping(calibrated_damping(*stabilisation_, settings_.stabilise.fraction,
+                                                   a1.strain_energy - a0.strain_energy, x1 - x0, dt));
+  }
+
   Problem& problem_;
   StepperSettings settings_;
+  ViscousStabilisation* stabilisation_ = nullptr;  // owned by the model; null: not stabilised
+  double dissipated_ = 0.0;                        // N mm, from the run's start
 };
 
 class DynamicStepper final : public Stepper {

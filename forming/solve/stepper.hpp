@@ -36,6 +36,7 @@
 #include "forming/solve/arc_length.hpp"
 #include "forming/solve/dynamic_solver.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "forming/solve/stabilisation.hpp"
 
 namespace sf::forming {
 
@@ -49,6 +50,10 @@ struct StepperSettings {
   UzawaOptions uzawa;               // kLoad with constrained bodies
   double process_time = 1.0;        // kLoad: s per unit load factor (t = lambda process_time)
   int max_multiplier_updates = 30;  // kLoad: augmented-Lagrangian repeats of a step
+  // kLoad: viscous stabilisation (forming/solve/stabilisation.hpp). When active the
+  // load stepper uses the model's ViscousStabilisation interaction, adding one when the
+  // model has none; with `fraction` it calibrates c from the first step.
+  StabiliseOptions stabilise;
   DynamicOptions dynamics;          // kDynamic: per output interval (its times are set per step)
   double end_time = 1.0;            // kDynamic, s
   ArcLengthOptions arc;             // kArcLength
@@ -72,6 +77,11 @@ struct StepInfo {
   int iterations = 0;     // Newton iterations of the step
   int cutbacks = 0;       // cut-backs inside the step
   double residual = 0.0;  // |r_f| at its end, N
+  // Load control with stabilisation: the energy it dissipated from the run's start to
+  // the end of this step (N mm) and its damping factor c (N s/mm^4; 0 before calibration).
+  bool stabilised = false;
+  double stabilisation_energy = 0.0;
+  double damping = 0.0;
 };
 
 enum class StepAction { kContinue, kStop };

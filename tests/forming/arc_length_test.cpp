@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "common/core/error.hpp"
@@ -26,7 +27,9 @@
 #include "forming/model/ply_mesh.hpp"
 #include "forming/case/reader.hpp"
 #include "forming/run/run.hpp"
+#include "forming/solve/stabilisation.hpp"
 #include "forming/solve/static_solver.hpp"
+#include "forming/solve/stepper.hpp"
 
 namespace sf::forming {
 namespace {
@@ -264,6 +267,246 @@ TEST(ArcLength, DiaphragmSamplePassesThePressureMaximum) {
   EXPECT_LT(last, 0.8 * peak);
   std::printf("diaphragm: peak load factor %.4f (%.4f MPa), %.4f at 150 mm\n", peak, 0.02 * peak, last);
   std::filesystem::remove_all(o.out_dir);
+}
+
+// ---- Viscous stabilisation (forming/solve/stabilisation.hpp) on the same arch ----------
+//
+// Load control with F_v = c M* (x - x_prev) / dt added: below the limit point the result
+// is the static one up to the dissipated fraction; past it the arch snaps onto its
+// inverted branch, which the arc-length path locates independently.
+
+// The clamped shallow arch of ShallowArchSnapsThroughItsLimitPoint.
+Tube make_arch() { return make_tube(8, 10.0, 10.05, 0.4, true); }
+Index arch_crown(const Model& model) { return model.dof(0, 4, 0, 0); }
+
+// Its arc-length path (crown deflection, pressure in MPa) through the limit point to a
+// crown deflection of 0.5 mm, computed once.
+const std::vector<std::pair<double, double>>& arch_path() {
+  static const std::vector<std::pair<double, double>> path = [] {
+    Tube t = make_arch();
+    const LoadFunction load = [&](double lambda, const VecX& x, bool want_tangent) {
+      return t.loads.assemble(t.model, x, lambda, want_tangent);
+    };
+    ArcLengthOptions o;
+    o.arc_length = 0.01;
+    o.max_arc = 0.05;
+    o.max_steps = 400;
+    const Index crown = arch_crown(t.model);
+    const VecX X = t.model.reference_positions();
+    const ArcLengthResult r = solve_arc_length(t.model, X, t.fixed, load, true, o,
+                                               [&](const ArcLengthPoint& pt) { return X(crown) - pt.x(crown) > 0.5; });
+    std::vector<std::pair<double, double>> out;
+    if (r.ok())
+      for (const ArcLengthPoint& pt : r.path) out.emplace_back(X(crown) - pt.x(crown), pt.lambda);
+    return out;
+  }();
+  return path;
+}
+
+double arch_limit_pressure() {
+  double p_max = 0.0;
+  for (const auto& [w, p] : arch_path()) {
+    if (p < p_max) break;
+    p_max = p;
+  }
+  return p_max;
+}
+
+// Crown deflection on the inverted branch (after the pressure's minimum) at pressure p,
+// interpolated along the arc-length path; < 0 when the path does not reach p there.
+double inverted_branch_deflection(double p) {
+  const auto& path = arch_path();
+  std::size_t k = 1;
+  while (k < path.size() && path[k].second <= path[k - 1].second) ++k;  // rising to the limit
+  while (k < path.size() && path[k].second >= path[k - 1].second) ++k;
+  while (k < path.size() && path[k].second < path[k - 1].second) ++k;  // falling to the minimum
+  for (; k < path.size(); ++k)
+    if (path[k - 1].second <= p && p <= path[k].second) {
+      const double t = (p - path[k - 1].second) / (path[k].second - path[k - 1].second);
+      return path[k - 1].first + t * (path[k].first - path[k - 1].first);
+    }
+  return -1.0;
+}
+
+// The arch as a Problem for the load stepper: ends held, the follower pressure following
+// `table` (MPa against the load factor).
+Problem arch_problem(const LoadTable& table) {
+  Tube t = make_arch();
+  Problem p;
+  p.model = std::move(t.model);
+  for (const PrescribedDof& f : t.fixed) p.prescriptions.add(Prescription{f.dof, f.value, 0.0, Ramp::kLinear});
+  p.loads.add(table, std::move(t.loads));
+  p.density.assign(1, 0.0);
+  return p;
+}
+
+// Keeps every converged step.
+struct Steps final : StepObserver {
+  std::vector<StepInfo> info;
+  std::vector<VecX> x;
+  StepAction on_step(const StepInfo& step, const SteppingState& state, const VecX&) override {
+    info.push_back(step);
+    x.push_back(state.x);
+    return StepAction::kContinue;
+  }
+};
+
+struct StepperRun {
+  SteppingReport report;
+  Steps steps;
+  double crown = 0.0;         // deflection at the last converged step, mm
+  double static_residual = 0.0;  // |f_int - f_ext| on the free dofs there, relative to |f_ext|
+};
+
+StepperRun run_arch(const LoadTable& table, int steps, const StabiliseOptions& stabilise) {
+  Problem p = arch_problem(table);
+  StepperSettings s;
+  s.steps = steps;
+  s.statics.max_iterations = 30;
+  s.statics.max_steps = 4000;
+  s.stabilise = stabilise;
+  StepperRun out;
+  SteppingState state{p.model.reference_positions(), VecX::Zero(p.model.n_dofs()), 0.0};
+  out.report = make_stepper(p, s)->run(state, out.steps);
+  const VecX X = p.model.reference_positions();
+  out.crown = X(arch_crown(p.model)) - state.x(arch_crown(p.model));
+  // The static residual without the stabilisation: interactions other than it (none here).
+  const Assembly a = p.model.assemble(state.x, false);
+  const ExternalLoad f = p.loads.at(p.model, state.load_factor, state.x, false);
+  std::vector<bool> held(static_cast<std::size_t>(p.model.n_dofs()), false);
+  for (const PrescribedDof& d : p.prescriptions.at(state.load_factor)) held[static_cast<std::size_t>(d.dof)] = true;
+  VecX r = a.force - f.force;
+  for (Index d = 0; d < r.size(); ++d)
+    if (held[static_cast<std::size_t>(d)]) r(d) = 0.0;
+  out.static_residual = r.norm() / std::max(f.force.norm(), 1e-300);
+  return out;
+}
+
+// Below the limit point (half the limit pressure in 5 steps): with Abaqus' default
+// fraction the stabilised result is the static one to 1e-4 and it dissipates about
+// that fraction of the strain energy.
+TEST(Stabilisation, BelowTheLimitPointTheStabilisedArchIsTheStaticOne) {
+  const double p_max = arch_limit_pressure();
+  ASSERT_GT(p_max, 0.0);
+  const LoadTable table{{0.0, 1.0}, {0.0, 0.5 * p_max}};
+  const StepperRun plain = run_arch(table, 5, {});
+  StabiliseOptions st;
+  st.fraction = 2e-4;
+  const StepperRun stab = run_arch(table, 5, st);
+  ASSERT_EQ(plain.report.status, SteppingReport::Status::kFinished) << plain.report.message;
+  ASSERT_EQ(stab.report.status, SteppingReport::Status::kFinished) << stab.report.message;
+  ASSERT_EQ(stab.steps.info.size(), 5u);
+  const StepInfo& last = stab.steps.info.back();
+  EXPECT_TRUE(last.stabilised);
+  EXPECT_GT(last.damping, 0.0) << "c calibrated from step 1";
+  // The strain energy of the last state: 1/2 p.. measured through the model.
+  Problem p = arch_problem(table);
+  const double strain = p.model.assemble(stab.steps.x.back(), false).strain_energy;
+  const double ratio = last.stabilisation_energy / strain;
+  EXPECT_GT(ratio, 0.0);
+  EXPECT_LT(ratio, 2e-3) << "a few times the fraction over five steps";
+  EXPECT_NEAR(stab.crown, plain.crown, 1e-4 * plain.crown);
+  // The viscous force at the end of each step is what separates the two.
+  EXPECT_LT(stab.static_residual, 1e-3);
+  std::printf(
+      "stabilised arch below the limit: crown %.9f mm (static %.9f), c %.3g N s/mm^4, dissipated %.3g N mm = %.3g "
+      "of the strain energy, static residual %.2g\n",
+      stab.crown, plain.crown, last.damping, last.stabilisation_energy, ratio, stab.static_residual);
+}
+
+// Past the limit point: the pressure rises to 1.02 p_max in 10 steps and is then held
+// for 10. Load control alone fails at the limit; stabilised, the arch snaps onto its
+// inverted branch, and once the pressure is held the viscous force dies away: the crown
+// agrees with the arc-length path's inverted branch at that pressure.
+TEST(Stabilisation, StabilisedLoadControlSnapsTheArchOntoItsInvertedBranch) {
+  const double p_max = arch_limit_pressure();
+  ASSERT_GT(p_max, 0.0);
+  const double p = 1.02 * p_max;
+  const double w_ref = inverted_branch_deflection(p);
+  ASSERT_GT(w_ref, 0.0) << "the arc-length path reaches " << p << " MPa on the inverted branch";
+  const LoadTable table{{0.0, 0.5, 1.0}, {0.0, p, p}};
+  const StepperRun plain = run_arch(table, 20, {});
+  EXPECT_EQ(plain.report.status, SteppingReport::Status::kFailed) << "load control stops at the limit point";
+  StabiliseOptions st;
+  st.fraction = 2e-4;
+  const StepperRun stab = run_arch(table, 20, st);
+  ASSERT_EQ(stab.report.status, SteppingReport::Status::kFinished) << stab.report.message;
+  EXPECT_NEAR(stab.crown, w_ref, 0.01 * w_ref);
+  EXPECT_LT(stab.static_residual, 1e-4) << "held: the viscous force has died away";
+  // The snap released energy the stabilisation took: its ratio says so.
+  Problem pr = arch_problem(table);
+  const double strain = pr.model.assemble(stab.steps.x.back(), false).strain_energy;
+  const double ratio = stab.steps.info.back().stabilisation_energy / strain;
+  EXPECT_GT(ratio, 0.05) << "a snap is not quasi-static: the run should warn";
+  int cutbacks = 0;
+  for (const StepInfo& i : stab.steps.info) cutbacks += i.cutbacks;
+  std::printf(
+      "stabilised arch past the limit (%.5g MPa = 1.02 p_max): crown %.5f mm, arc-length inverted branch %.5f mm; "
+      "unstabilised: %s; %d Newton iterations, %d cut-backs; dissipated %.3g of the strain energy; static "
+      "residual %.2g\n",
+      p, stab.crown, w_ref, plain.report.step_failure.c_str(), stab.report.total_iterations, cutbacks, ratio,
+      stab.static_residual);
+}
+
+// The added tangent (c / dt) M* against central differences of the added force, its
+// symmetry, the dissipation F_v . dx, and M* as the volume for a rigid translation.
+TEST(Stabilisation, TangentForceAndDissipationAreConsistent) {
+  Tube t = make_arch();
+  const double c = 0.37, t0 = 0.1, t1 = 0.35;
+  ViscousStabilisation s(t.model, c);
+  const Index n = t.model.n_dofs();
+  const VecX X = t.model.reference_positions();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  VecX prev = X, x = X;
+  for (Index d = 0; d < n; ++d) {
+    prev(d) += u(rng);
+    x(d) += 10 * u(rng);
+  }
+  const InteractionContext ctx{t1, nullptr, &prev, t0};
+  auto force = [&](const VecX& at, linalg::TripletAssembler* k) {
+    InteractionSums sums;
+    sums.force = VecX::Zero(n);
+    sums.stiffness = k;
+    s.add_to(at, ctx, sums);
+    EXPECT_TRUE(sums.ok);
+    EXPECT_EQ(sums.energy, 0.0);
+    return sums.force;
+  };
+  linalg::TripletAssembler k(n, n);
+  const VecX f = force(x, &k);
+  const MatX K = MatX(k.compress());
+  // The force is c M* v with v = (x - prev) / dt.
+  EXPECT_LT((f - c * (s.mass() * (x - prev)) / (t1 - t0)).norm(), 1e-12 * f.norm());
+  MatX fd(n, n);
+  const double h = 1e-6;
+  for (Index j = 0; j < n; ++j) {
+    VecX xp = x, xm = x;
+    xp(j) += h;
+    xm(j) -= h;
+    fd.col(j) = (force(xp, nullptr) - force(xm, nullptr)) / (2 * h);
+  }
+  EXPECT_LT((K - fd).cwiseAbs().maxCoeff(), 1e-7 * K.cwiseAbs().maxCoeff());
+  EXPECT_LT((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-14 * K.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(f.dot(x - prev), s.dissipation(prev, x, t1 - t0), 1e-12 * f.dot(x - prev));
+  // Rigid translation along x: u^T M* u is the arch's volume (unit density).
+  VecX e = VecX::Zero(n);
+  for (Index node = 0; node < t.model.ply(0).n_nodes(); ++node) e(t.model.dof(0, node, 0, 0)) = 1.0;
+  const double volume = 0.4 * 10.025 * 0.05 * 0.1;  // span x mean radius x wall x depth, mm^3
+  EXPECT_NEAR(s.mass_norm(e), volume, 1e-6 * volume);
+  // Nothing without rates (the arc-length and dynamic solvers' contexts) or with c = 0.
+  InteractionSums none;
+  none.force = VecX::Zero(n);
+  s.add_to(x, InteractionContext{}, none);
+  EXPECT_EQ(none.force.norm(), 0.0);
+  ViscousStabilisation off(t.model);
+  off.add_to(x, ctx, none);
+  EXPECT_EQ(none.force.norm(), 0.0);
+  EXPECT_THROW(s.set_damping(-1.0), InputError);
+  StabiliseOptions both;
+  both.fraction = 2e-4;
+  both.damping = 1.0;
+  EXPECT_THROW(both.validate(), InputError);
 }
 
 TEST(ArcLength, BadOptionsAreInputErrors) {

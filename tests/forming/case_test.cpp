@@ -273,6 +273,55 @@ TEST_P(FormingCaseUniaxial, SmallStrainReactionIsYoungsModulusTimesArea) {
 
 INSTANTIATE_TEST_SUITE_P(Fibres, FormingCaseUniaxial, ::testing::Values(0.0, 90.0));
 
+// solver stabilise on a stable run (the 90 degree stretch, whose lateral contraction is
+// free): the outputs carry the dissipated energy and its ratio, and the reaction is the
+// unstabilised one to well within the ratio.
+TEST(FormingCase, StabilisedStableRunMatchesTheStaticOneAndReportsItsEnergy) {
+  const FormingCase plain_spec = parse_ok(uniaxial_case(90.0, 10.0));
+  const FormingCase spec = parse_ok(uniaxial_case(90.0, 10.0, ", stabilise: {fraction: 2.0e-4}"));
+  EXPECT_EQ(spec.solver.stabilise_fraction, 2e-4);
+  const RunOutput plain = run_in(plain_spec, "stabilise_off");
+  const RunOutput out = run_in(spec, "stabilise_on");
+  ASSERT_TRUE(out.report.ok()) << out.report.message;
+  ASSERT_TRUE(plain.report.ok()) << plain.report.message;
+  const double fx = last(out.history, "tool_fx"), fx0 = last(plain.history, "tool_fx");
+  EXPECT_NEAR(fx, fx0, 1e-4 * std::abs(fx0));
+  EXPECT_FALSE(plain.summary.contains("stabilisation"));
+  EXPECT_FALSE(plain.history.has_column("stabilisation_energy"));
+  const double energy = last(out.history, "stabilisation_energy"), ratio = last(out.history, "stabilisation_ratio");
+  EXPECT_GT(energy, 0.0);
+  EXPECT_NEAR(ratio, energy / last(out.history, "strain_energy"), 1e-12);
+  EXPECT_LT(ratio, 1e-3);
+  const nlohmann::json& st = out.summary["stabilisation"];
+  EXPECT_GT(st["damping"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(st["energy"].get<double>(), energy);
+  EXPECT_TRUE(st["quasi_static"].get<bool>());
+  EXPECT_DOUBLE_EQ(out.summary["parameters"]["solver"]["stabilise"]["fraction"].get<double>(), 2e-4);
+  std::printf("stabilised uniaxial (90 deg, 10 %%): fx %.10g N (static %.10g), c %.3g, ratio %.3g\n", fx, fx0,
+              st["damping"].get<double>(), ratio);
+}
+
+TEST(FormingCase, StabiliseKeyErrorsNameTheField) {
+  const auto problems = [](const std::string& extra, const std::string& analysis = "") {
+    std::string text = uniaxial_case(0.0, 1.0, extra + analysis);
+    std::vector<std::string> all;
+    const CaseCheck c = check_case_text(text, "stab.yaml");
+    for (std::size_t i = 0; i < c.problems.size(); ++i) all.push_back(c.located(i));
+    return all;
+  };
+  using ::testing::ElementsAre;
+  using ::testing::HasSubstr;
+  EXPECT_THAT(problems(", stabilise: {fraction: 2.0e-4, damping: 1}"), ElementsAre(HasSubstr("not both")));
+  EXPECT_THAT(problems(", stabilise: {}"), ElementsAre(HasSubstr("give fraction")));
+  EXPECT_THAT(problems(", stabilise: {fraction: 2}"), ElementsAre(HasSubstr("stabilise fraction: expected")));
+  EXPECT_THAT(problems(", stabilise: {damping: -1}"), ElementsAre(HasSubstr("N s/mm^4")));
+  EXPECT_THAT(problems(", stabilise: {fraction: 1e-4, ratio: 1}"), ElementsAre(HasSubstr("unknown key 'ratio'")));
+  EXPECT_THAT(problems(", stabilise: 2e-4"), ElementsAre(HasSubstr("expected a mapping")));
+  EXPECT_THAT(problems(", stabilise: {damping: 0.1}", ", analysis: dynamic"),
+              ::testing::Contains(HasSubstr("stabilise: load control only")));
+  EXPECT_TRUE(problems(", stabilise: {damping: 0.1, warn_ratio: 0.02}").empty());
+}
+
 TEST(FormingCase, RunThatCannotConvergeLeavesPartialResult) {
   // One Newton iteration per attempt and no cut-back room: the first step fails.
   const FormingCase spec = parse_ok(uniaxial_case(0.0, 1.0, ", max_iterations: 1, min_increment: 1"));

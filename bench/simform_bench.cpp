@@ -49,6 +49,7 @@
 #include <omp.h>
 
 #include "common/core/memory.hpp"
+#include "common/core/parallel.hpp"
 #include "common/linalg/dense_kernels.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/mesh/surface_mesh.hpp"
@@ -292,9 +293,10 @@ int main(int argc, char** argv) {
         "MPa), fibres 0/90/0/90; plies are independent bodies (no contact yet)\n",
         kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
     std::printf(
-        "# element loop on %d threads (OpenMP), kernel vector instructions: %s (processor's best: %s); "
-        "linear solver: CHOLMOD supernodal Cholesky, LDL^T when indefinite\n# BLAS: %s\n",
-        omp_get_max_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
+        "# element loop on %d threads (OpenMP; SF_THREADS), kernel vector instructions: %s (processor's best: %s); "
+        "linear solver: CHOLMOD supernodal Cholesky, MUMPS LDL^T when indefinite (UMFPACK LU without MUMPS)\n"
+        "# BLAS: %s\n",
+        sf::default_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
         linalg::to_string(linalg::best_kernel_isa()).c_str(), linalg::blas_description().c_str());
     std::printf(
         "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",

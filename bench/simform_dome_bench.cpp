@@ -35,8 +35,11 @@
 //   --factor-only no run: the tangent of the flat start (contact pattern included: the
 //                 plies touch and the die and holder touch the stack) factorised by each
 //                 direct solver and ordering, printing nnz, fill, flops and seconds (the
-//                 numeric factorisation is repeated with the analysis kept)
-#include <omp.h>
+//                 numeric factorisation is repeated with the analysis kept, timed in processor
+//                 seconds of all threads) and one solve of a random right-hand side
+//                 (|Kx-b|/|b|; neg: negative pivots of MUMPS's LDL^T, the tangent's inertia)
+//   --solvers K,K with --factor-only: only these kinds (umfpack, cholmod, cholmod-ldlt, mumps,
+//                 mumps-ldlt); --ordering O: only that ordering
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -47,10 +50,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <thread>
 
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
 #include "common/io/csv.hpp"
 #include "common/core/memory.hpp"
 #include "common/linalg/krylov.hpp"
@@ -192,7 +197,7 @@ static void compare_iterative(const Model& model, linalg::PatternAssembler& pa, 
 }
 
 // --factor-only: the start tangent through each solver and ordering.
-static int factor_only(const FormingCase& spec, bool iterative) {
+static int factor_only(const FormingCase& spec, bool iterative, const std::string& solvers) {
   const Problem problem = build_problem(spec);
   const Model& model = problem.model;
   const VecX x = model.reference_positions();
@@ -223,8 +228,9 @@ static int factor_only(const FormingCase& spec, bool iterative) {
     compare_iterative(model, lower, false);
     return 0;
   }
-  std::printf("%-20s %-8s %-30s %12s %7s %9s %10s %10s %10s %s\n", "solver", "ordering", "ordering used", "nnz(factor)",
-              "fill", "Gflop", "analyse_s", "factor_s", "factor_cpu", "status");
+  std::printf("%-12s %-8s %-30s %12s %7s %9s %10s %10s %10s %10s %9s %6s %s\n", "solver", "ordering", "ordering used",
+              "nnz(factor)", "fill", "Gflop", "analyse_s", "factor_s", "factor_cpu", "solve_cpu", "|Kx-b|/|b|", "neg",
+              "status");
   using linalg::Ordering;
   using linalg::SolverKind;
   struct Trial {
@@ -236,13 +242,23 @@ static int factor_only(const FormingCase& spec, bool iterative) {
       {SolverKind::kUmfpack, linalg::MatrixProperty::kUnsymmetric, false},
       {SolverKind::kCholmod, linalg::MatrixProperty::kSymmetricPositiveDefinite, true},
       {SolverKind::kCholmodLdlt, linalg::MatrixProperty::kSymmetricIndefinite, true},
+      {SolverKind::kMumps, linalg::MatrixProperty::kUnsymmetric, false},
+      {SolverKind::kMumpsLdlt, linalg::MatrixProperty::kSymmetricIndefinite, true},
   };
-  for (const Trial& t : trials)
+  const Eigen::VectorXd b = fixed_random(full.n_active());
+  for (const Trial& t : trials) {
+    if (!linalg::solver_available(t.kind)) {
+      std::printf("%-12s not in this build\n", linalg::to_string(t.kind).c_str());
+      continue;
+    }
+    if (!solvers.empty() && solvers.find("," + linalg::to_string(t.kind) + ",") == std::string::npos) continue;
     for (Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis}) {
-      if (t.kind == SolverKind::kUmfpack && o == Ordering::kNesdis) continue;  // METIS stands in for it
+      if (TangentSolver::default_ordering() != Ordering::kDefault && o != TangentSolver::default_ordering()) continue;
+      const bool cholmod = t.kind == SolverKind::kCholmod || t.kind == SolverKind::kCholmodLdlt;
+      if (!cholmod && o == Ordering::kNesdis) continue;  // METIS stands in for it
       if (t.kind == SolverKind::kCholmodLdlt && full.n_active() > 20000) {
         // Simplicial (no BLAS): 6-10 processor seconds a factorisation at 10.6k unknowns.
-        std::printf("%-20s %-8s skipped above 20000 unknowns (simplicial: minutes)\n", "cholmod-ldlt",
+        std::printf("%-12s %-8s skipped above 20000 unknowns (simplicial: minutes)\n", "cholmod-ldlt",
                     linalg::to_string(o).c_str());
         continue;
       }
@@ -250,15 +266,24 @@ static int factor_only(const FormingCase& spec, bool iterative) {
       solver.set_ordering(o);
       const linalg::SparseMatrix& k = t.use_lower ? lower.matrix() : full.matrix();
       const linalg::SolveReport first = solver.factorize(k);
-      const double c0 = thread_cpu_seconds();
+      const double c0 = cpu_seconds();
       const linalg::SolveReport& r = solver.factorize(k);  // the analysis kept: a Newton iteration's cost
-      const double cpu = thread_cpu_seconds() - c0;
-      std::printf("%-20s %-8s %-30s %12.4g %7.1f %9.3f %10.3f %10.3f %10.3f %s\n", linalg::to_string(t.kind).c_str(),
-                  linalg::to_string(o).c_str(), first.ordering.c_str(), r.factor_nonzeros,
-                  r.factor_nonzeros / static_cast<double>(k.nonZeros()), r.factor_flops * 1e-9, first.analyze_seconds,
-                  r.factor_seconds, cpu, r.ok() ? "ok" : linalg::to_string(r.status).c_str());
+      const double cpu = cpu_seconds() - c0;
+      double residual = std::numeric_limits<double>::quiet_NaN(), solve_cpu = 0.0;
+      if (r.ok()) {
+        const double c1 = cpu_seconds();
+        const Eigen::MatrixXd sol = solver.solve(b);
+        solve_cpu = cpu_seconds() - c1;
+        residual = solver.residual(b, sol).norm() / b.norm();
+      }
+      std::printf("%-12s %-8s %-30s %12.4g %7.1f %9.3f %10.3f %10.3f %10.3f %10.3f %9.2g %6d %s\n",
+                  linalg::to_string(t.kind).c_str(), linalg::to_string(o).c_str(), first.ordering.c_str(),
+                  r.factor_nonzeros, r.factor_nonzeros / static_cast<double>(k.nonZeros()), r.factor_flops * 1e-9,
+                  first.analyze_seconds, r.factor_seconds, cpu, solve_cpu, residual, r.negative_pivots,
+                  r.ok() ? "ok" : (linalg::to_string(r.status) + ": " + r.message).c_str());
       std::fflush(stdout);
     }
+  }
   return 0;
 }
 
@@ -273,6 +298,7 @@ int main(int argc, char** argv) {
   bool only_factor = false;
   bool iterative = false;
   std::string linear;
+  std::string solvers;  // --solvers: ",kind,kind," (empty: all)
   double time_limit = 0.0;
   double stabilise = 0.0;
   for (int i = 1; i < argc; ++i) {
@@ -307,6 +333,8 @@ int main(int argc, char** argv) {
       iterative = true;
     } else if (a == "--no-band-pattern") {
       Model::set_band_pattern(false);
+    } else if (a == "--solvers" && i + 1 < argc) {
+      solvers = std::string(",") + argv[++i] + ",";
     } else if (a == "--linear" && i + 1 < argc) {
       linear = argv[++i];
     } else if (a == "--case" && i + 1 < argc) {
@@ -320,8 +348,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
-                   "[--factor-only | --iterative] [--linear direct|iterative|iterative-ply|auto] [--no-band-pattern] "
-                   "[--time-limit S] [--stabilise FRACTION]\n");
+                   "[--factor-only [--solvers K,K] | --iterative] [--linear direct|iterative|iterative-ply|auto] "
+                   "[--no-band-pattern] [--time-limit S] [--stabilise FRACTION]\n");
       return 2;
     }
   }
@@ -345,8 +373,8 @@ int main(int argc, char** argv) {
                 quick ? " (--quick: at most 4 x 4 bricks a ply)" : "", spec.plies.size(), elements,
                 spec.contacts.size(), spec.solver.steps,
                 max_steps > 0 ? (", stopping after " + std::to_string(max_steps)).c_str() : "");
-    std::printf("threads: %d for the element loop (OpenMP), factorisation BLAS: %s; freed memory %s\n",
-                omp_get_max_threads(), linalg::blas_description().c_str(),
+    std::printf("threads: %d for the element loop (OpenMP; SF_THREADS), factorisation BLAS: %s; freed memory %s\n",
+                sf::default_threads(), linalg::blas_description().c_str(),
                 kept ? "kept for reuse (mallopt)" : "returned to the system (malloc tuned by the environment)");
     std::fflush(stdout);
     if (!linear.empty()) spec.solver.linear = to_string(parse_linear_mode(linear, "--linear"));
@@ -354,7 +382,7 @@ int main(int argc, char** argv) {
       spec.solver.stabilise_fraction = stabilise;
       spec.solver.stabilise_damping = 0.0;
     }
-    if (only_factor) return factor_only(spec, iterative);
+    if (only_factor) return factor_only(spec, iterative, solvers);
     // One folder per process: runs side by side (sizes, orderings) do not collide.
     const std::filesystem::path dir =
         std::filesystem::temp_directory_path() / ("sf_simform_dome_bench_" + std::to_string(getpid()));

@@ -31,6 +31,25 @@ else()
   target_link_libraries(sf_suitesparse INTERFACE ${SF_CHOLMOD_LIBRARY} ${SF_UMFPACK_LIBRARY})
 endif()
 
+# MUMPS, sequential build (Debian's libmumps-seq-dev; no MPI): the symmetric-indefinite
+# LDL^T with pivoting that factorises a Newton tangent Cholesky cannot (common/linalg/solver.hpp,
+# forming/solve/tangent_solver.hpp). Optional: without it such tangents go to UMFPACK's LU.
+find_path(SF_MUMPS_INCLUDE_DIR dmumps_c.h)
+find_library(SF_DMUMPS_LIBRARY dmumps_seq)
+find_library(SF_MUMPS_COMMON_LIBRARY mumps_common_seq)
+find_library(SF_MUMPS_MPISEQ_LIBRARY mpiseq_seq)
+add_library(sf_mumps INTERFACE)
+if(SF_MUMPS_INCLUDE_DIR AND SF_DMUMPS_LIBRARY AND SF_MUMPS_COMMON_LIBRARY AND SF_MUMPS_MPISEQ_LIBRARY)
+  target_include_directories(sf_mumps SYSTEM INTERFACE ${SF_MUMPS_INCLUDE_DIR})
+  target_link_libraries(sf_mumps INTERFACE ${SF_DMUMPS_LIBRARY} ${SF_MUMPS_COMMON_LIBRARY} ${SF_MUMPS_MPISEQ_LIBRARY})
+  target_compile_definitions(sf_mumps INTERFACE SF_LINALG_HAVE_MUMPS=1)
+  message(STATUS "MUMPS (sequential): ${SF_DMUMPS_LIBRARY}")
+else()
+  message(WARNING "MUMPS (sequential) not found: install Debian's libmumps-seq-dev (scripts/install_deps.sh). "
+                  "Building without it: the solver kinds 'mumps' and 'mumps-ldlt' are unavailable and a "
+                  "symmetric Newton tangent that is not positive definite is factorised by UMFPACK's LU.")
+endif()
+
 find_package(Threads REQUIRED)
 # OpenMP (GCC's libgomp): the threaded element loop of simform's assembly.
 find_package(OpenMP REQUIRED COMPONENTS CXX)

@@ -10,6 +10,7 @@ packages=(
   libyaml-cpp-dev libfmt-dev xvfb xauth
   pybind11-dev python3-dev python3-numpy  # the Python module `sheetform` (python/, docs/python.md)
   dpkg-dev file  # cpack -G DEB: dpkg-shlibdeps finds the runtime packages of the .deb (docs/install.md)
+  libmumps-seq-dev  # MUMPS 5.5 (sequential): symmetric-indefinite LDL^T of Newton tangents (common/linalg/solver.hpp)
   libopenblas0-serial  # optimised BLAS under CHOLMOD (reference BLAS is ~10x slower; serial: no spinning threads)
   libjs-three  # three.js r111, inlined into gsa's 3-D view (report.html, gsa view; gsa/view3d.hpp)
   chromium  # headless browser for the 3-D view's tests (tests/gsa/view3d_browser.py; skipped without it)

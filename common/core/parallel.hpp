@@ -23,18 +23,31 @@ inline std::atomic<int>& thread_setting() {
 }
 }  // namespace detail
 
-// Threads a parallel loop uses by default: set_default_threads(n) when called with n >= 1
-// (e.g. from a command-line option), else the environment variable SF_THREADS when it is a
-// whole number >= 1, else one per core. Results never depend on it (see above): 1 and 2
-// threads give the same numbers to the last bit (tests: gsa.analysis.thread_count_*).
+// Threads of both tools by default, the one setting: set_default_threads(n) when called
+// with n >= 1 (e.g. from a command-line option), else the environment variable SF_THREADS
+// when it is a whole number >= 1, else OMP_NUM_THREADS likewise (its first entry, as OpenMP
+// reads it), else one per core. gsa's parallel loops (below), simform's element loop
+// (forming::Model::threads, OpenMP) and the threads of one factorisation under a threaded
+// BLAS (linalg::factorisation_threads) all start from it. Results never depend on it (see
+// above): 1 and 2 threads give the same numbers to the last bit (tests:
+// gsa.analysis.thread_count_*, the forming element loop's colouring).
 inline void set_default_threads(int threads) { detail::thread_setting().store(threads > 0 ? threads : 0); }
+namespace detail {
+// The leading whole number of an environment variable if it is one in [1, 1024], else 0.
+inline int threads_from_env(const char* name, bool leading_only) {
+  const char* env = std::getenv(name);
+  if (env == nullptr) return 0;
+  char* end = nullptr;
+  const long v = std::strtol(env, &end, 10);
+  if (end == env || !(v >= 1 && v <= 1024)) return 0;
+  if (*end != '\0' && !(leading_only && *end == ',')) return 0;
+  return static_cast<int>(v);
+}
+}  // namespace detail
 inline int default_threads() {
   if (const int set = detail::thread_setting().load(); set > 0) return set;
-  if (const char* env = std::getenv("SF_THREADS")) {
-    char* end = nullptr;
-    const long v = std::strtol(env, &end, 10);
-    if (end != env && *end == '\0' && v >= 1 && v <= 1024) return static_cast<int>(v);
-  }
+  if (const int sf = detail::threads_from_env("SF_THREADS", false); sf > 0) return sf;
+  if (const int omp = detail::threads_from_env("OMP_NUM_THREADS", true); omp > 0) return omp;
   return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 

@@ -16,8 +16,11 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
+#include "common/linalg/krylov.hpp"
 
 // SuiteSparse is linked privately into sf_common; without it the kAuto choice
 // falls back to Eigen's own solvers.
@@ -27,6 +30,15 @@
 #include <Eigen/UmfPackSupport>
 #else
 #define SF_LINALG_HAVE_SUITESPARSE 0
+#endif
+
+// MUMPS (Debian's libmumps-seq-dev, the sequential build): defined by CMake when found
+// (cmake/SfDependencies.cmake); without it the kMumps kinds are not available.
+#ifndef SF_LINALG_HAVE_MUMPS
+#define SF_LINALG_HAVE_MUMPS 0
+#endif
+#if SF_LINALG_HAVE_MUMPS
+#include <dmumps_c.h>
 #endif
 
 namespace sf::linalg {
@@ -47,6 +59,8 @@ constexpr NamedKind kSolverNames[] = {
     {SolverKind::kEigenLDLT, "eigen-ldlt"},
     {SolverKind::kEigenLU, "eigen-lu"},
     {SolverKind::kCholmodLdlt, "cholmod-ldlt"},
+    {SolverKind::kMumps, "mumps"},
+    {SolverKind::kMumpsLdlt, "mumps-ldlt"},
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -79,6 +93,8 @@ class Backend {
   virtual void set_ordering(Ordering) {}
   // Iterative refinement of solves (back ends that do it: UMFPACK, 2 steps by default).
   virtual void set_refinement(bool) {}
+  // Negative pivots of the last symmetric indefinite factorisation (-1: not known).
+  virtual int negative_pivots() const { return -1; }
 };
 
 // OpenBLAS's thread control, looked up at run time (any BLAS may be installed as
@@ -273,7 +289,10 @@ class UmfpackBackend final : public Backend {
   std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
-    lu_.factorize(a);
+    {
+      const BlasSection blas;  // UMFPACK's frontal matrices are BLAS calls
+      lu_.factorize(a);
+    }
     const int code = lu_.umfpackFactorizeReturncode();
     // Determinant under/overflow warnings do not affect the factors.
     if (code == UMFPACK_OK || code == UMFPACK_WARNING_determinant_underflow ||
@@ -288,6 +307,7 @@ class UmfpackBackend final : public Backend {
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    const BlasSection blas;
     x = lu_.solve(b);
     return lu_.info() == Eigen::Success;
   }
@@ -298,6 +318,166 @@ class UmfpackBackend final : public Backend {
 };
 
 #endif  // SF_LINALG_HAVE_SUITESPARSE
+
+#if SF_LINALG_HAVE_MUMPS
+
+// MUMPS's multifrontal factorisation, sequential build (no MPI: its stub library stands in).
+//   symmetric (kMumpsLdlt): SYM = 2, A = P L D L^T P^T with threshold pivoting (1x1 and 2x2
+//     pivots), so a symmetric indefinite matrix needs no LU; reads the lower triangle.
+//   unsymmetric (kMumps):   SYM = 0, LU with threshold partial pivoting.
+// The analysis (ordering, elimination tree) is kept while the pattern stays; each
+// factorisation passes the values only. Every call runs inside a BlasSection: MUMPS's dense
+// kernels are BLAS calls, like CHOLMOD's supernodal ones.
+class MumpsBackend final : public Backend {
+ public:
+  explicit MumpsBackend(bool symmetric) : symmetric_(symmetric), id_(std::make_unique<DMUMPS_STRUC_C>()) {
+    *id_ = DMUMPS_STRUC_C{};
+    id_->comm_fortran = kUseCommWorld;
+    id_->par = 1;  // the host works (the only process)
+    id_->sym = symmetric_ ? 2 : 0;
+    call(-1);
+    initialised_ = id_->infog[0] >= 0;
+    if (!initialised_) return;
+    icntl(1) = -1;  // no error, diagnostic, global or statistics output
+    icntl(2) = -1;
+    icntl(3) = -1;
+    icntl(4) = 0;
+  }
+  ~MumpsBackend() override {
+    if (initialised_) call(-2);
+  }
+  MumpsBackend(const MumpsBackend&) = delete;
+  MumpsBackend& operator=(const MumpsBackend&) = delete;
+
+  // kDefault: MUMPS's own choice (ICNTL(7) = 7; Debian's build has SCOTCH and PORD but
+  // not METIS, and picks AMF at the dome's sizes); kAmd: AMD; kMetis and kNesdis: SCOTCH's
+  // nested dissection (the nested dissection Debian's MUMPS has).
+  void set_ordering(Ordering ordering) override {
+    ordering_choice_ = ordering == Ordering::kAmd ? 0 : ordering == Ordering::kDefault ? 7 : 3;
+  }
+
+  Outcome analyze(const SparseMatrix& a) override {
+    if (!initialised_) return {Status::kFailed, "MUMPS initialisation failed"};
+    const int n = static_cast<int>(a.rows());
+    rows_.clear();
+    cols_.clear();
+    take_.clear();
+    rows_.reserve(static_cast<std::size_t>(a.nonZeros()));
+    cols_.reserve(static_cast<std::size_t>(a.nonZeros()));
+    bool all = true;
+    for (int j = 0; j < n; ++j)
+      for (int p = a.outerIndexPtr()[j]; p < a.outerIndexPtr()[j + 1]; ++p) {
+        const int i = a.innerIndexPtr()[p];
+        if (symmetric_ && i < j) {  // the upper triangle: the lower one holds it
+          all = false;
+          continue;
+        }
+        rows_.push_back(i + 1);
+        cols_.push_back(j + 1);
+        take_.push_back(p);
+      }
+    if (all) take_.clear();  // every entry, in order: pass the matrix's own values
+    id_->n = n;
+    id_->nnz = static_cast<MUMPS_INT8>(rows_.size());
+    id_->irn = rows_.data();
+    id_->jcn = cols_.data();
+    id_->a = nullptr;
+    icntl(7) = ordering_choice_;
+    icntl(14) = kWorkspacePercent;
+    call(1);
+    if (id_->infog[0] < 0) return failure("symbolic analysis");
+    const int used = infog(7);
+    ordering_ = used == 0   ? "amd"
+                : used == 2 ? "amf"
+                : used == 3 ? "scotch"
+                : used == 4 ? "pord"
+                : used == 5 ? "metis"
+                : used == 6 ? "qamd"
+                            : "other";
+    flops_ = rinfog(1);  // the analysis's estimate; the factorisation's count replaces it
+    entries_ = static_cast<double>(infog(20));
+    return {};
+  }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    if (take_.empty()) {
+      id_->a = const_cast<double*>(a.valuePtr());  // MUMPS reads A, never writes it
+    } else {
+      values_.resize(take_.size());
+      for (std::size_t k = 0; k < take_.size(); ++k) values_[k] = a.valuePtr()[take_[k]];
+      id_->a = values_.data();
+    }
+    icntl(14) = kWorkspacePercent;
+    for (int attempt = 0;; ++attempt) {
+      call(2);
+      const int code = id_->infog[0];
+      // -8, -9: the workspace estimated by the analysis was too small (pivoting delayed
+      // more than it foresaw): more and again.
+      if ((code == -8 || code == -9) && attempt < 4) {
+        icntl(14) *= 2;
+        continue;
+      }
+      break;
+    }
+    if (id_->infog[0] == -10)
+      return {Status::kSingular, "matrix is singular: MUMPS found it numerically singular (INFOG(1) = -10)"};
+    if (id_->infog[0] < 0) return failure("numeric factorisation");
+    flops_ = rinfog(3);
+    const int e = infog(29);  // negative: millions
+    entries_ = e >= 0 ? static_cast<double>(e) : -1e6 * static_cast<double>(e);
+    negative_pivots_ = symmetric_ ? infog(12) : -1;
+    return {};
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    x = b;  // MUMPS overwrites the right-hand sides with the solutions
+    id_->rhs = x.data();
+    id_->nrhs = static_cast<int>(x.cols());
+    id_->lrhs = static_cast<int>(x.rows());
+    call(3);
+    id_->rhs = nullptr;
+    return id_->infog[0] >= 0;
+  }
+
+  double factor_flops() const override { return flops_; }
+  double factor_nonzeros() const override { return entries_; }
+  std::string ordering_used() const override { return ordering_; }
+  int negative_pivots() const override { return negative_pivots_; }
+
+ private:
+  static constexpr int kUseCommWorld = -987654;  // MUMPS's code for MPI_COMM_WORLD
+  static constexpr int kWorkspacePercent = 30;   // ICNTL(14): extra workspace for delayed pivots
+
+  MUMPS_INT& icntl(int i) { return id_->icntl[i - 1]; }
+  int infog(int i) const { return id_->infog[i - 1]; }
+  double rinfog(int i) const { return id_->rinfog[i - 1]; }
+  void call(int job) const {
+    const BlasSection blas;
+    id_->job = job;
+    dmumps_c(id_.get());
+  }
+  Outcome failure(const char* what) const {
+    const int code = infog(1);
+    return {Status::kFailed, fmt::format("MUMPS {} failed (INFOG(1) = {}, INFOG(2) = {}{})", what, code, infog(2),
+                                         code == -13  ? ": out of memory"
+                                         : code == -6 ? ": structurally singular"
+                                                      : "")};
+  }
+
+  bool symmetric_ = false;
+  bool initialised_ = false;
+  std::unique_ptr<DMUMPS_STRUC_C> id_;  // MUMPS's state (large); solve() changes only its rhs fields
+  std::vector<MUMPS_INT> rows_, cols_;  // 1-based coordinates of the entries passed
+  std::vector<int> take_;               // their positions in A's values (empty: all, in order)
+  std::vector<double> values_;
+  int ordering_choice_ = 7;
+  std::string ordering_;
+  double flops_ = 0.0;
+  double entries_ = 0.0;
+  int negative_pivots_ = -1;
+};
+
+#endif  // SF_LINALG_HAVE_MUMPS
 
 class EigenLdltBackend final : public Backend {
  public:
@@ -376,6 +556,12 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif
+#if SF_LINALG_HAVE_MUMPS
+    case SolverKind::kMumps:
+      return std::make_unique<MumpsBackend>(false);
+    case SolverKind::kMumpsLdlt:
+      return std::make_unique<MumpsBackend>(true);
+#endif
     case SolverKind::kEigenLDLT:
       return std::make_unique<EigenLdltBackend>();
     case SolverKind::kEigenLU:
@@ -429,6 +615,9 @@ bool solver_available(SolverKind kind) {
     case SolverKind::kCholmodLdlt:
     case SolverKind::kUmfpack:
       return SF_LINALG_HAVE_SUITESPARSE != 0;
+    case SolverKind::kMumps:
+    case SolverKind::kMumpsLdlt:
+      return SF_LINALG_HAVE_MUMPS != 0;
     default:
       return true;
   }
@@ -439,6 +628,7 @@ bool reads_lower_triangle(SolverKind kind) {
     case SolverKind::kCholmod:
     case SolverKind::kCholmodSimplicial:
     case SolverKind::kCholmodLdlt:
+    case SolverKind::kMumpsLdlt:
     case SolverKind::kEigenLDLT:
       return true;
     default:
@@ -477,12 +667,7 @@ void set_factorisation_threads(int threads) {
 int factorisation_threads() {
   const int n = g_factor_threads.load();
   if (n > 0) return n;
-  // As OpenMP counts them: OMP_NUM_THREADS when set (its first entry), else the cores.
-  if (const char* env = std::getenv("OMP_NUM_THREADS")) {
-    const int k = std::atoi(env);
-    if (k > 0) return k;
-  }
-  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return default_threads();  // SF_THREADS, else OMP_NUM_THREADS, else the cores
 }
 
 std::string blas_description() {
@@ -580,10 +765,10 @@ LinearSolver::LinearSolver(SolverKind kind, MatrixProperty property) : impl_(std
                     to_string(kind)));
   }
   if (!solver_available(kind)) {
-    throw InputError(
-        fmt::format("linear solver '{}' is not available: this build has no SuiteSparse "
-                    "(use 'eigen-ldlt', 'eigen-lu' or 'auto')",
-                    to_string(kind)));
+    const bool mumps = kind == SolverKind::kMumps || kind == SolverKind::kMumpsLdlt;
+    throw InputError(fmt::format("linear solver '{}' is not available: this build has no {} (use {})", to_string(kind),
+                                 mumps ? "MUMPS (Debian's libmumps-seq-dev; scripts/install_deps.sh)" : "SuiteSparse",
+                                 mumps ? "'umfpack', 'cholmod-ldlt' or 'auto'" : "'eigen-ldlt', 'eigen-lu' or 'auto'"));
   }
   impl_->kind = kind == SolverKind::kAuto ? resolve_auto(property) : kind;
   impl_->property = property;
@@ -662,6 +847,7 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   im.report.factor_flops = im.backend->factor_flops();
   im.report.factor_nonzeros = im.backend->factor_nonzeros();
   im.report.ordering = im.backend->ordering_used();
+  im.report.negative_pivots = im.backend->negative_pivots();
   im.report.status = outcome.status;
   im.report.message = std::move(outcome.message);
   return im.report;
@@ -688,6 +874,33 @@ Eigen::MatrixXd LinearSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) 
     return nan_matrix(im.matrix.rows(), b.cols());
   }
   return x;
+}
+
+Eigen::MatrixXd LinearSolver::residual(const Eigen::Ref<const Eigen::MatrixXd>& b,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& x) const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  const Impl& im = *impl_;
+  SF_ASSERT(b.rows() == im.matrix.rows() && x.rows() == b.rows() && x.cols() == b.cols(), "residual: wrong sizes");
+  const bool lower = reads_lower_triangle(im.kind);
+  // A back end that reads the lower triangle may have been given both: read only that one.
+  bool upper = false;
+  if (lower)
+    for (Eigen::Index j = 0; j < im.matrix.outerSize() && !upper; ++j)
+      for (SparseMatrix::InnerIterator it(im.matrix, j); it && !upper; ++it) upper = it.row() < it.col();
+  const SparseMatrix lower_copy = upper ? SparseMatrix(im.matrix.triangularView<Eigen::Lower>()) : SparseMatrix();
+  const SparseMatrix& a = upper ? lower_copy : im.matrix;
+  Eigen::MatrixXd r(b.rows(), b.cols());
+  Eigen::VectorXd ax(b.rows());
+  for (Eigen::Index c = 0; c < b.cols(); ++c) {
+    multiply(a, lower ? Storage::kLower : Storage::kFull, x.col(c), ax);
+    r.col(c) = b.col(c) - ax;
+  }
+  return r;
+}
+
+const SparseMatrix& LinearSolver::matrix() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->matrix;
 }
 
 const SolveReport& LinearSolver::last_report() const {

@@ -9,6 +9,11 @@
 //   kUmfpack    UMFPACK LU with partial pivoting. Any square nonsingular A.
 //   kCholmodLdlt CHOLMOD simplicial A = L D L^T (no pivoting): symmetric, definite or
 //               not, as long as no pivot vanishes; reads the lower triangle of A.
+//   kMumps      MUMPS multifrontal LU with threshold partial pivoting (SYM = 0). Any square
+//               nonsingular A. Needs MUMPS (Debian's libmumps-seq-dev) in the build.
+//   kMumpsLdlt  MUMPS multifrontal A = P L D L^T P^T with threshold pivoting (1x1 and 2x2
+//               pivots; SYM = 2): symmetric, definite or indefinite, singular only when A
+//               is; reads the lower triangle of A. Needs MUMPS.
 //   kEigenLDLT  Eigen SimplicialLDLT, A = P^T L D L^T P without pivoting.
 //               Symmetric only; reads the lower triangle of A.
 //   kEigenLU    Eigen SparseLU (COLAMD ordering). Any square nonsingular A.
@@ -42,9 +47,20 @@ namespace sf::linalg {
 // kCholmod: CHOLMOD's supernodal Cholesky (dense blocks through BLAS);
 // kCholmodSimplicial: its column-by-column Cholesky, which calls no BLAS and so
 // can run on several threads at once (one solver per thread).
-enum class SolverKind { kAuto, kCholmod, kCholmodSimplicial, kUmfpack, kEigenLDLT, kEigenLU, kCholmodLdlt };
+enum class SolverKind {
+  kAuto,
+  kCholmod,
+  kCholmodSimplicial,
+  kUmfpack,
+  kEigenLDLT,
+  kEigenLU,
+  kCholmodLdlt,
+  kMumps,
+  kMumpsLdlt
+};
 
-// "auto", "cholmod", "cholmod-simplicial", "umfpack", "eigen-ldlt", "eigen-lu", "cholmod-ldlt".
+// "auto", "cholmod", "cholmod-simplicial", "umfpack", "eigen-ldlt", "eigen-lu", "cholmod-ldlt",
+// "mumps", "mumps-ldlt".
 std::string to_string(SolverKind kind);
 
 // Inverse of to_string(SolverKind) (exact, lower case). Throws sf::InputError
@@ -53,18 +69,20 @@ std::string to_string(SolverKind kind);
 SolverKind parse_solver_kind(const std::string& name, const std::string& where = "");
 
 // True when the back end is compiled in (kAuto, kEigenLDLT and kEigenLU
-// always are; kCholmod and kUmfpack need SuiteSparse).
+// always are; the CHOLMOD and UMFPACK ones need SuiteSparse, kMumps and kMumpsLdlt MUMPS).
 bool solver_available(SolverKind kind);
 // True when the back end reads only the lower triangle of A (the Cholesky and LDL^T
 // ones), so a matrix stored as its lower triangle may be passed.
 bool reads_lower_triangle(SolverKind kind);
 
-// Fill-reducing ordering of the CHOLMOD and UMFPACK back ends (the Eigen ones use their own):
+// Fill-reducing ordering of the CHOLMOD, UMFPACK and MUMPS back ends (the Eigen ones use their own):
 //   kDefault  CHOLMOD's choice: AMD, and METIS as well when AMD's fill looks high
 //   kAmd      approximate minimum degree
 //   kMetis    METIS nested dissection (through CHOLMOD)
 //   kNesdis   CHOLMOD's nested dissection (METIS partitions, constrained minimum degree)
 // UMFPACK: kDefault and kAmd give its AMD / COLAMD, kMetis and kNesdis its METIS.
+// MUMPS: kDefault its own choice (AMF or SCOTCH by size: Debian's build has no METIS), kAmd
+// AMD, kMetis and kNesdis SCOTCH's nested dissection.
 enum class Ordering { kDefault, kAmd, kMetis, kNesdis };
 // "default", "amd", "metis", "nesdis".
 std::string to_string(Ordering ordering);
@@ -75,9 +93,12 @@ Ordering parse_ordering(const std::string& name, const std::string& where = "");
 // (Debian's libopenblas0-pthread chosen by update-alternatives) each supernodal
 // factorisation and solve runs on factorisation_threads() BLAS threads and on one thread
 // between them (so idle BLAS threads do not compete with the element loop); with a serial
-// BLAS on one. Supernodal factorisations and solves of all LinearSolvers are serialised
-// by one lock: the serial OpenBLAS is not safe to call from two threads at once.
-// Threads for one factorisation: by default OMP_NUM_THREADS when set, else the cores; set_factorisation_threads(n) overrides it (n >= 1), e.g. from a command-line option.
+// BLAS on one. The BLAS-calling factorisations and solves (CHOLMOD supernodal, UMFPACK,
+// MUMPS) of all LinearSolvers are serialised by one lock: the serial OpenBLAS is not safe
+// to call from two threads at once.
+// Threads for one factorisation: by default sf::default_threads() (SF_THREADS, else
+// OMP_NUM_THREADS, else the cores; common/core/parallel.hpp); set_factorisation_threads(n)
+// overrides it (n >= 1), e.g. from a command-line option.
 void set_factorisation_threads(int threads);
 int factorisation_threads();
 // One line naming the BLAS and its threading, e.g.
@@ -120,6 +141,9 @@ struct SolveReport {
   std::string ordering;                 // fill-reducing ordering the analysis used, e.g. "amd",
                                         // "metis", "nesdis", "colamd"; with UMFPACK also its strategy
                                         // ("amd, symmetric strategy"); empty when unknown
+  int negative_pivots = -1;             // negative eigenvalues of A (its inertia, Sylvester's law)
+                                        // from a symmetric indefinite factorisation that counts them
+                                        // (MUMPS LDL^T); -1 when unknown
 
   bool ok() const { return status == Status::kOk; }
   // One line, e.g. "cholmod n=900 nnz=4380: ok; analyse 0.0004 s, factor 0.0011 s, solve 0.0001 s"
@@ -172,6 +196,14 @@ class LinearSolver {
   // solve_seconds in last_report(); if the back end fails, the status becomes
   // kFailed and the result is NaN.
   Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+
+  // B - A X (n x n_rhs) with the solver's own copy of the last factorised A (read as its
+  // lower triangle when the back end reads only that one): the check of a solution and the
+  // right-hand side of a refinement step, X += solve(B - A X).
+  Eigen::MatrixXd residual(const Eigen::Ref<const Eigen::MatrixXd>& b,
+                           const Eigen::Ref<const Eigen::MatrixXd>& x) const;
+  // The solver's own copy of the last analysed or factorised A (compressed).
+  const SparseMatrix& matrix() const;
 
   // Report of the last analyze_pattern / factorize (and solve timing).
   const SolveReport& last_report() const;

@@ -167,9 +167,9 @@ struct CaseSolver {
   // last step's increment (forming/solve/static_solver.hpp StaticOptions::extrapolate).
   bool extrapolate = false;
   double process_time = 1.0;  // s
-  // linear: how the Newton tangent is solved: direct (sparse LU / Cholesky), iterative
-  // (GMRES preconditioned by an earlier tangent's factorisation), iterative-ply (GMRES
-  // preconditioned per ply) or auto (by size); forming/solve/tangent_solver.hpp.
+  // linear: how the Newton tangent is solved: direct (sparse Cholesky / LDL^T / LU),
+  // iterative (GMRES preconditioned by an earlier tangent's factorisation) or auto (direct);
+  // forming/solve/tangent_solver.hpp. (iterative-ply: benchmarks only, set directly.)
   std::string linear = "auto";
   // stabilise (load control): viscous stabilisation F_v = c M* v
   // (forming/solve/stabilisation.hpp): {fraction: f} calibrates c from the first step so

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
 #include "forming/model/solve_profile.hpp"
 
 namespace sf::forming {
@@ -34,7 +35,7 @@ std::atomic<bool> g_band_pattern{true};
 void Model::set_band_pattern(bool on) { g_band_pattern.store(on); }
 bool Model::band_pattern() { return g_band_pattern.load(); }
 
-int Model::threads() const { return threads_ > 0 ? threads_ : omp_get_max_threads(); }
+int Model::threads() const { return threads_ > 0 ? threads_ : sf::default_threads(); }
 
 int Model::add_ply(PlyMesh ply, std::shared_ptr<const Material> material, const ConstraintTerms& constraints) {
   if (!material) throw InputError("model: ply added without a material");

@@ -140,8 +140,8 @@ class Model {
   // The element entries (global dof, coefficient, local index) of every brick of every
   // body, bodies in order: what make_pattern lays out.
   const std::vector<linalg::ElementEntries>& element_entries() const { return entries_; }
-  // Threads for the element loop: 0 (default) = as many as OpenMP offers (OMP_NUM_THREADS
-  // or the cores); results do not depend on it.
+  // Threads for the element loop: 0 (default) = sf::default_threads() (SF_THREADS, else
+  // OMP_NUM_THREADS, else the cores; common/core/parallel.hpp); results do not depend on it.
   void set_threads(int threads) { threads_ = threads; }
   int threads() const;
   // Whether a growing tangent pattern is laid out for every interaction pair within the

@@ -24,7 +24,13 @@ std::string solve_profile_linear_summary(const SolveProfile& p) {
                             "{} preconditioner factorisations, {} direct fallbacks",
                             p.krylov_solves,
                             static_cast<double>(p.krylov_iterations) / static_cast<double>(p.krylov_solves),
-                            p.krylov_worst_residual, p.preconditioner_factorizations, p.direct_fallbacks));
+                            p.krylov_worst_residual, p.preconditioner_factorizations, p.direct_fallbacks)) +
+         (p.indefinite_factorizations == 0
+              ? std::string()
+              : fmt::format("; indefinite: {} LDL^T factorisations, worst |K dx - b|/|b| {:.2g}, {} refinement "
+                            "steps, {} residual fallbacks to LU",
+                            p.indefinite_factorizations, p.indefinite_worst_residual, p.residual_refinements,
+                            p.residual_fallbacks));
 }
 
 }  // namespace sf::forming

@@ -45,6 +45,15 @@ struct SolveProfile {
   double krylov_worst_residual = 0.0;
   long preconditioner_factorizations = 0;
   long direct_fallbacks = 0;
+  // Direct solves of a symmetric tangent that is not positive definite (forming/solve/
+  // tangent_solver.hpp): factorisations by the symmetric indefinite solver (MUMPS LDL^T),
+  // the refinement steps its solutions took, the solves whose residual stayed above the
+  // tolerance and went to the LU, and the largest |K dx - b|/|b| the indefinite solves
+  // ended with.
+  long indefinite_factorizations = 0;
+  long residual_refinements = 0;
+  long residual_fallbacks = 0;
+  double indefinite_worst_residual = 0.0;
   void reset() { *this = SolveProfile{}; }
 };
 

@@ -1,7 +1,9 @@
 #include "forming/solve/tangent_solver.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -66,14 +68,22 @@ TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric, LinearMo
   if (symmetric_auto && linalg::solver_available(SolverKind::kCholmod)) {
     spd_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmod,
                                                   linalg::MatrixProperty::kSymmetricPositiveDefinite);
-    // The indefinite fallback: UMFPACK (symmetric strategy, threshold pivoting) on the
-    // matrix expanded from its lower triangle. CHOLMOD's LDL^T is simplicial (no BLAS):
-    // on the dome's start tangent 2x slower than UMFPACK at 1944 unknowns and 9x (6.5
-    // against 0.72 processor seconds) at 10584 (bench/simform_dome_bench --factor-only).
+    spd_->set_ordering(ordering);
+    // Where Cholesky breaks down: MUMPS's LDL^T with pivoting on the same lower triangle
+    // (see the header), checked by the residual of each solution.
+    if (linalg::solver_available(SolverKind::kMumpsLdlt)) {
+      indefinite_ =
+          std::make_unique<linalg::LinearSolver>(SolverKind::kMumpsLdlt, linalg::MatrixProperty::kSymmetricIndefinite);
+      indefinite_->set_ordering(ordering);
+    }
+    // The last resort (and the indefinite solver of builds without MUMPS): UMFPACK
+    // (symmetric strategy, threshold pivoting) on the matrix expanded from its lower
+    // triangle. CHOLMOD's LDL^T is simplicial (no BLAS, no pivoting): on the dome's start
+    // tangent 2x slower than UMFPACK at 1944 unknowns and 9x (6.5 against 0.72 processor
+    // seconds) at 10584 (bench/simform_dome_bench --factor-only).
     const SolverKind fallback =
         linalg::solver_available(SolverKind::kUmfpack) ? SolverKind::kUmfpack : SolverKind::kCholmodLdlt;
     general_ = std::make_unique<linalg::LinearSolver>(fallback, linalg::MatrixProperty::kSymmetricIndefinite);
-    spd_->set_ordering(ordering);
     general_->set_ordering(ordering);
     if (use_iterative_) general_->set_refinement(false);  // a preconditioner: GMRES refines
     lower_ = true;
@@ -97,7 +107,7 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
   k_ = k;
   preconditioner_fresh_ = false;
   if (!preconditioner_ok_ || !same_pattern || refactor_next_)
-    factorize_preconditioner(k_);  // counted as a factorisation (factorize_direct)
+    factorize_preconditioner();  // counted as a factorisation (factorize_direct)
   else
     ++profile.factorizations;
   iterative_report_ = linalg::SolveReport{};
@@ -115,12 +125,11 @@ const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& 
   return iterative_report_;
 }
 
-bool TangentSolver::factorize_preconditioner(const linalg::SparseMatrix& k) const {
-  auto* self = const_cast<TangentSolver*>(this);  // the preconditioner is a cache of k_
+// The preconditioner from the current tangent k_.
+bool TangentSolver::factorize_preconditioner() {
   ++solve_profile().preconditioner_factorizations;
-  const linalg::SolveReport& r = mode_ == LinearMode::kIterativePly
-                                     ? self->factorize_direct(linalg::block_diagonal(k, group_))
-                                     : self->factorize_direct(k);
+  const linalg::SolveReport& r =
+      mode_ == LinearMode::kIterativePly ? factorize_direct(linalg::block_diagonal(k_, group_)) : factorize_direct(k_);
   preconditioner_ok_ = r.ok();
   preconditioner_fresh_ = true;
   refactor_next_ = false;
@@ -170,6 +179,16 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
     skip_cholesky_ = 4;
   }
   if (spd_) ++n_indefinite_;
+  if (indefinite_) {
+    const linalg::SolveReport& r = indefinite_->factorize(k);
+    record(r);
+    ++profile.indefinite_factorizations;
+    if (r.ok()) {
+      active_ = indefinite_.get();
+      return r;
+    }
+    // Singular or failed: the LU below says which.
+  }
   if (lower_ && !linalg::reads_lower_triangle(general_->kind())) {
     // Both triangles for the LU; the same lower pattern expands to the same full one, so
     // its analysis is kept as well.
@@ -185,18 +204,62 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
   return r;
 }
 
-Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
+Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) {
   if (use_iterative_) return solve_iterative(b);
   SF_ASSERT(active_ != nullptr, "TangentSolver::solve() needs a successful factorize()");
   const auto t0 = std::chrono::steady_clock::now();
   Eigen::MatrixXd x = active_->solve(b);
+  if (active_ == indefinite_.get()) check_indefinite(b, x);
   SolveProfile& profile = solve_profile();
   ++profile.solves;
   profile.solve_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return x;
 }
 
-Eigen::MatrixXd TangentSolver::solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b) const {
+void TangentSolver::check_indefinite(const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::MatrixXd& x) {
+  SolveProfile& profile = solve_profile();
+  // The largest relative residual over the columns (a zero column of b has x = 0 exactly).
+  const auto worst = [&b](const Eigen::MatrixXd& r) {
+    double w = 0.0;
+    for (Index c = 0; c < b.cols(); ++c) {
+      const double nb = b.col(c).norm();
+      w = std::max(w, nb > 0.0 ? r.col(c).norm() / nb : r.col(c).norm());
+    }
+    return w;
+  };
+  Eigen::MatrixXd r = indefinite_->residual(b, x);
+  double w = worst(r);
+  for (int step = 0; step < kRefinementSteps && w > residual_tolerance_ && std::isfinite(w); ++step) {
+    const Eigen::MatrixXd dx = indefinite_->solve(r);
+    ++profile.residual_refinements;
+    const Eigen::MatrixXd x_new = x + dx;
+    Eigen::MatrixXd r_new = indefinite_->residual(b, x_new);
+    const double w_new = worst(r_new);
+    if (!(w_new < w)) break;  // refinement no longer helps
+    x = x_new;
+    r = std::move(r_new);
+    w = w_new;
+  }
+  if (w <= residual_tolerance_) {
+    profile.indefinite_worst_residual = std::max(profile.indefinite_worst_residual, w);
+    return;
+  }
+  // The LDL^T's solution is not good enough (pivots too small for its threshold): the LU.
+  ++n_residual_fallbacks_;
+  ++profile.residual_fallbacks;
+  expanded_ = indefinite_->matrix().selfadjointView<Eigen::Lower>();
+  const linalg::SolveReport& lu = linalg::reads_lower_triangle(general_->kind())
+                                      ? general_->factorize(indefinite_->matrix())
+                                      : general_->factorize(expanded_);
+  if (!lu.ok()) {  // keep the LDL^T's solution, the best there is; record how far off it is
+    profile.indefinite_worst_residual = std::max(profile.indefinite_worst_residual, w);
+    return;
+  }
+  active_ = general_.get();
+  x = general_->solve(b);
+}
+
+Eigen::MatrixXd TangentSolver::solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b) {
   const auto t0 = std::chrono::steady_clock::now();
   SolveProfile& profile = solve_profile();
   const linalg::Storage storage = lower_ ? linalg::Storage::kLower : linalg::Storage::kFull;
@@ -210,7 +273,7 @@ Eigen::MatrixXd TangentSolver::solve_iterative(const Eigen::Ref<const Eigen::Mat
     for (int attempt = 0; attempt < 2; ++attempt) {
       if (attempt == 1) {
         if (preconditioner_fresh_) break;  // a fresh one did not do: no use trying again
-        factorize_preconditioner(k_);
+        factorize_preconditioner();
         if (!(r.relative_residual < 1.0)) xc.setZero();  // else GMRES goes on from the stale attempt's x
       }
       if (!preconditioner_ok_) continue;
@@ -244,7 +307,9 @@ Eigen::MatrixXd TangentSolver::solve_iterative(const Eigen::Ref<const Eigen::Mat
       x.col(c).setConstant(std::numeric_limits<double>::quiet_NaN());
       continue;
     }
-    x.col(c) = fallback_->active_->solve(b.col(c));
+    Eigen::MatrixXd xc_direct = fallback_->active_->solve(b.col(c));
+    if (fallback_->active_ == fallback_->indefinite_.get()) fallback_->check_indefinite(b.col(c), xc_direct);
+    x.col(c) = xc_direct;
   }
   profile.solve_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ++profile.solves;

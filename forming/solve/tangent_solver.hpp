@@ -31,30 +31,33 @@ struct FreeDofs {
 // Linear solves with a Newton tangent K_ff as Model::assemble_into lays it out
 // (linalg::PatternAssembler). With kAuto and a symmetric tangent the matrix is stored as
 // its lower triangle (lower() is true) and factorised by supernodal Cholesky (CHOLMOD)
-// while it is positive definite, as it is at stable equilibria; where Cholesky breaks
-// down (past a limit point, under compressive instability, the dome's flat start) by
-// UMFPACK's LU with its symmetric strategy on the matrix expanded from that lower
-// triangle (CHOLMOD's simplicial LDL^T without SuiteSparse's UMFPACK): measured on the
-// dome's start tangent, CHOLMOD's LDL^T (simplicial, no BLAS, no pivoting) took 9x the
-// LU's time at 10584 unknowns. After a breakdown the next few factorisations go to the
-// fallback directly. Unsymmetric tangents (follower loads, friction: the viscous
-// inter-ply slip of the forming cases) and an explicit solver kind go straight to that
-// one (kAuto: UMFPACK), with both triangles stored unless the kind reads only the lower
-// one.
+// while it is positive definite, as it is at stable equilibria. Where Cholesky breaks
+// down (past a limit point, under compressive instability, the dome's flat start) the
+// symmetric indefinite LDL^T of MUMPS (threshold 1x1/2x2 pivoting) factorises the same
+// lower triangle, and each of its solutions is checked: |K dx - b| <= kResidualTolerance |b|,
+// after up to kRefinementSteps steps of iterative refinement; a solution that fails the
+// check, or an LDL^T that fails, goes to UMFPACK's LU (symmetric strategy) on the matrix
+// expanded from the lower triangle, the path of builds without MUMPS (and CHOLMOD's
+// simplicial LDL^T without UMFPACK). After a breakdown the next few factorisations skip
+// Cholesky. Unsymmetric tangents (follower loads, friction: the viscous inter-ply slip of
+// the forming cases) and an explicit solver kind go straight to that one (kAuto: UMFPACK),
+// with both triangles stored unless the kind reads only the lower one.
 // Each back end keeps its symbolic analysis while the pattern stays the same (across
 // iterations and, with a solver kept between solves, load steps).
 //
-// Iterative modes (the case key `solver: {linear: iterative | iterative-ply}`): solve()
+// Iterative mode (the case key `solver: {linear: iterative}`): solve()
 // runs restarted GMRES (common/linalg/krylov.hpp) on the whole K_ff, preconditioned by a
 // factorisation made by the direct path above and kept over Newton iterations (and load
 // steps) while it still works:
 //   kIterative     the factorisation of an earlier tangent of the run (K_ff as it was at
 //                  the last refactorisation): near the current one, so GMRES needs a few
 //                  iterations while Newton's tangents change little;
-//   kIterativePly  the block-diagonal part of K_ff, one block per ply (body): each ply's
-//                  own stiffness and the diagonal part of its contact, much smaller
-//                  factors than the laminate's, the contact coupling between plies left
-//                  to the iteration (measured: slow under stiff penalty contact, see docs).
+//   kIterativePly  (benchmarks only, bench/simform_dome_bench --linear iterative-ply; not a
+//                  case key: it fails under penalty contact) the block-diagonal part of
+//                  K_ff, one block per ply (body): each ply's own stiffness and the diagonal
+//                  part of its contact, much smaller factors than the laminate's, the contact
+//                  coupling between plies left to the iteration (measured: hundreds of GMRES
+//                  iterations or the direct fallback under stiff penalty contact, see docs).
 // Tolerance: |K dx + r| <= kTolerance |r| (1e-10, below the Newton tolerances of the cases,
 // so Newton converges as with the direct solve). The preconditioner is refactorised by the
 // next factorize() when the last solve needed more than kRefactorAfter GMRES iterations
@@ -70,6 +73,7 @@ enum class LinearMode { kAuto, kDirect, kIterative, kIterativePly };
 // "auto", "direct", "iterative", "iterative-ply".
 std::string to_string(LinearMode mode);
 // Inverse of to_string(LinearMode); sf::InputError otherwise (message starts with `where`).
+// Accepts "iterative-ply" (benchmarks); the case reader does not.
 LinearMode parse_linear_mode(const std::string& name, const std::string& where = "");
 
 class TangentSolver {
@@ -81,11 +85,21 @@ class TangentSolver {
   // True when factorize() expects the lower triangle only.
   bool lower() const { return lower_; }
   const linalg::SolveReport& factorize(const linalg::SparseMatrix& k);
-  Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+  // dx with K dx = b for the last factorize()d K. Not const: a solution that fails its
+  // residual check factorises the LU fallback, and an aged preconditioner is refactorised.
+  Eigen::MatrixXd solve(const Eigen::Ref<const Eigen::MatrixXd>& b);
   // True when the last factorize() set up the iterative path (not the direct one).
   bool iterative() const { return use_iterative_; }
   // Factorisations that fell back to the indefinite solver so far.
   int n_indefinite() const { return n_indefinite_; }
+  // Solves of the symmetric indefinite solver whose residual check sent them to the LU.
+  int n_residual_fallbacks() const { return n_residual_fallbacks_; }
+  // A solution of the indefinite path is accepted when |K dx - b| <= kResidualTolerance |b|
+  // (the GMRES tolerance below), after at most kRefinementSteps refinement steps.
+  static constexpr double kResidualTolerance = 1e-10;
+  static constexpr int kRefinementSteps = 2;
+  // Another tolerance for that check (tests: 0 sends every such solve to the LU).
+  void set_residual_tolerance(double tolerance) { residual_tolerance_ = tolerance; }
   // The back end that did the last successful factorisation (null before one).
   const linalg::LinearSolver* active() const { return active_; }
   // Fill-reducing ordering of the Newton tangents' solvers made from now on (process-wide;
@@ -96,11 +110,15 @@ class TangentSolver {
 
  private:
   const linalg::SolveReport& factorize_direct(const linalg::SparseMatrix& k);
-  bool factorize_preconditioner(const linalg::SparseMatrix& k) const;
-  Eigen::MatrixXd solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b) const;
+  bool factorize_preconditioner();
+  Eigen::MatrixXd solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b);
+  // The indefinite path's residual check and refinement of x (K x = b); LU when it fails.
+  void check_indefinite(const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::MatrixXd& x);
   linalg::SolverKind fallback_kind_ = linalg::SolverKind::kAuto;
   bool fallback_unsymmetric_ = false;
-  std::unique_ptr<linalg::LinearSolver> spd_, general_;
+  // spd_: Cholesky; indefinite_: symmetric indefinite LDL^T (MUMPS; null without it);
+  // general_: the LU (or whatever an explicit kind or an unsymmetric tangent asks for).
+  std::unique_ptr<linalg::LinearSolver> spd_, indefinite_, general_;
   // Iterative mode: the tangent (a copy: the caller reassembles in place), the groups, the
   // preconditioner's state and a direct solver for the fallback (made when first needed).
   LinearMode mode_ = LinearMode::kDirect;
@@ -108,14 +126,14 @@ class TangentSolver {
   bool use_iterative_ = false;
   linalg::SparseMatrix k_;
   linalg::SolveReport iterative_report_;
-  mutable bool preconditioner_ok_ = false;           // the block factorisation is usable
-  mutable bool preconditioner_fresh_ = false;        // it was made from the current k_
-  mutable bool refactor_next_ = false;               // the next factorize() refactorises it
-  mutable std::unique_ptr<TangentSolver> fallback_;  // direct solver of the whole K_ff
-  static constexpr int kRefactorIterations = 40;     // GMRES iterations allowed a stale preconditioner
-  static constexpr int kRefactorAfter = 20;          // more in a solve: refactorise for the next
-  static constexpr int kMaxIterations = 400;         // and a fresh one
-  static constexpr double kTolerance = 1e-10;        // GMRES: |K dx + r| <= kTolerance |r|
+  bool preconditioner_ok_ = false;                // the block factorisation is usable
+  bool preconditioner_fresh_ = false;             // it was made from the current k_
+  bool refactor_next_ = false;                    // the next factorize() refactorises it
+  std::unique_ptr<TangentSolver> fallback_;       // direct solver of the whole K_ff
+  static constexpr int kRefactorIterations = 40;  // GMRES iterations allowed a stale preconditioner
+  static constexpr int kRefactorAfter = 20;       // more in a solve: refactorise for the next
+  static constexpr int kMaxIterations = 400;      // and a fresh one
+  static constexpr double kTolerance = 1e-10;     // GMRES: |K dx + r| <= kTolerance |r|
   const linalg::LinearSolver* active_ = nullptr;
   bool lower_ = false;
   // From this many unknowns up the LU orders by METIS (nested dissection) rather than
@@ -125,6 +143,8 @@ class TangentSolver {
   linalg::SparseMatrix expanded_;  // both triangles of a lower-stored tangent, for an LU fallback
   int skip_cholesky_ = 0;          // after a breakdown, the next few factorisations go to general_
   int n_indefinite_ = 0;
+  int n_residual_fallbacks_ = 0;
+  double residual_tolerance_ = kResidualTolerance;
 };
 
 // The body (ply) of each of the unknowns `active_dofs` (global dofs, the order of K_ff):

@@ -6,9 +6,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <random>
 #include <string>
 #include <thread>
@@ -31,9 +34,18 @@ constexpr int kGridSize = 30;                 // 30 x 30 grid -> n = 900
 constexpr int kNumRhs = 4;
 constexpr unsigned kSeed = 20240611;
 
-const std::vector<SolverKind> kAllKinds = {SolverKind::kAuto,    SolverKind::kCholmod,   SolverKind::kCholmodSimplicial,
-                                           SolverKind::kUmfpack, SolverKind::kEigenLDLT, SolverKind::kEigenLU};
-const std::vector<SolverKind> kLuKinds = {SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLU};
+// The MUMPS kinds join in when the build has MUMPS (libmumps-seq-dev).
+std::vector<SolverKind> with_mumps(std::vector<SolverKind> kinds, std::initializer_list<SolverKind> mumps) {
+  for (const SolverKind k : mumps)
+    if (solver_available(k)) kinds.push_back(k);
+  return kinds;
+}
+const std::vector<SolverKind> kAllKinds =
+    with_mumps({SolverKind::kAuto, SolverKind::kCholmod, SolverKind::kCholmodSimplicial, SolverKind::kUmfpack,
+                SolverKind::kEigenLDLT, SolverKind::kEigenLU},
+               {SolverKind::kMumps, SolverKind::kMumpsLdlt});
+const std::vector<SolverKind> kLuKinds =
+    with_mumps({SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLU}, {SolverKind::kMumps});
 
 // Grid node (ix, iy) -> row; -1 outside the grid (Dirichlet boundary) or for
 // the node `skip` (a DOF no element touches).
@@ -275,11 +287,58 @@ TEST(LinalgSolver, IndefiniteSymmetricSolvedByPivotingBackends) {
   // 73 of 900 eigenvalues negative; min |lambda| = 0.017.
   const SparseMatrix a = laplacian_2d(kGridSize, -1.0);
   for (const SolverKind kind :
-       {SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLDLT, SolverKind::kEigenLU}) {
+       with_mumps({SolverKind::kAuto, SolverKind::kUmfpack, SolverKind::kEigenLDLT, SolverKind::kEigenLU},
+                  {SolverKind::kMumps, SolverKind::kMumpsLdlt})) {
     SCOPED_TRACE(to_string(kind));
     LinearSolver solver(kind, MatrixProperty::kSymmetricIndefinite);
     expect_solves(solver, a, "indefinite " + to_string(kind));
   }
+}
+
+// A symmetric indefinite matrix no LDL^T without pivoting can factorise: the 900-unknown
+// indefinite Laplacian (73 negative eigenvalues) beside five decoupled 2 x 2 blocks
+// [[0, 1], [1, 0]] (eigenvalues +-1), whose first pivot is zero in any elimination order.
+// Cholesky and the unpivoted LDL^T (CHOLMOD's, Eigen's) break down; MUMPS's LDL^T with
+// 2 x 2 pivots solves it and counts the negative eigenvalues (Sylvester's inertia).
+TEST(LinalgSolver, MumpsLdltSolvesWhereCholeskyAndUnpivotedLdltBreakDown) {
+  if (!solver_available(SolverKind::kMumpsLdlt)) GTEST_SKIP() << "this build has no MUMPS";
+  const SparseMatrix lap = laplacian_2d(kGridSize, -1.0);
+  const Index n0 = lap.rows(), n = n0 + 10;
+  TripletAssembler t(n, n);
+  for (int j = 0; j < lap.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(lap, j); it; ++it) t.add(it.row(), it.col(), it.value());
+  for (Index b = 0; b < 5; ++b) {
+    t.add(n0 + 2 * b, n0 + 2 * b + 1, 1.0);
+    t.add(n0 + 2 * b + 1, n0 + 2 * b, 1.0);
+  }
+  const SparseMatrix a = t.compress();
+  const SparseMatrix lower = a.triangularView<Eigen::Lower>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig{Eigen::MatrixXd(a)};
+  const int negative = static_cast<int>((eig.eigenvalues().array() < 0.0).count());
+  ASSERT_EQ(negative, 73 + 5);
+  ASSERT_GT(eig.eigenvalues().cwiseAbs().minCoeff(), 1e-3);  // nonsingular
+
+  for (const SolverKind kind : {SolverKind::kCholmod, SolverKind::kCholmodLdlt, SolverKind::kEigenLDLT}) {
+    LinearSolver unpivoted(kind, kind == SolverKind::kCholmod ? MatrixProperty::kSymmetricPositiveDefinite
+                                                              : MatrixProperty::kSymmetricIndefinite);
+    EXPECT_EQ(unpivoted.factorize(lower).status, SolveReport::Status::kSingular) << to_string(kind);
+  }
+  LinearSolver mumps(SolverKind::kMumpsLdlt, MatrixProperty::kSymmetricIndefinite);
+  for (const SparseMatrix* m : {&lower, &a}) {  // its lower triangle, or both (the upper one is not read)
+    const SolveReport& r = mumps.factorize(*m);
+    ASSERT_TRUE(r.ok()) << r.brief();
+    EXPECT_EQ(r.negative_pivots, negative);
+    EXPECT_GT(r.factor_flops, 0.0);
+    EXPECT_GT(r.factor_nonzeros, 0.0);
+    EXPECT_FALSE(r.ordering.empty());
+    const Eigen::MatrixXd b = random_rhs(n, kNumRhs, kSeed);
+    const Eigen::MatrixXd x = mumps.solve(b);
+    EXPECT_LT(max_relative_residual(a, x, b), kResidualTolerance) << r.brief();
+    // residual(): B - A X from the solver's own copy, read as its lower triangle.
+    EXPECT_LT((mumps.residual(b, x) - (b - a * x)).norm(), 1e-12 * b.norm());
+  }
+  // The same values again: the analysis is kept.
+  EXPECT_TRUE(mumps.factorize(a).reused_analysis);
 }
 
 TEST(LinalgSolver, RefactorizeReusesAnalysisOnlyForTheSamePattern) {

@@ -322,6 +322,17 @@ TEST(FormingCase, StabiliseKeyErrorsNameTheField) {
   EXPECT_TRUE(problems(", stabilise: {damping: 0.1, warn_ratio: 0.02}").empty());
 }
 
+// The Newton tangent's linear solver: direct, iterative or auto; the per-ply preconditioned
+// GMRES (iterative-ply) does not work under contact and is a benchmark's option only.
+TEST(FormingCase, LinearSolverKeyAcceptsDirectIterativeAutoOnly) {
+  for (const char* mode : {"direct", "iterative", "auto"})
+    EXPECT_EQ(parse_ok(uniaxial_case(0.0, 1.0, std::string(", linear: ") + mode)).solver.linear, mode);
+  const CaseCheck c = check_case_text(uniaxial_case(0.0, 1.0, ", linear: iterative-ply"), "ply.yaml");
+  ASSERT_EQ(c.problems.size(), 1u);
+  EXPECT_THAT(c.located(0), ::testing::MatchesRegex("ply.yaml:12:[0-9]+: solver linear: expected direct .*"
+                                                    "found 'iterative-ply'.*"));
+}
+
 TEST(FormingCase, RunThatCannotConvergeLeavesPartialResult) {
   // One Newton iteration per attempt and no cut-back room: the first step fails.
   const FormingCase spec = parse_ok(uniaxial_case(0.0, 1.0, ", max_iterations: 1, min_increment: 1"));

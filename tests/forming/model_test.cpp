@@ -15,6 +15,7 @@
 #include "common/mesh/surface_mesh.hpp"
 #include "forming/model/model.hpp"
 #include "forming/model/node_spring.hpp"
+#include "forming/model/solve_profile.hpp"
 #include "forming/solve/static_solver.hpp"
 #include "forming/solve/tangent_solver.hpp"
 #include "tests/common/tolerances.hpp"
@@ -152,38 +153,99 @@ TEST(FormingModel, InvertedElementIsReportedByTheFastAssembly) {
   EXPECT_TRUE(std::isinf(a.energy));
 }
 
-// The symmetric-indefinite path: a real ply tangent shifted to be indefinite, stored
-// as its lower triangle. Cholesky breaks down, the fallback (UMFPACK on the expanded
-// matrix) takes over and solves it.
-TEST(FormingTangentSolver, IndefiniteTangentIsSolvedByTheFallback) {
+// A real ply tangent shifted by a fraction of its mean diagonal, so that many
+// eigenvalues are negative, stored as its lower triangle.
+struct ShiftedPlyTangent {
   Model model;
-  model.add_ply(fixtures::rectangle_ply(20.0, 20.0, 1.0, 4, 4, 30.0), ti_model_material(fibre_from_layup_angle(30.0)));
-  std::vector<bool> is_free(static_cast<std::size_t>(model.n_dofs()), true);
-  for (Index d = 0; d < 48; ++d) is_free[static_cast<std::size_t>(d)] = false;  // a clamped corner node pair
+  std::vector<bool> is_free;
+  linalg::PatternAssembler pattern;
+  double mean = 0.0;
+  ShiftedPlyTangent() : model(make_model()), is_free(free_dofs(model)), pattern(model.make_pattern(is_free, true)) {
+    EXPECT_TRUE(model.assemble_into(model.reference_positions(), InteractionContext{}, &pattern).ok);
+    linalg::SparseMatrix& k = pattern.matrix();
+    for (int c = 0; c < k.outerSize(); ++c) mean += k.coeff(c, c);
+    mean /= k.outerSize();
+  }
+  void shift(double s) {
+    linalg::SparseMatrix& k = pattern.matrix();
+    for (int c = 0; c < k.outerSize(); ++c) k.coeffRef(c, c) -= s * mean;
+  }
+  static Model make_model() {
+    Model m;
+    m.add_ply(fixtures::rectangle_ply(20.0, 20.0, 1.0, 4, 4, 30.0), ti_model_material(fibre_from_layup_angle(30.0)));
+    return m;
+  }
+  static std::vector<bool> free_dofs(const Model& m) {
+    std::vector<bool> f(static_cast<std::size_t>(m.n_dofs()), true);
+    for (Index d = 0; d < 48; ++d) f[static_cast<std::size_t>(d)] = false;  // a clamped corner node pair
+    return f;
+  }
+};
+
+double lower_residual(const linalg::SparseMatrix& lower, const VecX& x, const VecX& b) {
+  const linalg::SparseMatrix full = lower.selfadjointView<Eigen::Lower>();
+  return (full * x - b).norm() / b.norm();
+}
+
+// The symmetric-indefinite path: Cholesky breaks down, the indefinite solver (MUMPS's
+// LDL^T with pivoting; UMFPACK's LU on the expanded matrix without MUMPS) takes over and
+// its solution passes the residual check.
+TEST(FormingTangentSolver, IndefiniteTangentIsSolvedByTheFallback) {
+  ShiftedPlyTangent t;
   TangentSolver solver(linalg::SolverKind::kAuto, false);
   ASSERT_TRUE(solver.lower());
-  linalg::PatternAssembler pattern = model.make_pattern(is_free, solver.lower());
-  ASSERT_TRUE(model.assemble_into(model.reference_positions(), InteractionContext{}, &pattern).ok);
-  linalg::SparseMatrix& k = pattern.matrix();
-  // Shift by the mean diagonal: many eigenvalues become negative.
-  double mean = 0.0;
-  for (int c = 0; c < k.outerSize(); ++c) mean += k.coeff(c, c);
-  mean /= k.outerSize();
-  for (int c = 0; c < k.outerSize(); ++c) k.coeffRef(c, c) -= 0.37 * mean;
+  t.shift(0.37);
+  const linalg::SparseMatrix& k = t.pattern.matrix();
   const linalg::SolveReport& r = solver.factorize(k);
   ASSERT_TRUE(r.ok()) << r.brief();
   EXPECT_EQ(solver.n_indefinite(), 1);
-  EXPECT_EQ(r.used, linalg::solver_available(linalg::SolverKind::kUmfpack) ? linalg::SolverKind::kUmfpack
-                                                                           : linalg::SolverKind::kCholmodLdlt);
+  const bool mumps = linalg::solver_available(linalg::SolverKind::kMumpsLdlt);
+  EXPECT_EQ(r.used, mumps                                                    ? linalg::SolverKind::kMumpsLdlt
+                    : linalg::solver_available(linalg::SolverKind::kUmfpack) ? linalg::SolverKind::kUmfpack
+                                                                             : linalg::SolverKind::kCholmodLdlt);
+  if (mumps) {
+    EXPECT_GT(r.negative_pivots, 0);
+  }
   const VecX b = VecX::LinSpaced(k.rows(), -1.0, 2.0);
   const VecX sol = solver.solve(b);
-  const linalg::SparseMatrix full = k.selfadjointView<Eigen::Lower>();
-  EXPECT_LT((full * sol - b).norm(), 1e-9 * b.norm() * std::max(1.0, sol.norm() * max_abs(MatX(full)) / b.norm()));
+  EXPECT_LT(lower_residual(k, sol, b), TangentSolver::kResidualTolerance);
+  EXPECT_EQ(solver.n_residual_fallbacks(), 0);
+  EXPECT_EQ(solver.active()->kind(), r.used);
   // Definite again: the next factorisations stay with the fallback for a while, still right.
-  for (int c = 0; c < k.outerSize(); ++c) k.coeffRef(c, c) += 0.37 * mean;
+  t.shift(-0.37);
   ASSERT_TRUE(solver.factorize(k).ok());
-  const linalg::SparseMatrix full2 = k.selfadjointView<Eigen::Lower>();
-  EXPECT_LT((full2 * solver.solve(b) - b).norm(), 1e-8 * b.norm());
+  EXPECT_LT(lower_residual(k, solver.solve(b), b), 1e-8);
+}
+
+// The residual check's way out: a solution of the indefinite solver that stays above the
+// tolerance after refinement is redone by the LU (here forced by a tolerance of 0, which
+// no solution meets), and that one is returned.
+TEST(FormingTangentSolver, IndefiniteSolutionFailingTheResidualCheckGoesToTheLu) {
+  if (!linalg::solver_available(linalg::SolverKind::kMumpsLdlt)) GTEST_SKIP() << "this build has no MUMPS";
+  ShiftedPlyTangent t;
+  t.shift(0.37);
+  const linalg::SparseMatrix& k = t.pattern.matrix();
+  const VecX b = VecX::LinSpaced(k.rows(), -1.0, 2.0);
+  solve_profile().reset();
+  TangentSolver strict(linalg::SolverKind::kAuto, false);
+  strict.set_residual_tolerance(0.0);
+  ASSERT_TRUE(strict.factorize(k).ok());
+  EXPECT_EQ(strict.active()->kind(), linalg::SolverKind::kMumpsLdlt);
+  const VecX x = strict.solve(b);
+  EXPECT_EQ(strict.n_residual_fallbacks(), 1);
+  EXPECT_EQ(solve_profile().residual_fallbacks, 1);
+  EXPECT_LE(solve_profile().residual_refinements, TangentSolver::kRefinementSteps);
+  ASSERT_NE(strict.active(), nullptr);
+  EXPECT_EQ(strict.active()->kind(), linalg::solver_available(linalg::SolverKind::kUmfpack)
+                                         ? linalg::SolverKind::kUmfpack
+                                         : linalg::SolverKind::kCholmodLdlt);
+  EXPECT_LT(lower_residual(k, x, b), TangentSolver::kResidualTolerance);
+  // The default tolerance: the LDL^T's own solution, no fallback, the same answer.
+  TangentSolver normal(linalg::SolverKind::kAuto, false);
+  ASSERT_TRUE(normal.factorize(k).ok());
+  const VecX y = normal.solve(b);
+  EXPECT_EQ(normal.n_residual_fallbacks(), 0);
+  EXPECT_LT((x - y).norm(), 1e-8 * y.norm());
 }
 
 // A run's load steps share one TangentWorkspace: the pattern is laid out once for both

@@ -13,16 +13,16 @@ set(out ${SF_BAD_DIR}/out)
 
 # Options: NaN and infinities name the option (exit 2); before, --beta nan was ignored and
 # inf failed later in the fit without naming it.
-sf_gsa_cli_test(bad.beta_nan COMMAND analyse ${grid} --out ${out} --no-plots --beta nan EXIT 2 STDERR "--beta")
-sf_gsa_cli_test(bad.gamma_inf COMMAND analyse ${grid} --out ${out} --no-plots --gamma inf EXIT 2 STDERR "--gamma")
-sf_gsa_cli_test(bad.smoothing_scale_inf COMMAND analyse ${grid} --out ${out} --no-plots --smoothing-scale inf
+sf_gsa_cli_test(bad.beta_nan COMMAND analyse ${grid} --out ${out}/beta_nan --no-plots --beta nan EXIT 2 STDERR "--beta")
+sf_gsa_cli_test(bad.gamma_inf COMMAND analyse ${grid} --out ${out}/gamma_inf --no-plots --gamma inf EXIT 2 STDERR "--gamma")
+sf_gsa_cli_test(bad.smoothing_scale_inf COMMAND analyse ${grid} --out ${out}/smoothing_scale_inf --no-plots --smoothing-scale inf
                 EXIT 2 STDERR "--smoothing-scale")
-sf_gsa_cli_test(bad.fibres_nan COMMAND analyse ${grid} --out ${out} --no-plots --fibres nan,90 EXIT 2 STDERR "--fibres")
-sf_gsa_cli_test(bad.units_newline COMMAND analyse ${grid} --out ${out} --no-plots --units "mm\nx" EXIT 2
+sf_gsa_cli_test(bad.fibres_nan COMMAND analyse ${grid} --out ${out}/fibres_nan --no-plots --fibres nan,90 EXIT 2 STDERR "--fibres")
+sf_gsa_cli_test(bad.units_newline COMMAND analyse ${grid} --out ${out}/units_newline --no-plots --units "mm\nx" EXIT 2
                 STDERR "--units")
-sf_gsa_cli_test(bad.delimiter_hash COMMAND analyse ${grid} --out ${out} --no-plots --delimiter "#" EXIT 2
+sf_gsa_cli_test(bad.delimiter_hash COMMAND analyse ${grid} --out ${out}/delimiter_hash --no-plots --delimiter "#" EXIT 2
                 STDERR "--delimiter" STDERR_NOT "internal error")
-sf_gsa_cli_test(bad.delimiter_quote COMMAND analyse ${grid} --out ${out} --no-plots --delimiter "\"" EXIT 2
+sf_gsa_cli_test(bad.delimiter_quote COMMAND analyse ${grid} --out ${out}/delimiter_quote --no-plots --delimiter "\"" EXIT 2
                 STDERR "--delimiter" STDERR_NOT "internal error")
 # An empty argument cannot pass through a CMake list: through sh.
 add_test(NAME gsa.cli.bad.out_empty
@@ -32,11 +32,11 @@ set_tests_properties(gsa.cli.bad.out_empty PROPERTIES LABELS "gsa;cli" TIMEOUT 6
                      PASS_REGULAR_EXPRESSION "--out: empty.*exit=2")
 
 # Mesh files: a folder and a number beyond a double were "internal error, please report".
-sf_gsa_cli_test(bad.mesh_folder COMMAND analyse ${grid} --out ${out} --no-plots --mesh data/gsa EXIT 1
+sf_gsa_cli_test(bad.mesh_folder COMMAND analyse ${grid} --out ${out}/mesh_folder --no-plots --mesh data/gsa EXIT 1
                 STDERR "data/gsa: is a folder" STDERR_NOT "internal error")
 file(WRITE ${SF_BAD_DIR}/mesh_1e400.json
      "{\"nodes\": [[-50,-50,0],[50,-50,0],[-50,50,1e400],[50,50,0]], \"elements\": [[0,1,2,3]]}\n")
-sf_gsa_cli_test(bad.mesh_number_overflow COMMAND analyse ${grid} --out ${out} --no-plots
+sf_gsa_cli_test(bad.mesh_number_overflow COMMAND analyse ${grid} --out ${out}/mesh_number_overflow --no-plots
                 --mesh ${SF_BAD_DIR}/mesh_1e400.json EXIT 1 STDERR "mesh_1e400.json.*1e400" STDERR_NOT "internal error")
 # A user mesh that covers a small part of the marks: a warning with the count.
 file(WRITE ${SF_BAD_DIR}/mesh_small.json
@@ -54,7 +54,7 @@ sf_gsa_cli_test(bad.triangles_nothing COMMAND analyse ${SF_BAD_DIR}/no_triangles
 # A 2 MB header line is not echoed whole.
 string(REPEAT "a" 2000000 long_header)
 file(WRITE ${SF_BAD_DIR}/long_header.csv "id,${long_header},x\n1,2,3\n")
-sf_gsa_cli_test(bad.long_header COMMAND analyse ${SF_BAD_DIR}/long_header.csv --out ${out} --no-plots EXIT 1
+sf_gsa_cli_test(bad.long_header COMMAND analyse ${SF_BAD_DIR}/long_header.csv --out ${out}/long_header --no-plots EXIT 1
                 STDERR "characters left out")
 
 # simform case files.

@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <utility>
 
@@ -125,6 +127,16 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
   const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
   const double band = options_.band > 0.0 ? options_.band : kBand * slave_.thickness();
   const double engage = engage_gap();
+  // SF_CONTACT_TRACE=1: at every tangent assembly (once per Newton iteration) the
+  // points whose normal status changed since the last one, on stderr.
+  static const bool trace = std::getenv("SF_CONTACT_TRACE") != nullptr;
+  const bool tracing = trace && tangent;
+  std::vector<signed char> status;
+  std::vector<Eigen::Vector4d> where;  // x, y, z, gap of each point
+  if (tracing) {
+    status.assign(static_cast<std::size_t>(n_points()), -1);
+    where.assign(static_cast<std::size_t>(n_points()), Eigen::Vector4d::Zero());
+  }
   std::vector<PairBlock> blocks;
   for (Index f = 0; f < slave_.n_faces(); ++f) {
     const SurfaceFace& sf = slave_.face(f);
@@ -186,6 +198,10 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       rec.partner = true;
       rec.gap = k.gap;
       rec.normal = k.normal;
+      if (tracing) {
+        status[id] = law.normal.pressure <= 0.0 ? 0 : law.normal.stiffness >= options_.normal.stiffness ? 2 : 1;
+        where[id] = Eigen::Vector4d(xs.x(), xs.y(), xs.z(), k.gap);
+      }
       const bool contributes = law.normal.pressure > 0.0 || law.normal.stiffness > 0.0 ||
                                (pr.have && (law.viscous > 0.0 || (law.coulomb > 0.0 && law.normal.pressure > 0.0)));
       if (!contributes) {
@@ -230,6 +246,24 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
         sums->energy += options_.half_pass ? 0.5 * b.local.energy : b.local.energy;
         scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, options_.half_pass, *sums);
       }
+  }
+  if (tracing) {
+    int count[4] = {0, 0, 0, 0}, changed = 0;
+    std::ostringstream os;
+    os.precision(4);
+    for (std::size_t i = 0; i < status.size(); ++i) {
+      ++count[status[i] + 1];
+      // No partner and open carry no force alike: a point between them has not changed.
+      if (trace_status_.size() != status.size() ||
+          std::max<signed char>(trace_status_[i], 0) == std::max<signed char>(status[i], 0))
+        continue;
+      if (++changed <= 6)
+        os << " [" << static_cast<int>(trace_status_[i]) << ">" << static_cast<int>(status[i]) << " x " << where[i][0]
+           << " y " << where[i][1] << " z " << where[i][2] << " g " << where[i][3] << "]";
+    }
+    std::fprintf(stderr, "contact %s: none %d open %d band %d closed %d; changed %d%s\n", name_.c_str(), count[0],
+                 count[1], count[2], count[3], changed, os.str().c_str());
+    trace_status_ = std::move(status);
   }
 }
 

@@ -157,6 +157,9 @@ class SurfaceContact : public Interaction {
   bool shear_known_ = false;                               // shear_ holds the last committed state
   double dissipated_ = 0.0;
   int updates_ = 0;
+  // SF_CONTACT_TRACE=1: each point's normal status (-1 no partner, 0 open, 1 in the
+  // band, 2 closed) at the last tangent assembly, to report the points that changed.
+  mutable std::vector<signed char> trace_status_;
 };
 
 }  // namespace sf::forming

@@ -368,6 +368,8 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       rec.failure = "linear solve " + sr.brief();
       return;
     }
+    if (trace)
+      std::fprintf(stderr, "newton:   tangent: %s, negative pivots %d\n", sr.brief().c_str(), sr.negative_pivots);
     const VecX dxf = solver_->solve(-rf);
     ++rec.iterations;
     if (!dxf.allFinite()) {

@@ -25,6 +25,22 @@ double median_of(std::vector<double> v) {
 // Median of a chi distribution with k degrees of freedom (|e| of k unit normals).
 double chi_median(int k) { return k == 1 ? 0.674490 : 1.538172; }
 
+// Working storage of deviation(), one per thread (thread_local below): the matrices keep
+// their size from point to point, so a check of 1e6 points does not allocate a dozen
+// small heap blocks per fit. The same Eigen types and expressions as with fresh
+// matrices, so the same operations in the same order: the deviations are the same bits.
+struct DeviationWork {
+  MatX A, b, ata, atb, c;
+  VecX e0;
+  Eigen::LDLT<MatX> ldlt;
+  std::vector<Index> others;  // a neighbour's neighbours without the candidate
+};
+
+DeviationWork& deviation_work() {
+  thread_local DeviationWork work;
+  return work;
+}
+
 // Leave-one-out deviation of point p from the local quadratic of its neighbours.
 double deviation(const Points3& X, const Points3& v, Index p, const std::vector<Index>& nb, bool normal_only) {
   const Index k = static_cast<Index>(nb.size());
@@ -44,8 +60,11 @@ double deviation(const Points3& X, const Points3& v, Index p, const std::vector<
   const Vec3 n = es.eigenvectors().col(0), t1 = es.eigenvectors().col(2), t2 = es.eigenvectors().col(1);
   // Quadratic with >= 10 neighbours, else linear; coordinates scaled to O(1).
   const int terms = k >= 10 ? 6 : 3;
-  MatX A(k, terms);
-  MatX b(k, normal_only ? 1 : 3);
+  DeviationWork& w = deviation_work();
+  MatX& A = w.A;
+  MatX& b = w.b;
+  A.resize(k, terms);
+  b.resize(k, normal_only ? 1 : 3);
   for (Index i = 0; i < k; ++i) {
     const Index q = nb[static_cast<std::size_t>(i)];
     const Vec3 d = X.row(q).transpose() - X.row(p).transpose();
@@ -63,26 +82,27 @@ double deviation(const Points3& X, const Points3& v, Index p, const std::vector<
     else
       b.row(i) = v.row(q) - v.row(p);  // relative to the point: the prediction is then -deviation
   }
-  const MatX ata = A.transpose() * A;
-  const Eigen::LDLT<MatX> ldlt(ata);
+  w.ata.noalias() = A.transpose() * A;
+  const Eigen::LDLT<MatX>& ldlt = w.ldlt.compute(w.ata);
   if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-10)) return std::numeric_limits<double>::quiet_NaN();
-  const MatX c = ldlt.solve(A.transpose() * b);
+  w.atb.noalias() = A.transpose() * b;
+  w.c = ldlt.solve(w.atb);
   // Standardised: the prediction c0 carries noise of variance v0 sigma^2 on top of
   // the point's own (v0 = (A^T A)^-1_00: larger at gaps and at the outline).
-  const VecX e0 = ldlt.solve(VecX::Unit(terms, 0));
-  return c.row(0).norm() / std::sqrt(1.0 + e0[0]);
+  w.e0 = ldlt.solve(VecX::Unit(terms, 0));
+  return w.c.row(0).norm() / std::sqrt(1.0 + w.e0[0]);
 }
 
-// The first `k` of `candidates` (nearest first) neither flagged nor `left_out`.
-std::vector<Index> nearest_unflagged(const std::vector<Index>& candidates, const std::vector<bool>& flagged, int k,
-                                     Index left_out = -1) {
-  std::vector<Index> nb;
+// The first `k` of `candidates` (nearest first) neither flagged nor `left_out`, into `nb`
+// (its storage reused).
+void nearest_unflagged(const std::vector<Index>& candidates, const std::vector<bool>& flagged, int k,
+                       std::vector<Index>& nb, Index left_out = -1) {
+  nb.clear();
   nb.reserve(static_cast<std::size_t>(k));
   for (Index q : candidates) {
     if (static_cast<int>(nb.size()) == k) break;
     if (q != left_out && !flagged[static_cast<std::size_t>(q)]) nb.push_back(q);
   }
-  return nb;
 }
 
 }  // namespace
@@ -139,7 +159,7 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
       if (pass > 0 &&
           std::none_of(nb[pp].begin(), nb[pp].end(), [&](Index q) { return out.flagged[static_cast<std::size_t>(q)]; }))
         return;
-      nb[pp] = nearest_unflagged(candidates[pp], out.flagged, o.neighbours);
+      nearest_unflagged(candidates[pp], out.flagged, o.neighbours, nb[pp]);
       out.deviation[pp] = X.row(p).allFinite() ? deviation(X, values, p, nb[pp], normal_only)
                                                : std::numeric_limits<double>::quiet_NaN();
     });
@@ -169,8 +189,8 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
       // neighbours' local fits towards itself).
       std::vector<double> around;
       for (Index q : nb[static_cast<std::size_t>(p)]) {
-        const std::vector<Index> others =
-            nearest_unflagged(candidates[static_cast<std::size_t>(q)], out.flagged, o.neighbours, p);
+        std::vector<Index>& others = deviation_work().others;
+        nearest_unflagged(candidates[static_cast<std::size_t>(q)], out.flagged, o.neighbours, others, p);
         const double eq = deviation(X, values, q, others, normal_only);
         if (std::isfinite(eq)) around.push_back(eq);
         if (around.size() == 8) break;

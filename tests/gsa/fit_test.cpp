@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/core/parallel.hpp"
 #include "common/fe/surface_field.hpp"
 #include "common/mesh/surface_mesh.hpp"
 #include "gsa/fit.hpp"
@@ -223,6 +224,35 @@ TEST(GsaFit, ZeroWeightsAndPairsOfPenalties) {
   const FitResult sa = system.solve(a, p.zero_reference()), sb = system.solve(b, p.zero_reference());
   EXPECT_LT((pair[0].parameters - sa.parameters).cwiseAbs().maxCoeff(), kExactField);
   EXPECT_LT((pair[1].parameters - sb.parameters).cwiseAbs().maxCoeff(), kExactField);
+}
+
+// The fits' factorisations are CHOLMOD's supernodal ones, through the serial OpenBLAS,
+// which gives wrong numbers when two threads call it at once: a pair on two threads
+// must be the same bits as the same fits one at a time, pair after pair (the two
+// factorisations take turns; everything else runs side by side).
+TEST(GsaFit, PairsOnTwoThreadsAreTheSameBitsAsOneAtATime) {
+  const Problem p;
+  const MatX values = p.values(random_bicubic(test::kSeed + 6));
+  FitSystem together(p.mesh, p.penalties, p.at, VecX()), alone(p.mesh, p.penalties, p.at, VecX());
+  together.set_values(values);
+  alone.set_values(values);
+  struct TwoThreads {
+    TwoThreads() { set_default_threads(2); }
+    ~TwoThreads() { set_default_threads(0); }
+  } two;
+  for (int k = 0; k < 12; ++k) {
+    Penalty a, b;
+    a.delta = std::pow(10.0, -2.0 + 0.5 * k);
+    b.delta = 3.0 * a.delta;
+    b.boundary = 10.0 * b.delta;
+    const std::array<FitResult, 2> pair = together.solve_pair({a, b}, p.zero_reference(), 4, 2);
+    const FitResult sa = alone.solve(a, p.zero_reference(), 4, 2), sb = alone.solve(b, p.zero_reference(), 4, 2);
+    ASSERT_TRUE(pair[0].ok && pair[1].ok && sa.ok && sb.ok);
+    EXPECT_TRUE(pair[0].parameters == sa.parameters) << "pair " << k << ", first";
+    EXPECT_TRUE(pair[1].parameters == sb.parameters) << "pair " << k << ", second";
+    EXPECT_EQ(pair[0].edf, sa.edf) << "pair " << k;
+    EXPECT_EQ(pair[1].edf, sb.edf) << "pair " << k;
+  }
 }
 
 // Too few points for the mesh and no smoothing: the fit reports a singular system (a

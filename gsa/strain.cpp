@@ -22,13 +22,22 @@ std::optional<SurfaceStrain> surface_strain(const Mat32& G, const Mat32& g) {
   SurfaceStrain s;
   s.lambda1 = std::sqrt(l2[1]);
   s.lambda2 = std::sqrt(l2[0]);
-  const Vec2 v1 = es.eigenvectors().col(1), v2 = es.eigenvectors().col(0);
+  // A principal direction is an axis; the eigen solver's sign of v is whatever round-off
+  // gives, so on symmetric data neighbouring marks could point opposite ways. Convention:
+  // the major direction on the deformed surface points to +x (to +y where it is across x,
+  // then +z), and (major, minor, normal) is right-handed on each surface.
+  Vec2 v1 = es.eigenvectors().col(1), v2 = es.eigenvectors().col(0);
+  s.normal_undeformed = G.col(0).cross(G.col(1)).normalized();
+  s.normal_deformed = g.col(0).cross(g.col(1)).normalized();
+  const Vec3 d1 = (g * v1).normalized();
+  constexpr double kAcross = 1e-9;  // a component this small is taken as 0
+  const int lead = std::abs(d1.x()) > kAcross ? 0 : std::abs(d1.y()) > kAcross ? 1 : 2;
+  if (d1(lead) < 0.0) v1 = -v1;
+  if ((g * v1).cross(g * v2).dot(s.normal_deformed) < 0.0) v2 = -v2;
   s.dir1_deformed = (g * v1).normalized();
   s.dir2_deformed = (g * v2).normalized();
   s.dir1_undeformed = (G * v1).normalized();
   s.dir2_undeformed = (G * v2).normalized();
-  s.normal_undeformed = G.col(0).cross(G.col(1)).normalized();
-  s.normal_deformed = g.col(0).cross(g.col(1)).normalized();
   return s;
 }
 

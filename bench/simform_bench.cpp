@@ -6,6 +6,9 @@
 //   build/bin/simform_bench --factorisation N PLIES [repeats]   (orderings, CHOLMOD variants)
 //   build/bin/simform_bench --case N PLIES [repeats]            (one line of the table)
 //   build/bin/simform_bench --shear-stretch CASE.yaml
+//   --lu KIND (with any of the above): the tangent stored with both triangles and factorised
+//   as an unsymmetric tangent is (forming/solve/tangent_solver.hpp): auto (MUMPS's LU, checked,
+//   UMFPACK without MUMPS) or umfpack; the Newton tangents of the static solves stay symmetric
 //
 // For n x n bricks per ply (n = 10, 20, 40) and 1 or 4 plies (100 x 100 x 0.25 mm,
 // compressible transversely isotropic law, fibres 0/90/0/90, stacked as separate bodies:
@@ -123,6 +126,11 @@ void factorisation_study(const linalg::SparseMatrix& k, int repeats) {
     }
 }
 
+// --lu KIND: the tangent stored with both triangles and factorised as an unsymmetric one
+// would be (TangentSolver(KIND, unsymmetric)): "auto" (MUMPS's LU, UMFPACK without MUMPS)
+// or "umfpack". Empty: the symmetric path (Cholesky).
+std::string g_lu;
+
 int run_case(int n, int plies, int repeats, bool study = false) {
   Model model;
   for (int k = 0; k < plies; ++k) {
@@ -159,7 +167,8 @@ int run_case(int n, int plies, int repeats, bool study = false) {
   VecX x = X;
   for (Index p = 0; p < nd / 3; ++p) x(3 * p) *= kStretch;
 
-  TangentSolver solver(linalg::SolverKind::kAuto, false);
+  const bool unsym = !g_lu.empty();
+  TangentSolver solver(unsym ? linalg::parse_solver_kind(g_lu, "--lu") : linalg::SolverKind::kAuto, unsym);
   auto t0 = std::chrono::steady_clock::now();
   linalg::PatternAssembler pattern = model.make_pattern(is_free, solver.lower());
   const double layout_s = seconds_since(t0);
@@ -206,6 +215,8 @@ int run_case(int n, int plies, int repeats, bool study = false) {
   linalg::SolveReport first = solver.factorize(pattern.matrix());
   const double first_s = seconds_since(t0);
   if (!first.ok()) std::printf("# factorisation failed: %s\n", first.brief().c_str());
+  if (unsym)
+    std::printf("# --lu %s: %s (%s)\n", g_lu.c_str(), linalg::to_string(first.used).c_str(), first.ordering.c_str());
   const double analyse_s = first.analyze_seconds;
   double flops = first.factor_flops;
   const double fact_s = median_time(repeats, [&] { flops = solver.factorize(pattern.matrix()).factor_flops; });
@@ -280,6 +291,19 @@ int run_shear_stretch(const std::string& path) {
 int main(int argc, char** argv) {
   keep_freed_memory();  // as simform does (common/core/memory.hpp)
   try {
+    // --lu KIND anywhere: taken out of the arguments, passed on to the cases.
+    std::vector<char*> args;
+    for (int i = 0; i < argc; ++i) {
+      if (std::strcmp(argv[i], "--lu") == 0 && i + 1 < argc) {
+        g_lu = argv[++i];
+        linalg::parse_solver_kind(g_lu, "--lu");  // a bad name fails here, with the accepted ones
+        continue;
+      }
+      args.push_back(argv[i]);
+    }
+    argc = static_cast<int>(args.size());
+    argv = args.data();
+    const std::string lu_arg = g_lu.empty() ? std::string() : " --lu " + g_lu;
     if (argc >= 4 && std::strcmp(argv[1], "--case") == 0)
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);
     if (argc >= 4 && std::strcmp(argv[1], "--factorisation") == 0)
@@ -294,10 +318,13 @@ int main(int argc, char** argv) {
         kL, kL, kH, tp.mu_T, tp.mu_L, tp.kappa_f, tp.lambda);
     std::printf(
         "# element loop on %d threads (OpenMP; SF_THREADS), kernel vector instructions: %s (processor's best: %s); "
-        "linear solver: CHOLMOD supernodal Cholesky, MUMPS LDL^T when indefinite (UMFPACK LU without MUMPS)\n"
+        "linear solver: %s\n"
         "# BLAS: %s\n",
         sf::default_threads(), linalg::to_string(linalg::kernel_isa()).c_str(),
-        linalg::to_string(linalg::best_kernel_isa()).c_str(), linalg::blas_description().c_str());
+        linalg::to_string(linalg::best_kernel_isa()).c_str(),
+        g_lu.empty() ? "CHOLMOD supernodal Cholesky, MUMPS LDL^T when indefinite (UMFPACK LU without MUMPS)"
+                     : ("--lu " + g_lu + ": the tangent as an unsymmetric one (both triangles, LU)").c_str(),
+        linalg::blas_description().c_str());
     std::printf(
         "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
         repeats);
@@ -309,8 +336,8 @@ int main(int argc, char** argv) {
     for (int n : {10, 20, 40}) {
       if (n > max_n) break;
       for (int plies : {1, 4}) {
-        const std::string cmd =
-            "'" + self + "' --case " + std::to_string(n) + " " + std::to_string(plies) + " " + std::to_string(repeats);
+        const std::string cmd = "'" + self + "' --case " + std::to_string(n) + " " + std::to_string(plies) + " " +
+                                std::to_string(repeats) + lu_arg;
         if (std::system(cmd.c_str()) != 0) std::printf("# case %dx%d, %d plies failed\n", n, n, plies);
       }
     }

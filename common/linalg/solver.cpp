@@ -95,6 +95,8 @@ class Backend {
   virtual void set_refinement(bool) {}
   // Negative pivots of the last symmetric indefinite factorisation (-1: not known).
   virtual int negative_pivots() const { return -1; }
+  // Working memory allowed a factorisation, megabytes (0: no limit; MUMPS only).
+  virtual void set_memory_limit(int) {}
 };
 
 // OpenBLAS's thread control, looked up at run time (any BLAS may be installed as
@@ -328,21 +330,17 @@ class UmfpackBackend final : public Backend {
 // The analysis (ordering, elimination tree) is kept while the pattern stays; each
 // factorisation passes the values only. Every call runs inside a BlasSection: MUMPS's dense
 // kernels are BLAS calls, like CHOLMOD's supernodal ones.
+// Controls other than the ordering and ICNTL(14) are MUMPS's defaults, measured on the dome's
+// 10584-unknown tangent with the LU (processor seconds of one factorisation, analysis kept;
+// data/forming/processes/README.md): ICNTL(7) = 7 picks SCOTCH (16.6 Gflop, 0.65 s; AMD and
+// QAMD 22.5 Gflop, 0.80-0.84 s; PORD 19.8 Gflop, 0.73-0.76 s); ICNTL(6) (matching) and
+// ICNTL(8) (scaling) off changed the time within the noise (0.60-0.67 s); ICNTL(10) = 2
+// (MUMPS's iterative refinement) doubled the solve for a residual already at 1e-13 (the
+// tangent solver checks each solution itself); ICNTL(24) = 1 (null-pivot detection)
+// found none; ICNTL(14) = 20 against 30 left the peak memory unchanged (616 / 618 MB).
 class MumpsBackend final : public Backend {
  public:
-  explicit MumpsBackend(bool symmetric) : symmetric_(symmetric), id_(std::make_unique<DMUMPS_STRUC_C>()) {
-    *id_ = DMUMPS_STRUC_C{};
-    id_->comm_fortran = kUseCommWorld;
-    id_->par = 1;  // the host works (the only process)
-    id_->sym = symmetric_ ? 2 : 0;
-    call(-1);
-    initialised_ = id_->infog[0] >= 0;
-    if (!initialised_) return;
-    icntl(1) = -1;  // no error, diagnostic, global or statistics output
-    icntl(2) = -1;
-    icntl(3) = -1;
-    icntl(4) = 0;
-  }
+  explicit MumpsBackend(bool symmetric) : symmetric_(symmetric), id_(std::make_unique<DMUMPS_STRUC_C>()) { start(); }
   ~MumpsBackend() override {
     if (initialised_) call(-2);
   }
@@ -357,7 +355,16 @@ class MumpsBackend final : public Backend {
   }
 
   Outcome analyze(const SparseMatrix& a) override {
+    if (initialised_ && analysed_) {
+      // A new pattern (contact grew it): MUMPS's instance ended and started afresh, so the
+      // old factors and workspace are freed before the new analysis sizes larger ones (else
+      // they were reallocated at the next factorisation while the old ones were still held).
+      call(-2);
+      initialised_ = false;
+      start();
+    }
     if (!initialised_) return {Status::kFailed, "MUMPS initialisation failed"};
+    analysed_ = true;
     const int n = static_cast<int>(a.rows());
     rows_.clear();
     cols_.clear();
@@ -408,6 +415,7 @@ class MumpsBackend final : public Backend {
       id_->a = values_.data();
     }
     icntl(14) = kWorkspacePercent;
+    icntl(23) = memory_limit_mb_;
     for (int attempt = 0;; ++attempt) {
       call(2);
       const int code = id_->infog[0];
@@ -443,12 +451,26 @@ class MumpsBackend final : public Backend {
   double factor_nonzeros() const override { return entries_; }
   std::string ordering_used() const override { return ordering_; }
   int negative_pivots() const override { return negative_pivots_; }
+  void set_memory_limit(int megabytes) override { memory_limit_mb_ = megabytes; }
 
  private:
   static constexpr int kUseCommWorld = -987654;  // MUMPS's code for MPI_COMM_WORLD
   static constexpr int kWorkspacePercent = 30;   // ICNTL(14): extra workspace for delayed pivots
 
   MUMPS_INT& icntl(int i) { return id_->icntl[i - 1]; }
+  void start() {
+    *id_ = DMUMPS_STRUC_C{};
+    id_->comm_fortran = kUseCommWorld;
+    id_->par = 1;  // the host works (the only process)
+    id_->sym = symmetric_ ? 2 : 0;
+    call(-1);
+    initialised_ = id_->infog[0] >= 0;
+    if (!initialised_) return;
+    icntl(1) = -1;  // no error, diagnostic, global or statistics output
+    icntl(2) = -1;
+    icntl(3) = -1;
+    icntl(4) = 0;
+  }
   int infog(int i) const { return id_->infog[i - 1]; }
   double rinfog(int i) const { return id_->rinfog[i - 1]; }
   void call(int job) const {
@@ -459,18 +481,21 @@ class MumpsBackend final : public Backend {
   Outcome failure(const char* what) const {
     const int code = infog(1);
     return {Status::kFailed, fmt::format("MUMPS {} failed (INFOG(1) = {}, INFOG(2) = {}{})", what, code, infog(2),
-                                         code == -13  ? ": out of memory"
-                                         : code == -6 ? ": structurally singular"
-                                                      : "")};
+                                         code == -13   ? ": out of memory"
+                                         : code == -19 ? ": working memory above the limit set (ICNTL(23))"
+                                         : code == -6  ? ": structurally singular"
+                                                       : "")};
   }
 
   bool symmetric_ = false;
   bool initialised_ = false;
+  bool analysed_ = false;               // an analysis was made by this instance of MUMPS
   std::unique_ptr<DMUMPS_STRUC_C> id_;  // MUMPS's state (large); solve() changes only its rhs fields
   std::vector<MUMPS_INT> rows_, cols_;  // 1-based coordinates of the entries passed
   std::vector<int> take_;               // their positions in A's values (empty: all, in order)
   std::vector<double> values_;
   int ordering_choice_ = 7;
+  int memory_limit_mb_ = 0;  // ICNTL(23): 0, MUMPS's own estimate (no limit)
   std::string ordering_;
   double flops_ = 0.0;
   double entries_ = 0.0;
@@ -809,6 +834,12 @@ void LinearSolver::set_ordering(Ordering ordering) {
 void LinearSolver::set_refinement(bool on) {
   SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
   impl_->backend->set_refinement(on);
+}
+
+void LinearSolver::set_memory_limit(int megabytes) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  SF_ASSERT(megabytes >= 0, "memory limit must be >= 0");
+  impl_->backend->set_memory_limit(megabytes);
 }
 
 Ordering LinearSolver::ordering() const {

@@ -183,6 +183,10 @@ class LinearSolver {
   // with A and another pair of triangular solves; ignored by the other back ends). Off
   // for a preconditioner, whose solves need not be exact: a third of the solve's cost.
   void set_refinement(bool on);
+  // Working memory a numeric factorisation may use, megabytes (MUMPS's ICNTL(23); 0, the
+  // default: as much as its analysis estimates; ignored by the other back ends). A
+  // factorisation that would need more fails (kFailed) rather than swap.
+  void set_memory_limit(int megabytes);
 
   // Numeric factorisation of a. Analyses first when no analysis exists or when
   // a's pattern (size, column pointers, row indices) differs from the analysed

@@ -30,7 +30,12 @@ std::string solve_profile_linear_summary(const SolveProfile& p) {
               : fmt::format("; indefinite: {} LDL^T factorisations, worst |K dx - b|/|b| {:.2g}, {} refinement "
                             "steps, {} residual fallbacks to LU",
                             p.indefinite_factorizations, p.indefinite_worst_residual, p.residual_refinements,
-                            p.residual_fallbacks));
+                            p.residual_fallbacks)) +
+         (p.lu_checked_solves == 0 && p.lu_fallbacks == 0
+              ? std::string()
+              : fmt::format("; LU: {} checked solves, worst |K dx - b|/|b| {:.2g}, {} refinement steps, {} "
+                            "fallbacks to UMFPACK",
+                            p.lu_checked_solves, p.lu_worst_residual, p.lu_refinements, p.lu_fallbacks));
 }
 
 }  // namespace sf::forming

@@ -54,6 +54,14 @@ struct SolveProfile {
   long residual_refinements = 0;
   long residual_fallbacks = 0;
   double indefinite_worst_residual = 0.0;
+  // Direct solves of an unsymmetric tangent by MUMPS's LU (the default when MUMPS is built
+  // in; forming/solve/tangent_solver.hpp): solves checked, refinement steps they took, the
+  // largest |K dx - b|/|b| they ended with, and the factorisations or solves that went to
+  // UMFPACK instead (MUMPS failed, or a solution failed its check).
+  long lu_checked_solves = 0;
+  long lu_refinements = 0;
+  double lu_worst_residual = 0.0;
+  long lu_fallbacks = 0;
   void reset() { *this = SolveProfile{}; }
 };
 

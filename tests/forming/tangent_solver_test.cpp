@@ -213,3 +213,114 @@ INSTANTIATE_TEST_SUITE_P(OnOff, BandPattern, ::testing::Values(true, false),
 
 }  // namespace
 }  // namespace sf::forming
+
+namespace sf::forming {
+namespace {
+
+// The unsymmetric tangent of the small dome (viscous inter-ply slip between x0 and x1)
+// with both triangles, the way the Newton loop stores it for an unsymmetric solver.
+struct UnsymmetricDomeTangent {
+  SmallDome d;
+  linalg::PatternAssembler pa;
+  UnsymmetricDomeTangent() : pa(d.problem.model.make_pattern(d.is_free, false)) {
+    EXPECT_TRUE(d.problem.model.assemble_into(d.x1, d.context, &pa).ok);
+  }
+  const linalg::SparseMatrix& k() const { return pa.matrix(); }
+  double asymmetry() const {
+    const linalg::SparseMatrix kt = k().transpose();
+    return linalg::SparseMatrix(k() - kt).norm() / k().norm();
+  }
+  // UMFPACK's solution (the LU of builds without MUMPS and of main before MUMPS's LU).
+  Eigen::VectorXd umfpack_solution(const Eigen::VectorXd& b) const {
+    TangentSolver umfpack(linalg::SolverKind::kUmfpack, true);
+    EXPECT_TRUE(umfpack.factorize(k()).ok());
+    return umfpack.solve(b).col(0);
+  }
+};
+
+// kAuto with an unsymmetric tangent: MUMPS's LU when it is built in, the solution checked
+// and the same as UMFPACK's; a second tangent of the same pattern keeps the analysis.
+TEST(FormingTangentSolver, UnsymmetricTangentIsFactorisedByMumpsLuWithUmfpacksAnswer) {
+  if (!linalg::solver_available(linalg::SolverKind::kMumps) || !linalg::solver_available(linalg::SolverKind::kUmfpack))
+    GTEST_SKIP() << "this build has no MUMPS or no UMFPACK";
+  const UnsymmetricDomeTangent t;
+  ASSERT_GT(t.asymmetry(), 1e-8) << "the test needs an unsymmetric tangent";
+  const Eigen::VectorXd b = smooth_rhs(t.k().rows());
+  solve_profile().reset();
+  TangentSolver solver(linalg::SolverKind::kAuto, true);
+  EXPECT_FALSE(solver.lower());
+  const linalg::SolveReport& r = solver.factorize(t.k());
+  ASSERT_TRUE(r.ok()) << r.brief();
+  EXPECT_EQ(r.used, linalg::SolverKind::kMumps);
+  ASSERT_NE(solver.active(), nullptr);
+  EXPECT_EQ(solver.active()->kind(), linalg::SolverKind::kMumps);
+  const Eigen::VectorXd x = solver.solve(b).col(0);
+  EXPECT_LT(relative_residual(t.k(), linalg::Storage::kFull, x, b), TangentSolver::kResidualTolerance);
+  const Eigen::VectorXd y = t.umfpack_solution(b);
+  EXPECT_LT((x - y).norm(), 1e-9 * y.norm());
+  EXPECT_EQ(solver.n_lu_fallbacks(), 0);
+  EXPECT_EQ(solve_profile().lu_checked_solves, 1);
+  EXPECT_EQ(solve_profile().lu_fallbacks, 0);
+  // The next iteration's tangent (same pattern, other values): the analysis is kept.
+  linalg::PatternAssembler pa = t.d.problem.model.make_pattern(t.d.is_free, false);
+  ASSERT_TRUE(t.d.problem.model.assemble_into(t.d.x0, t.d.context, &pa).ok);
+  ASSERT_EQ(pa.matrix().nonZeros(), t.k().nonZeros());
+  const linalg::SolveReport& r2 = solver.factorize(pa.matrix());
+  ASSERT_TRUE(r2.ok()) << r2.brief();
+  EXPECT_TRUE(r2.reused_analysis);
+  EXPECT_EQ(r2.used, linalg::SolverKind::kMumps);
+  EXPECT_LT(relative_residual(pa.matrix(), linalg::Storage::kFull, solver.solve(b).col(0), b),
+            TangentSolver::kResidualTolerance);
+}
+
+// A MUMPS factorisation that fails (here: its working memory limited to 1 MB, far below
+// what the tangent needs) is done by UMFPACK, with the same answer.
+TEST(FormingTangentSolver, FailedMumpsLuFallsBackToUmfpack) {
+  if (!linalg::solver_available(linalg::SolverKind::kMumps) || !linalg::solver_available(linalg::SolverKind::kUmfpack))
+    GTEST_SKIP() << "this build has no MUMPS or no UMFPACK";
+  const UnsymmetricDomeTangent t;
+  const Eigen::VectorXd b = smooth_rhs(t.k().rows());
+  solve_profile().reset();
+  TangentSolver solver(linalg::SolverKind::kAuto, true);
+  ASSERT_NE(solver.checked_lu(), nullptr);
+  solver.checked_lu()->set_memory_limit(1);
+  const linalg::SolveReport& r = solver.factorize(t.k());
+  ASSERT_TRUE(r.ok()) << r.brief();
+  EXPECT_EQ(r.used, linalg::SolverKind::kUmfpack);
+  EXPECT_EQ(solver.checked_lu()->last_report().status, linalg::SolveReport::Status::kFailed);
+  EXPECT_NE(solver.checked_lu()->last_report().message.find("ICNTL(23)"), std::string::npos)
+      << solver.checked_lu()->last_report().message;
+  EXPECT_EQ(solver.n_lu_fallbacks(), 1);
+  EXPECT_EQ(solve_profile().lu_fallbacks, 1);
+  const Eigen::VectorXd x = solver.solve(b).col(0);
+  EXPECT_EQ(solver.active()->kind(), linalg::SolverKind::kUmfpack);
+  EXPECT_EQ(solve_profile().lu_checked_solves, 0) << "UMFPACK's solutions are not checked";
+  EXPECT_LT((x - t.umfpack_solution(b)).norm(), 1e-12 * x.norm());
+  // Without the limit the next factorisation is MUMPS's again.
+  solver.checked_lu()->set_memory_limit(0);
+  ASSERT_TRUE(solver.factorize(t.k()).ok());
+  EXPECT_EQ(solver.active()->kind(), linalg::SolverKind::kMumps);
+}
+
+// A MUMPS solution that fails the residual check (forced: tolerance 0) is redone by
+// UMFPACK's LU of the same tangent, and that one is returned.
+TEST(FormingTangentSolver, MumpsLuSolutionFailingTheCheckGoesToUmfpack) {
+  if (!linalg::solver_available(linalg::SolverKind::kMumps) || !linalg::solver_available(linalg::SolverKind::kUmfpack))
+    GTEST_SKIP() << "this build has no MUMPS or no UMFPACK";
+  const UnsymmetricDomeTangent t;
+  const Eigen::VectorXd b = smooth_rhs(t.k().rows());
+  solve_profile().reset();
+  TangentSolver strict(linalg::SolverKind::kAuto, true);
+  strict.set_residual_tolerance(0.0);
+  ASSERT_TRUE(strict.factorize(t.k()).ok());
+  EXPECT_EQ(strict.active()->kind(), linalg::SolverKind::kMumps);
+  const Eigen::VectorXd x = strict.solve(b).col(0);
+  EXPECT_EQ(strict.n_lu_fallbacks(), 1);
+  EXPECT_EQ(solve_profile().lu_fallbacks, 1);
+  EXPECT_LE(solve_profile().lu_refinements, TangentSolver::kRefinementSteps);
+  EXPECT_EQ(strict.active()->kind(), linalg::SolverKind::kUmfpack);
+  EXPECT_LT((x - t.umfpack_solution(b)).norm(), 1e-12 * x.norm());
+}
+
+}  // namespace
+}  // namespace sf::forming

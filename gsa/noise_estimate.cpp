@@ -172,6 +172,11 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
                               const NoiseEstimate& undeformed) {
   const Index m = marks.size();
   const double d = setup.mark_spacing;
+  // Noise-free reference positions (nominal subset centres of a 2-D DIC export, a printed
+  // grid placed by --pitch): the blank shows no noise, so its correlation length is
+  // unknown, not zero, and the deformed data are the only evidence of it. The ladder then
+  // fits the length too (the blank's bank of lengths, confirmed by the next pilot).
+  const bool free_length = !(undeformed.sigma_total() > 0.0);
   const double length = undeformed.effective_length();
   const VecX& w = problem.weight();
   const std::vector<std::vector<Index>> around = mesh::neighbours_within(marks.undeformed, 3.0 * d);
@@ -182,7 +187,8 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
   // cannot follow leaves bias that looks like noise; lighter pilots leave less of it,
   // while true noise gives the same estimate at every pilot (the shrinkage correction).
   // Independent noise is a correlated one with a length far below the spacing.
-  const ProbeBank bank = make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
+  const ProbeBank bank = free_length ? make_probe_bank(marks.undeformed, d)
+                                     : make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
   // The pairs depend on the points left out only: kept while the same points are usable.
   std::vector<bool> paired;
   std::optional<VariogramPairs> pairs;
@@ -234,7 +240,7 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
     ahead.emplace(k - 1, std::move(lighter));
     return p;
   };
-  return pilot_ladder(4, -1, vo.max_lag, d, false, heaviest_unbiased, [&](int k) -> std::optional<NoiseEstimate> {
+  return pilot_ladder(4, -1, vo.max_lag, d, free_length, heaviest_unbiased, [&](int k) -> std::optional<NoiseEstimate> {
     PilotFits p = fits_of(k);
     if (p.error) std::rethrow_exception(p.error);
     const FitResult& f = p.fit;
@@ -268,6 +274,7 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
       return at;
     };
     NoiseEstimate e = fit_noise_model(*pairs, pairs->gamma(residual, 3), bank, shrink);
+    if (free_length) return e;
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;
     return e;
@@ -279,6 +286,10 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
                              const NoiseEstimate& undeformed) {
   NoiseEstimate e = deformed_ladder(problem, marks, setup, undeformed);
+  // Both states noise-free (a simulated part's virtual marks): round-off, no model (as for
+  // the blank alone, undeformed_noise).
+  if (!(undeformed.sigma_total() > 0.0) && e.sigma_total() <= kNoiseFloor * setup.mark_spacing)
+    e.sigma_correlated = e.sigma_white = e.correlation_length = e.bias_slope = 0.0;
   // The blank's correlated amplitude as a floor: the deformed data hold both states'
   // noise, and the blank's heavy pilots see noise correlated over several spacings, where
   // the light deformed pilots take most of it up themselves and the shrinkage correction

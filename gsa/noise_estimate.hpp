@@ -16,9 +16,14 @@
 // Deformed state: a formed part is not simple, so heavy pilots are biased; its
 // correlation length is taken from the undeformed state (the same measurement, the same
 // image subsets) and only the amplitudes (correlated and independent) are fitted, on
-// light pilots (k = 4 .. 1), leaving out the points whose neighbourhood fits far worse
-// than typical (a neck the pilot cannot follow is misfit, not noise). Taken: the median
-// over the pilots.
+// light pilots (k = 4 .. -1), leaving out the points whose neighbourhood fits far worse
+// than typical (a neck the pilot cannot follow is misfit, not noise). Taken: the heaviest
+// pilot without smooth bias that the next lighter one confirms.
+// A blank without noise (nominal positions: the subset centres of a 2-D DIC export, a
+// grid placed by --pitch) gives no length: the deformed ladder then fits the length as
+// well (the blank's bank of lengths, confirmed as the blank's ladder confirms it). A
+// deformation the pilots cannot follow can pass for long correlated noise there (the
+// DICe coupon's hole, docs/usage.md "Real exports").
 
 #include "common/core/types.hpp"
 #include "gsa/frame_mesh.hpp"

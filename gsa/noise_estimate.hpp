@@ -21,9 +21,10 @@
 // pilot without smooth bias that the next lighter one confirms.
 // A blank without noise (nominal positions: the subset centres of a 2-D DIC export, a
 // grid placed by --pitch) gives no length: the deformed ladder then fits the length as
-// well (the blank's bank of lengths, confirmed as the blank's ladder confirms it). A
-// deformation the pilots cannot follow can pass for long correlated noise there (the
-// DICe coupon's hole, docs/usage.md "Real exports").
+// well, up to 2 spacings, and only an estimate the next lighter pilot confirms counts
+// (else independent noise, as before). Without those limits a deformation the pilots
+// cannot follow passed for long correlated noise (noise-free marks on a wavy part, the
+// DICe coupon's hole: docs/theory/strain.md, "Noise model").
 
 #include "common/core/types.hpp"
 #include "gsa/frame_mesh.hpp"

@@ -72,10 +72,7 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       // over a spacing or more, or neighbouring marks correlated by 0.3 or more (a length
       // estimated just under the spacing: GCV there chose a gauge of 0.6 spacings and
       // 3.3 x the 24-neighbour fit's error on the rubber strip, gsa_realdata_bench).
-      // With noise-free reference positions (nominal DIC subset centres) the blank has no
-      // estimate: the deformed one, whose length is then fitted (gsa/noise_estimate.hpp).
-      const bool correlated = undeformed_noise.sigma_total() > 0.0 ? undeformed_noise.correlated_over(d)
-                                                                    : out.noise.correlated_over(d);
+      const bool correlated = undeformed_noise.correlated_over(d);
       const MatX probes = correlated ? noise_probes(out.noise, marks.undeformed, kCpNoiseProbes) : MatX();
       const double noise_s = seconds_since(tn);
       times.noise += noise_s;

@@ -37,11 +37,6 @@ constexpr double kMisfitFactor = 6.0;
 // An undeformed estimate below this fraction of the mark spacing is round-off, not noise
 // (a measurement quantised to 1 um at 1 mm spacing has 3e-4).
 constexpr double kNoiseFloor = 1e-6;
-// The longest correlation length the deformed data alone may show (spacings), where the
-// blank has no noise: DIC noise is correlated over about a subset, a few steps at most,
-// while a deformation the pilots cannot follow (a curved part, a hole's strain field)
-// passes for noise correlated over many spacings.
-constexpr double kFreeLengthMaxSpacings = 2.0;
 // The deformed data's correlated amplitude is at least sqrt(2) x the blank's: the noise
 // of the two states adds (the same measuring system), the blank's part entering through
 // the marks' surface coordinates.
@@ -73,10 +68,9 @@ bool unbiased(const NoiseEstimate& e, double max_lag) {
 // when the pilot fit fails) is run lazily, heaviest first; taken is the first estimate
 // without smooth bias that the next lighter one confirms, else (`unconfirmed`) the
 // heaviest one without smooth bias or the lightest one run.
-// kNothing: no estimate (nullopt) unless one is confirmed.
-enum class Unconfirmed { kLightest, kHeaviestUnbiased, kNothing };
+enum class Unconfirmed { kLightest, kHeaviestUnbiased };
 template <class Estimate>
-std::optional<NoiseEstimate> pilot_ladder(int heaviest, int lightest, double max_lag, double d, bool length, Unconfirmed unconfirmed,
+NoiseEstimate pilot_ladder(int heaviest, int lightest, double max_lag, double d, bool length, Unconfirmed unconfirmed,
                            const Estimate& estimate) {
   std::optional<NoiseEstimate> heavier, first_unbiased;
   for (int k = heaviest; k >= lightest; --k) {
@@ -86,7 +80,6 @@ std::optional<NoiseEstimate> pilot_ladder(int heaviest, int lightest, double max
     if (!first_unbiased && unbiased(*e, max_lag)) first_unbiased = e;
     heavier = std::move(e);
   }
-  if (unconfirmed == Unconfirmed::kNothing) return std::nullopt;
   if (unconfirmed == Unconfirmed::kHeaviestUnbiased && first_unbiased) return *first_unbiased;
   return heavier ? *heavier : NoiseEstimate{};
 }
@@ -137,7 +130,7 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
   const bool two = default_threads() >= 2;
   std::map<int, std::optional<NoiseEstimate>> ahead;
   const Unconfirmed lightest = Unconfirmed::kLightest;
-  NoiseEstimate e = *pilot_ladder(8, 1, vo.max_lag, d, true, lightest, [&](int k) -> std::optional<NoiseEstimate> {
+  NoiseEstimate e = pilot_ladder(8, 1, vo.max_lag, d, true, lightest, [&](int k) -> std::optional<NoiseEstimate> {
     if (const auto it = ahead.find(k); it != ahead.end()) return it->second;
     if (!two || k - 1 < 1) return estimate(k, 0);
     std::optional<NoiseEstimate> lighter;
@@ -174,11 +167,9 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
 
 namespace {
 
-// The deformed pilots' estimate (deformed_noise below adds the blank's floor); with
-// `free_length`, L fitted too and only a confirmed estimate (else nullopt).
-std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const FitMarks& marks,
-                                             const FrameAndMesh& setup, const NoiseEstimate& undeformed,
-                                             bool free_length) {
+// The deformed pilots' estimate (deformed_noise below adds the blank's floor).
+NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
+                              const NoiseEstimate& undeformed) {
   const Index m = marks.size();
   const double d = setup.mark_spacing;
   const double length = undeformed.effective_length();
@@ -191,8 +182,7 @@ std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const Fit
   // cannot follow leaves bias that looks like noise; lighter pilots leave less of it,
   // while true noise gives the same estimate at every pilot (the shrinkage correction).
   // Independent noise is a correlated one with a length far below the spacing.
-  const ProbeBank bank = free_length ? make_probe_bank(marks.undeformed, d, 0.0, kFreeLengthMaxSpacings)
-                                     : make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
+  const ProbeBank bank = make_probe_bank(marks.undeformed, d, length > 0 ? length : 0.01 * d);
   // The pairs depend on the points left out only: kept while the same points are usable.
   std::vector<bool> paired;
   std::optional<VariogramPairs> pairs;
@@ -202,7 +192,7 @@ std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const Fit
   // it there (measured: a 1 mm neck under noise correlated over 5 spacings, 1.07 x the
   // noise at k = 4, 23 x at k = -1, the lightest, which was taken); true noise gives the
   // same estimate at every pilot, the heaviest one with the least correction.
-  const Unconfirmed heaviest_unbiased = free_length ? Unconfirmed::kNothing : Unconfirmed::kHeaviestUnbiased;
+  const Unconfirmed heaviest_unbiased = Unconfirmed::kHeaviestUnbiased;
   // A pilot's fits: the data's and the probe fields' residuals, from one factorisation in
   // the problem's workspace `slot`. Phi^T W of the probe fields is the same for every
   // pilot (the weights do not change here), formed once; forming it builds the system.
@@ -244,7 +234,7 @@ std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const Fit
     ahead.emplace(k - 1, std::move(lighter));
     return p;
   };
-  return pilot_ladder(4, -1, vo.max_lag, d, free_length, heaviest_unbiased, [&](int k) -> std::optional<NoiseEstimate> {
+  return pilot_ladder(4, -1, vo.max_lag, d, false, heaviest_unbiased, [&](int k) -> std::optional<NoiseEstimate> {
     PilotFits p = fits_of(k);
     if (p.error) std::rethrow_exception(p.error);
     const FitResult& f = p.fit;
@@ -278,7 +268,6 @@ std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const Fit
       return at;
     };
     NoiseEstimate e = fit_noise_model(*pairs, pairs->gamma(residual, 3), bank, shrink);
-    if (free_length) return e;
     if (length <= 0) e.sigma_white = e.sigma_total(), e.sigma_correlated = 0.0;
     e.correlation_length = length;
     return e;
@@ -289,16 +278,7 @@ std::optional<NoiseEstimate> deformed_ladder(DeformedProblem& problem, const Fit
 
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
                              const NoiseEstimate& undeformed) {
-  // Noise-free reference positions (nominal subset centres of a 2-D DIC export, a grid
-  // placed by --pitch): the blank shows no noise, so its correlation length is unknown,
-  // not zero, and the deformed data are the only evidence of it. The ladder then fits the
-  // length too (the blank's bank of lengths), and its estimate counts only where the next
-  // lighter pilot confirms it: true noise gives the same estimate at every pilot, while
-  // the misfit of a deformation the pilots cannot follow (noise-free marks on a curved
-  // part) shrinks with each lighter pilot. Unconfirmed: independent noise, as before.
-  std::optional<NoiseEstimate> free;
-  if (!(undeformed.sigma_total() > 0.0)) free = deformed_ladder(problem, marks, setup, undeformed, true);
-  NoiseEstimate e = free ? *free : *deformed_ladder(problem, marks, setup, undeformed, false);
+  NoiseEstimate e = deformed_ladder(problem, marks, setup, undeformed);
   // The blank's correlated amplitude as a floor: the deformed data hold both states'
   // noise, and the blank's heavy pilots see noise correlated over several spacings, where
   // the light deformed pilots take most of it up themselves and the shrinkage correction

@@ -16,15 +16,9 @@
 // Deformed state: a formed part is not simple, so heavy pilots are biased; its
 // correlation length is taken from the undeformed state (the same measurement, the same
 // image subsets) and only the amplitudes (correlated and independent) are fitted, on
-// light pilots (k = 4 .. -1), leaving out the points whose neighbourhood fits far worse
-// than typical (a neck the pilot cannot follow is misfit, not noise). Taken: the heaviest
-// pilot without smooth bias that the next lighter one confirms.
-// A blank without noise (nominal positions: the subset centres of a 2-D DIC export, a
-// grid placed by --pitch) gives no length: the deformed ladder then fits the length as
-// well, up to 2 spacings, and only an estimate the next lighter pilot confirms counts
-// (else independent noise, as before). Without those limits a deformation the pilots
-// cannot follow passed for long correlated noise (noise-free marks on a wavy part, the
-// DICe coupon's hole: docs/theory/strain.md, "Noise model").
+// light pilots (k = 4 .. 1), leaving out the points whose neighbourhood fits far worse
+// than typical (a neck the pilot cannot follow is misfit, not noise). Taken: the median
+// over the pilots.
 
 #include "common/core/types.hpp"
 #include "gsa/frame_mesh.hpp"

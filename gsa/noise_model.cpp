@@ -309,14 +309,12 @@ std::vector<double> VariogramPairs::gamma_at_rows(const MatX& values, int compon
   return out;
 }
 
-ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length, double max_spacings) {
+ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length) {
   ProbeBank bank;
   if (fixed_length > 0)
     bank.lengths.push_back(fixed_length);
   else
-    for (int k = 0; k <= 12; ++k)
-      if (0.5 * std::pow(16.0, k / 12.0) <= max_spacings * (1.0 + 1e-9))
-        bank.lengths.push_back(spacing * 0.5 * std::pow(16.0, k / 12.0));
+    for (int k = 0; k <= 12; ++k) bank.lengths.push_back(spacing * 0.5 * std::pow(16.0, k / 12.0));
   const Index n = positions.rows();
   const int nl = static_cast<int>(bank.lengths.size());
   bank.probes.resize(n, 3 * (nl + 1));

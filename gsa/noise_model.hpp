@@ -119,9 +119,7 @@ struct ProbeBank {
   std::vector<double> lengths;  // mm
   MatX probes;                  // n x 3 (lengths + 1)
 };
-// max_spacings: the longest trial length (spacings) when the length is not fixed.
-ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length = 0.0,
-                          double max_spacings = 8.0);
+ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed_length = 0.0);
 
 // The noise model whose residuals under a smoother match the residuals' variogram:
 // `smooth_residual(w, rows)` returns (I - H) w for probe data w (n x k) at the points

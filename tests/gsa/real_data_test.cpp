@@ -164,38 +164,6 @@ TEST(GsaRealData, RubberStripWithNoiseCorrelatedOverASpacingIsSmoothed) {
   EXPECT_EQ(without_strain(r), 0);
 }
 
-// Noise-free reference positions, as a 2-D DIC export gives them (DICe, VIC-2D: the
-// nominal subset centres), with all the noise, correlated over one spacing, in the
-// deformed state. The blank shows no noise, so its estimate has no correlation length;
-// the rule used to read that as independent noise and chose GCV, which took the
-// correlated error for signal: gauge 0.74 spacings, 17 x the best fixed smoothing's
-// error and 2.4 x the 24-neighbour fit's (bench/gsa_realdata_bench, stretch_L1.0_ref0,
-// two seeds). Now the deformed estimate fits the length itself and Cp is used: measured
-// (two seeds) L 1.1 spacings, gauge 6.0 spacings, 1.02 x the best fixed smoothing,
-// 0.15 x the local fit. The same points with independent noise stay with GCV.
-TEST(GsaRealData, NoiseFreeReferencePositionsStillSeeCorrelatedNoise) {
-  const PointLayout layout = plate();
-  const double d = layout.spacing;
-  SyntheticMeasurementOptions o = dic_like(layout, 1.0, 1);
-  o.undeformed_noise = NoiseModel{0.0, 0.0, 0.0};
-  const SyntheticMeasurement m = make_measurement(deformation_of(synthetic_case("stretch")), o);
-  const AnalysisResult r = analyse(m.grid, {});
-  EXPECT_EQ(r.noise_undeformed.sigma_total(), 0.0);
-  EXPECT_EQ(r.smoothing_criterion, "Cp");
-  EXPECT_GT(r.noise.effective_length(), 0.6 * d);
-  EXPECT_LT(r.noise.effective_length(), 1.8 * d);
-  EXPECT_GT(r.gauge_length, 2.0 * d);
-  const double e = analysis_rms(m, d, r), e_local = local_fit_rms(m, d);
-  EXPECT_LT(e, 0.5 * e_local) << "surface fit " << e << ", 24-neighbour fit " << e_local;
-  EXPECT_EQ(flagged(r), 0);
-
-  SyntheticMeasurementOptions w = o;
-  w.deformed_noise = NoiseModel{0.0, 0.0, 0.004 * d};
-  const AnalysisResult rw = analyse(make_measurement(deformation_of(synthetic_case("stretch")), w).grid, {});
-  EXPECT_EQ(rw.smoothing_criterion, "GCV");
-  EXPECT_FALSE(rw.noise.correlated_over(d));
-}
-
 // The rule that picks Cp over GCV: independent noise on a grid fits as a short length
 // (0.5-0.7 spacings, correlation at one spacing 0.08-0.16, gsa_accuracy_bench's grid) and
 // stays with GCV; a length just under a spacing with the noise mostly correlated counts.

@@ -120,6 +120,18 @@ std::vector<Study> studies() {
     add("rubber" + tag, neck_deformation(0.23, 0.23, 1.0), rubber, 0.005, corr);
     add("dimple" + tag, dimple_deformation(1.1, 0.95, 0.05, 1.5, 0.0, 0.0), strip, 0.005, corr);
   }
+  // Noise-free reference positions, as a 2-D DIC export gives them (nominal subset
+  // centres): all the noise in the deformed state, none in the blank to estimate from.
+  for (double corr : {0.0, 1.0, 2.5}) {
+    const std::string tag = (corr > 0 ? "_L" + std::to_string(corr).substr(0, 3) : "_white") + "_ref0";
+    const std::size_t first = out.size();
+    add("stretch" + tag, deformation_of(synthetic_case("stretch")), plate, 0.004, corr);
+    add("dome" + tag, deformation_of(synthetic_case("dome")), plate, 0.004, corr);
+    add("neck30" + tag, neck_deformation(0.1, 0.3, 1.0), strip, 0.005, corr);
+    add("neckn30" + tag, neck_deformation(0.1, 0.3, 0.4), strip, 0.005, corr);
+    add("rubber" + tag, neck_deformation(0.23, 0.23, 1.0), rubber, 0.005, corr);
+    for (std::size_t i = first; i < out.size(); ++i) out[i].options.undeformed_noise = NoiseModel{0.0, 0.0, 0.0};
+  }
   return out;
 }
 

@@ -252,13 +252,20 @@ int run_case(int n, int plies, int repeats, bool study = false) {
   return 0;
 }
 
+// Keeps each converged step and shows it on stderr as it comes (a long case otherwise
+// runs minutes without a line).
 class Recorder final : public StepObserver {
  public:
   std::vector<StepInfo> steps;
   StepAction on_step(const StepInfo& step, const SteppingState&, const VecX&) override {
     steps.push_back(step);
+    std::fprintf(stderr, "#   step %d converged: load factor %.3f, %d Newton iterations, %d cut-backs, %.1f s\n",
+                 step.index, step.load_factor, step.iterations, step.cutbacks, seconds_since(t0_));
     return StepAction::kContinue;
   }
+
+ private:
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
 int run_shear_stretch(const std::string& path) {

@@ -1,7 +1,9 @@
 #include "forming/output/history.hpp"
 
+#include <algorithm>
 #include <utility>
 
+#include "common/core/error.hpp"
 #include "forming/model/ply_grid.hpp"
 
 namespace sf::forming {
@@ -65,10 +67,26 @@ HistoryTable::HistoryTable(const Model& model, ToolEdge tool, bool stabilised)
     : model_(model),
       tool_(std::move(tool)),
       X_(model.reference_positions()),
+      n_columns_(history_columns(model, stabilised).size()),
       writer_(out_, history_columns(model, stabilised)),
       header_size_(out_.str().size()),
       stabilised_(stabilised) {
   for (int i = 0; i < model.n_interactions(); ++i) tools_ = tools_ || !model.interaction(i).reactions(X_, {}).empty();
+}
+
+void HistoryTable::append_rows(const std::string& rows) {
+  std::istringstream in(rows);
+  std::string line;
+  for (int k = 1; std::getline(in, line); ++k) {
+    if (line.empty()) continue;
+    const std::size_t n = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+    if (n != n_columns_)
+      throw InputError("its history row " + std::to_string(k) + " has " + std::to_string(n) +
+                       " columns where this run's history.csv has " + std::to_string(n_columns_) +
+                       " (the file was written for other tools or stabilisation settings, or edited; run "
+                       "without --restart to start again)");
+  }
+  out_ << rows;
 }
 
 ToolState HistoryTable::add_row(int k, double load_factor, const VecX& x, const VecX& reactions, int iterations,

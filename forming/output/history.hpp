@@ -58,8 +58,10 @@ class HistoryTable {
  public:
   // `stabilised`: the stabilisation columns are added.
   HistoryTable(const Model& model, ToolEdge tool, bool stabilised = false);
-  // The rows of an earlier run (restart.json), appended after the header.
-  void append_rows(const std::string& rows) { out_ << rows; }
+  // The rows of an earlier run (restart.json), appended after the header. Throws
+  // InputError naming the first row whose number of columns is not this table's (a
+  // restart file written for other tools or without stabilisation, or edited by hand).
+  void append_rows(const std::string& rows);
   // A row for step k; returns the tool's state in it. `context`: the time and rates of
   // the step (rigid tools' reactions include friction).
   // `stabilisation_energy`: dissipated from the start to this step, N mm (stabilised tables).
@@ -78,6 +80,7 @@ class HistoryTable {
   ToolEdge tool_;
   VecX X_;
   std::ostringstream out_;
+  std::size_t n_columns_ = 0;
   io::CsvWriter writer_;
   std::size_t header_size_ = 0;
   bool tools_ = false;  // some interaction reports tool reactions

@@ -86,7 +86,11 @@ SteppingState RunRecorder::start() {
       else
         ++missing;
     }
-    history_.append_rows(restart_.history_rows);
+    try {
+      history_.append_rows(restart_.history_rows);
+    } catch (const InputError& e) {
+      throw InputError(restart_path_ + ": " + e.what());
+    }
     stabilisation_energy_ = restart_.stabilisation_energy;
     damping_ = restart_.stabilisation_damping;
     cli::status(options_.quiet, "simform: restarting from load factor " + std::to_string(state.load_factor) +

@@ -121,5 +121,38 @@ TEST(Restart, MissingOrForeignRestartFileIsAnInputError) {
   fs::remove_all(tmp);
 }
 
+// A restart file whose history rows do not have this run's columns (edited by hand, or
+// written for other tools) is refused naming the file, the row and both column counts,
+// before anything is written; earlier it failed later with a bare CSV field count.
+TEST(Restart, HistoryRowsOfAnotherShapeAreRefusedNamingTheFile) {
+  const FormingCase spec = load_case(std::string(SF_SOURCE_DIR) + "/data/forming/uniaxial_0.yaml");
+  const fs::path tmp = fs::temp_directory_path() / "sf_restart_test_history";
+  fs::remove_all(tmp);
+  RunOptions o;
+  o.out_dir = tmp.string();
+  o.quiet = true;
+  o.stop_after = 2;
+  ASSERT_EQ(run_case(spec, o).status, RunReport::Status::kStopped);
+  const fs::path restart = tmp / "restart.json";
+  nlohmann::json j = nlohmann::json::parse(fixtures::read_text(restart));
+  std::string rows = j["history_rows"];
+  const std::size_t second = rows.find('\n') + 1;  // row 1 loses its last column
+  const std::size_t end = rows.find('\n', second);
+  rows.erase(rows.rfind(',', end), end - rows.rfind(',', end));
+  j["history_rows"] = rows;
+  std::ofstream(restart) << j.dump();
+  o.stop_after = 0;
+  o.restart = true;
+  try {
+    run_case(spec, o);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("restart.json"), std::string::npos) << m;
+    EXPECT_NE(m.find("history row 2 has 11 columns where this run's history.csv has 12"), std::string::npos) << m;
+  }
+  fs::remove_all(tmp);
+}
+
 }  // namespace
 }  // namespace sf::forming

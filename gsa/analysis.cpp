@@ -65,6 +65,10 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
     } else {
       const auto tn = Clock::now();
       out.noise = deformed_noise(problem, marks, setup, undeformed_noise);
+      // Reported only (summary.json): the relaxation test with each component in its own
+      // level did not see the ARAMIS crack band either (docs/usage.md, "Real exports").
+      estimate_two_levels(out.noise, setup, und, out.fit.fit.parameters, MatX(problem.data()) - out.fit.fit.fitted,
+                          problem.weight());
       // Noise correlated over less than a spacing is independent as far as the smoother
       // can tell: there cross-validation, which needs no noise level, is as good and
       // does not inherit the estimate's error (measured: Cp on the wavy part with
@@ -402,6 +406,8 @@ AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid,
   }
   res.noise_outliers_undeformed = outliers.noise_undeformed;
   res.noise_outliers_deformed = outliers.noise_deformed;
+  res.noise_outliers_deformed_axis = outliers.noise_deformed_axis;
+  res.noise_outliers_deformed_across = outliers.noise_deformed_across;
   record_parameters(res, setup, und, problem, def, residuals, options);
   return res;
 }

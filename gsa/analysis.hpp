@@ -138,6 +138,7 @@ struct AnalysisResult {
   int refinement_rounds = 0;
   double smallest_element = 0.0;
   double noise_outliers_undeformed = 0.0, noise_outliers_deformed = 0.0;  // noise levels of the outlier checks (units)
+  double noise_outliers_deformed_axis = 0.0, noise_outliers_deformed_across = 0.0;  // its two levels: along the noisiest axis, across it (units)
   SigmaWeights weights_undeformed, weights_deformed;  // fit weights from the sigmas (used = false: all 1)
 };
 

@@ -13,13 +13,22 @@
 //      component over the neighbours' tangent-plane coordinates (s, t) about the
 //      point; the point's deviation is |v_p - c0| / sqrt(1 + v0) (mm), v0 the
 //      variance factor of the prediction c0 (larger at gaps and at the outline);
-//   2. the noise level is robust: the median deviation over all points over the
-//      median of a chi distribution with the tested number of components;
-//   3. a point is a blunder when its deviation exceeds `threshold` noise levels
-//      AND `isolation` times the second largest deviation among its 8 nearest
-//      neighbours, so a coherent region of large deviations (a feature, even a line
-//      one point wide) is never flagged;
-//   4. a pass flags only points whose deviation is the largest among their 8
+//   2. the noise, robust. Undeformed state: one level, the median deviation over all
+//      points over the median of a chi distribution with one component. Deformed state:
+//      a noise covariance of the deviation vectors (robust: the vectors within 3 x the
+//      median squared Mahalanobis distance, three rounds, scaled so that the median
+//      squared distance is chi-square(3)'s median). Stereo DIC measures along its
+//      viewing direction several times worse than across it: one level for all three
+//      components is set by that direction's noise, and an in-plane blunder of 10
+//      in-plane sigmas stays under it. The covariance has two levels, along its
+//      noisiest axis and across it, whatever the axis (the cameras' direction, fixed
+//      while a dome's normal turns). The point's score: the deviation in noise levels,
+//      its Mahalanobis length under the covariance (undeformed: deviation / level);
+//   3. a point is a blunder when its score exceeds `threshold` AND `isolation`
+//      times the second largest score among its 8 nearest neighbours, so a
+//      coherent region of large deviations (a feature, even a line one point wide)
+//      is never flagged; its deviation must also exceed `floor`;
+//   4. a pass flags only points whose score is the largest among their 8
 //      nearest neighbours (a blunder spoils its neighbours' fits too); the check is
 //      repeated without the points flagged so far, up to `passes` times.
 //
@@ -41,6 +50,8 @@ struct BlunderOptions {
   double threshold = 4.5;  // deviation in noise levels
   double isolation = 2.5;  // deviation over the second largest deviation of the 8 nearest neighbours
   int passes = 6;
+  bool two_level = true;  // deformed state: scored under the noise covariance (false: one level
+                          // for all components, the rule before; kept for comparison)
   double floor = 0.0;  // the threshold is at least this (mm): round-off and the local fit's own
                        // misfit set the noise level of noise-free data
   void validate() const;
@@ -57,10 +68,20 @@ struct BlunderNeighbours {
 
 struct BlunderCheck {
   std::vector<double> deviation;  // per point, mm (NaN where not checked)
-  double noise = 0.0;             // robust noise level per component, mm
-  double threshold = 0.0;         // deviation above which a point can be flagged, mm
+  std::vector<double> score;      // the deviation in noise levels (2. above)
+  double noise = 0.0;             // robust noise level per component, all components alike, mm
+  // Deformed state: the noise covariance's level along its noisiest axis, and per
+  // component across it (the root mean square of the other two), mm (0: not estimated).
+  double noise_axis = 0.0, noise_across = 0.0;
+  Vec3 axis = Vec3::Zero();       // the noisiest axis (unit; sign arbitrary)
+  double threshold = 0.0;         // threshold x noise (the isotropic level), mm: what a deviation of
+                                  // typical direction must exceed
   std::vector<bool> flagged;      // per point
   Index n_flagged() const;
+  // The noise level along point p's deviation (deviation / score), mm, and the deviation a
+  // point of that direction must exceed: max(threshold x that level, floor), mm.
+  double noise_along(Index p) const;
+  double threshold_of(Index p, const BlunderOptions& options) const;
   std::shared_ptr<const BlunderNeighbours> neighbours;  // the candidates searched (or reused)
 };
 

@@ -289,4 +289,33 @@ NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, co
   return e;
 }
 
+void estimate_two_levels(NoiseEstimate& into, const FrameAndMesh& setup, const UndeformedFit& undeformed,
+                         const MatX& parameters, const MatX& residual, const VecX& weight) {
+  const Index m = residual.rows();
+  const fe::SurfaceField surface(setup.mesh, parameters);
+  std::vector<double> rn, rt;
+  for (Index k = 0; k < m; ++k) {
+    if (!(weight[k] > 0) || !residual.row(k).allFinite()) continue;
+    const MeshLocation& loc = undeformed.location[static_cast<std::size_t>(k)];
+    const Mat32 t = surface.evaluate3(loc.element, loc.xi, basis::kFirst).dx;
+    const Vec3 n = t.col(0).cross(t.col(1));
+    if (!(n.norm() > 0)) continue;
+    const Vec3 r = residual.row(k).transpose();
+    const double a = r.dot(n.normalized());
+    rn.push_back(std::abs(a));
+    rt.push_back((r - a * n.normalized()).norm());
+  }
+  if (rn.size() < 10) return;
+  const double sn = median(rn) / 0.674490, st = median(rt) / 1.177410;
+  into.sigma_normal = sn;
+  into.sigma_tangent = st;
+  const double mean = (2.0 * st * st + sn * sn) / 3.0;
+  const double total = into.sigma_total();
+  if (total > 0 && mean > 0) {
+    const double scale = total / std::sqrt(mean);
+    into.sigma_normal *= scale;
+    into.sigma_tangent *= scale;
+  }
+}
+
 }  // namespace sf::gsa

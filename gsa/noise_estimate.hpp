@@ -34,4 +34,14 @@ NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks,
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
                              const NoiseEstimate& undeformed);
 
+// The two levels of the deformed data's noise (NoiseEstimate::sigma_tangent, sigma_normal):
+// the residuals of the deformed fit `parameters` (data - fitted, m x 3) at the marks with
+// weight > 0, projected on the fitted deformed surface's normal and tangent plane there;
+// robust: sigma_normal = median |r_n| / 0.6745, sigma_tangent = median |r_t| / 1.1774 (the
+// medians of the norm of one and of two unit normals). If `into` has an amplitude
+// (sigma_total > 0) the two are scaled to it, keeping their ratio; else they are set as
+// measured. Fewer than 10 marks: left at 0.
+void estimate_two_levels(NoiseEstimate& into, const FrameAndMesh& setup, const UndeformedFit& undeformed,
+                         const MatX& parameters, const MatX& residual, const VecX& weight);
+
 }  // namespace sf::gsa

@@ -34,6 +34,13 @@ struct NoiseEstimate {
   double correlation_length = 0.0;  // mm (0: no correlated part found)
   double sigma_white = 0.0;         // mm, per coordinate
   double bias_slope = 0.0;          // b of the model, 1 (mm^2 / mm^2)
+  // Two levels (stereo DIC measures along the viewing direction, about the part's normal,
+  // several times worse than across it): the noise per tangential component and along the
+  // normal, mm, from the deformed fit's residuals projected on the fitted surface's tangent
+  // plane and normal (robust: medians), scaled so that (2 sigma_tangent^2 + sigma_normal^2) / 3
+  // = sigma_total^2 when the model has an amplitude. Both 0: not estimated (isotropic).
+  // Reported (summary.json); the smoothing and its local relaxation do not use them yet.
+  double sigma_tangent = 0.0, sigma_normal = 0.0;
   double sigma_total() const;
   // The correlation length when the correlated part matters (> 30 % of the total
   // sigma), else 0: the noise counts as independent.

@@ -46,14 +46,15 @@ MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing
   const Index m = marks.size();
   MarkOutliers out;
   const std::vector<bool> all(static_cast<std::size_t>(m), true);
-  const BlunderCheck u =
-      find_blunders(marks.undeformed, marks.undeformed, all, true, blunder_options(mark_spacing, options));
+  const BlunderOptions bo = blunder_options(mark_spacing, options);
+  const BlunderCheck u = find_blunders(marks.undeformed, marks.undeformed, all, true, bo);
   out.noise_undeformed = u.noise;
   out.neighbours = u.neighbours;
   for (Index k = 0; k < m; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     if (u.flagged[kk])
-      out.undeformed.push_back({k, OutlierReason::kUndeformedOffNeighbours, u.deviation[kk], u.threshold, u.noise});
+      out.undeformed.push_back({k, OutlierReason::kUndeformedOffNeighbours, u.deviation[kk], u.threshold_of(k, bo),
+                                u.noise_along(k)});
   }
   return out;
 }
@@ -64,14 +65,17 @@ void find_deformed_outliers(const FitMarks& marks, const Points3& deformed, doub
   std::vector<bool> usable(static_cast<std::size_t>(m));
   for (Index k = 0; k < m; ++k) usable[static_cast<std::size_t>(k)] = deformed.row(k).allFinite();
   for (const OutlierFlag& f : out.undeformed) usable[static_cast<std::size_t>(f.mark)] = false;
-  const BlunderCheck d =
-      find_blunders(marks.undeformed, deformed, usable, false, blunder_options(mark_spacing, options), out.neighbours);
+  const BlunderOptions bo = blunder_options(mark_spacing, options);
+  const BlunderCheck d = find_blunders(marks.undeformed, deformed, usable, false, bo, out.neighbours);
   out.noise_deformed = d.noise;
+  out.noise_deformed_axis = d.noise_axis;
+  out.noise_deformed_across = d.noise_across;
   out.deformed.clear();
   for (Index k = 0; k < m; ++k) {
     const auto kk = static_cast<std::size_t>(k);
     if (d.flagged[kk])
-      out.deformed.push_back({k, OutlierReason::kDeformedOffNeighbours, d.deviation[kk], d.threshold, d.noise});
+      out.deformed.push_back({k, OutlierReason::kDeformedOffNeighbours, d.deviation[kk], d.threshold_of(k, bo),
+                              d.noise_along(k)});
   }
 }
 

@@ -48,7 +48,8 @@ struct OutlierFlag {
   OutlierReason reason = OutlierReason::kDeformedOffNeighbours;
   double deviation = 0.0;  // from the neighbours' local fit (units)
   double threshold = 0.0;  // the threshold it exceeded (units): sigma x noise, or the floor
-  double noise = 0.0;      // the robust noise level of the deviations (units)
+  double noise = 0.0;      // the robust noise level along its deviation (units): deviation / score,
+                           // the deformed check's noise covariance in that direction
 };
 // "deformed position 0.123 mm off its neighbours' local fit (threshold 0.061 mm = 4.5 x noise 0.0136 mm)"
 std::string describe(const OutlierFlag& flag, double sigma, const std::string& units);
@@ -56,6 +57,9 @@ std::string describe(const OutlierFlag& flag, double sigma, const std::string& u
 struct MarkOutliers {
   std::vector<OutlierFlag> undeformed, deformed;
   double noise_undeformed = 0.0, noise_deformed = 0.0;  // robust noise levels of the deviations (units)
+  // The deformed check's two levels (gsa/blunders.hpp): along its noise's noisiest axis
+  // (stereo DIC: the viewing direction) and per component across it (units).
+  double noise_deformed_axis = 0.0, noise_deformed_across = 0.0;
   // The undeformed check's neighbour candidates, reused by the deformed check when it
   // uses the same marks (gsa/blunders.hpp).
   std::shared_ptr<const BlunderNeighbours> neighbours;

@@ -322,14 +322,18 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
         return nlohmann::json{{"sigma_correlated", e.sigma_correlated},
                               {"correlation_length", e.correlation_length},
                               {"sigma_white", e.sigma_white},
-                              {"sigma_total", e.sigma_total()}};
+                              {"sigma_total", e.sigma_total()},
+                              {"sigma_tangent", e.sigma_tangent},
+                              {"sigma_normal", e.sigma_normal}};
       };
       params["noise_model"] = {{"undeformed", model(r.noise_undeformed)},
                                {"deformed", model(r.noise)},
                                {"meaning",
                                 "per coordinate; covariance sigma_correlated^2 exp(-r^2 / (2 L^2)) + "
                                 "sigma_white^2 [same point], L = correlation_length; deformed: of the "
-                                "displacement noise, both states together"}};
+                                "displacement noise, both states together; sigma_tangent, sigma_normal: per "
+                                "tangential component and along the fitted surface's normal, from the deformed "
+                                "fit's residuals (0: not estimated)"}};
     }
     nlohmann::json flagged = nlohmann::json::array();
     for (std::size_t p = 0; p < r.points.size(); ++p) {
@@ -350,10 +354,13 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
     j["outliers"] = {{"sigma", r.outlier_sigma},
                      {"noise_undeformed", r.noise_outliers_undeformed},
                      {"noise_deformed", r.noise_outliers_deformed},
+                     {"noise_deformed_axis", r.noise_outliers_deformed_axis},
+                     {"noise_deformed_across", r.noise_outliers_deformed_across},
                      {"rule",
                       "isolated points only: deviation from the local quadratic of the 16 nearest neighbours "
-                      "above sigma x noise and 2.5 x the second largest among the 8 nearest; flagged points "
-                      "keep a strain"},
+                      "above sigma x noise and 2.5 x the second largest among the 8 nearest (deformed: the noisiest-axis and "
+                      "across-axis parts each in its own noise level: the Mahalanobis length under a robust noise covariance); "
+                      "flagged points keep a strain"},
                      {"flagged", flagged}};
     j["fit"] = {{"undeformed", {{"rms_residual", r.rms_undeformed}, {"max_residual", r.max_undeformed}}},
                 {"deformed", {{"rms_residual", r.rms_deformed}, {"max_residual", r.max_deformed}}}};

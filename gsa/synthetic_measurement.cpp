@@ -158,10 +158,15 @@ SyntheticMeasurement make_measurement(const Deformation& deformation, const Synt
       g.i[p] = lp.i;
       g.j[p] = lp.j;
     }
-    Vec3 X = lp.X + field_u.at(lp.X), x = deformation.map(lp.X) + field_d.at(lp.X);
+    const Vec3 fu = field_u.at(lp.X), fd = field_d.at(lp.X), mx = deformation.map(lp.X);
+    Vec3 X = lp.X + fu, x = mx + fd;
     for (int c = 0; c < 3; ++c) {
-      X[c] += o.undeformed_noise.sigma_white * normal(rng);
-      x[c] += o.deformed_noise.sigma_white * normal(rng);
+      const double wu = o.undeformed_noise.sigma_white * normal(rng), wd = o.deformed_noise.sigma_white * normal(rng);
+      X[c] += wu;
+      x[c] += wd;
+      if (c == 2 && o.undeformed_noise.normal_factor != 1.0)
+        X[2] = lp.X[2] + o.undeformed_noise.normal_factor * (fu[2] + wu);
+      if (c == 2 && o.deformed_noise.normal_factor != 1.0) x[2] = mx[2] + o.deformed_noise.normal_factor * (fd[2] + wd);
     }
     g.undeformed.row(p) = X.transpose();
     g.deformed.row(p) = x.transpose();
@@ -178,6 +183,7 @@ SyntheticMeasurement make_measurement(const Deformation& deformation, const Synt
       while (taken[p]) p = pick(rng);
       taken[p] = true;
       Vec3 dir(normal(rng), normal(rng), normal(rng));
+      if (o.blunders_in_plane) dir[2] = 0.0;
       dir.normalize();
       g.deformed.row(p) += size * dir.transpose();
       m.blunder_points.push_back(p);

@@ -27,7 +27,11 @@ struct NoiseModel {
   double sigma_correlated = 0.0;    // mm
   double correlation_length = 0.0;  // mm (0 with sigma_correlated > 0: invalid)
   double sigma_white = 0.0;         // mm
-  double sigma_total() const;       // sqrt of the summed variances
+  // The z component's noise (correlated and independent) over the x and y components':
+  // stereo DIC of a part facing the cameras measures out of plane several times worse
+  // than in plane (1: isotropic). The sigmas above are the in-plane ones.
+  double normal_factor = 1.0;
+  double sigma_total() const;  // sqrt of the summed variances (in plane)
 };
 
 // An analytic deformation of a flat blank (Z = 0) with its exact gradient
@@ -70,6 +74,7 @@ struct SyntheticMeasurementOptions {
   NoiseModel undeformed_noise, deformed_noise;
   int blunders = 0;           // isolated marks moved by blunder_size (deformed state)
   double blunder_size = 0.0;  // mm, 0 = 10 x the deformed noise sigma
+  bool blunders_in_plane = false;  // blunders along x and y only (else in a random 3-D direction)
   unsigned seed = 1;
 };
 

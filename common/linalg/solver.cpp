@@ -118,16 +118,48 @@ const OpenBlas& openblas() {
   return o;
 }
 
+// The OpenMP runtime's nesting control, looked up at run time (libgomp is loaded when
+// CHOLMOD, MUMPS or the program use OpenMP; sf_common itself is not compiled with it).
+// CHOLMOD 3.0 (SuiteSparse 5.12) runs a few copying loops of each supernode (the map of its
+// rows, A into L, the update added into L) as `parallel for num_threads(4)`, four threads
+// whatever the cores or OMP_NUM_THREADS: on 2 cores, and worse on a loaded machine, each of
+// those regions' fork and join cost more than the copy (measured: kernel and libgomp 37 % of
+// the factorisation's samples). max-active-levels 0 makes every parallel region the calling
+// thread meets inactive, one thread; libgomp keeps it per thread (GCC >= 11), so the other
+// threads of the program are not affected.
+struct OmpNesting {
+  int (*get_max_active_levels)() = nullptr;
+  void (*set_max_active_levels)(int) = nullptr;
+  OmpNesting() {
+    get_max_active_levels = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+    set_max_active_levels = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  }
+  bool available() const { return get_max_active_levels && set_max_active_levels; }
+};
+
+const OmpNesting& omp_nesting() {
+  static const OmpNesting o;
+  return o;
+}
+
 std::atomic<int> g_factor_threads{0};
 
 // Serialises the BLAS-calling (supernodal) factorisations and solves; while held, the
-// BLAS runs on factorisation_threads() threads, and on one after.
+// BLAS runs on factorisation_threads() threads, and on one after. The libraries' own
+// OpenMP regions run on the calling thread alone (OmpNesting) unless the BLAS itself is
+// OpenMP-threaded (OpenBLAS's OpenMP build, whose threads those regions are).
 class BlasSection {
  public:
   BlasSection() : lock_(mutex()) {
     if (openblas().threaded()) openblas().set_num_threads(factorisation_threads());
+    const bool blas_uses_openmp = openblas().get_parallel && openblas().get_parallel() == 2;
+    if (omp_nesting().available() && !blas_uses_openmp) {
+      saved_levels_ = omp_nesting().get_max_active_levels();
+      omp_nesting().set_max_active_levels(0);
+    }
   }
   ~BlasSection() {
+    if (saved_levels_ >= 0) omp_nesting().set_max_active_levels(saved_levels_);
     if (openblas().threaded()) openblas().set_num_threads(1);
   }
   BlasSection(const BlasSection&) = delete;
@@ -139,6 +171,7 @@ class BlasSection {
     return m;
   }
   std::lock_guard<std::mutex> lock_;
+  int saved_levels_ = -1;  // max-active-levels to restore; -1: left alone
 };
 
 #if SF_LINALG_HAVE_SUITESPARSE

@@ -187,7 +187,7 @@ class CholmodLlt : public Wrapper {
 template <class Wrapper>
 class CholmodBackend final : public Backend {
  public:
-  CholmodBackend(bool ldlt, bool supernodal) : ldlt_(ldlt), supernodal_(supernodal) {
+  explicit CholmodBackend(bool ldlt) : ldlt_(ldlt) {
     llt_.cholmod().print = 0;  // report through SolveReport
   }
 
@@ -241,12 +241,7 @@ class CholmodBackend final : public Backend {
   std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
-    if (supernodal_) {
-      const BlasSection blas;
-      llt_.factorize(a);
-    } else {
-      llt_.factorize(a);
-    }
+    llt_.factorize(a);  // simplicial: no BLAS (the supernodal kind is CholmodPermutedBackend)
     if (llt_.info() == Eigen::Success) return {};
     const int status = llt_.cholmod().status;
     if (status < CHOLMOD_OK) {
@@ -265,19 +260,13 @@ class CholmodBackend final : public Backend {
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
-    if (supernodal_) {
-      const BlasSection blas;
-      x = llt_.solve(b);
-    } else {
-      x = llt_.solve(b);
-    }
+    x = llt_.solve(b);
     return llt_.info() == Eigen::Success;
   }
 
  private:
   CholmodLlt<Wrapper> llt_;
   bool ldlt_ = false;
-  bool supernodal_ = false;
   double flops_ = 0.0;
   double lnz_ = 0.0;
   std::string ordering_;
@@ -811,9 +800,9 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
     case SolverKind::kCholmod:
       return std::make_unique<CholmodPermutedBackend>();
     case SolverKind::kCholmodSimplicial:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>(false, false);
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>(false);
     case SolverKind::kCholmodLdlt:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true, false);
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true);
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif

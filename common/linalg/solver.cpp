@@ -118,16 +118,48 @@ const OpenBlas& openblas() {
   return o;
 }
 
+// The OpenMP runtime's nesting control, looked up at run time (libgomp is loaded when
+// CHOLMOD, MUMPS or the program use OpenMP; sf_common itself is not compiled with it).
+// CHOLMOD 3.0 (SuiteSparse 5.12) runs a few copying loops of each supernode (the map of its
+// rows, A into L, the update added into L) as `parallel for num_threads(4)`, four threads
+// whatever the cores or OMP_NUM_THREADS: on 2 cores, and worse on a loaded machine, each of
+// those regions' fork and join cost more than the copy (measured: kernel and libgomp 37 % of
+// the factorisation's samples). max-active-levels 0 makes every parallel region the calling
+// thread meets inactive, one thread; libgomp keeps it per thread (GCC >= 11), so the other
+// threads of the program are not affected.
+struct OmpNesting {
+  int (*get_max_active_levels)() = nullptr;
+  void (*set_max_active_levels)(int) = nullptr;
+  OmpNesting() {
+    get_max_active_levels = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+    set_max_active_levels = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  }
+  bool available() const { return get_max_active_levels && set_max_active_levels; }
+};
+
+const OmpNesting& omp_nesting() {
+  static const OmpNesting o;
+  return o;
+}
+
 std::atomic<int> g_factor_threads{0};
 
 // Serialises the BLAS-calling (supernodal) factorisations and solves; while held, the
-// BLAS runs on factorisation_threads() threads, and on one after.
+// BLAS runs on factorisation_threads() threads, and on one after. The libraries' own
+// OpenMP regions run on the calling thread alone (OmpNesting) unless the BLAS itself is
+// OpenMP-threaded (OpenBLAS's OpenMP build, whose threads those regions are).
 class BlasSection {
  public:
   BlasSection() : lock_(mutex()) {
     if (openblas().threaded()) openblas().set_num_threads(factorisation_threads());
+    const bool blas_uses_openmp = openblas().get_parallel && openblas().get_parallel() == 2;
+    if (omp_nesting().available() && !blas_uses_openmp) {
+      saved_levels_ = omp_nesting().get_max_active_levels();
+      omp_nesting().set_max_active_levels(0);
+    }
   }
   ~BlasSection() {
+    if (saved_levels_ >= 0) omp_nesting().set_max_active_levels(saved_levels_);
     if (openblas().threaded()) openblas().set_num_threads(1);
   }
   BlasSection(const BlasSection&) = delete;
@@ -139,6 +171,7 @@ class BlasSection {
     return m;
   }
   std::lock_guard<std::mutex> lock_;
+  int saved_levels_ = -1;  // max-active-levels to restore; -1: left alone
 };
 
 #if SF_LINALG_HAVE_SUITESPARSE
@@ -154,7 +187,7 @@ class CholmodLlt : public Wrapper {
 template <class Wrapper>
 class CholmodBackend final : public Backend {
  public:
-  CholmodBackend(bool ldlt, bool supernodal) : ldlt_(ldlt), supernodal_(supernodal) {
+  explicit CholmodBackend(bool ldlt) : ldlt_(ldlt) {
     llt_.cholmod().print = 0;  // report through SolveReport
   }
 
@@ -208,12 +241,7 @@ class CholmodBackend final : public Backend {
   std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
-    if (supernodal_) {
-      const BlasSection blas;
-      llt_.factorize(a);
-    } else {
-      llt_.factorize(a);
-    }
+    llt_.factorize(a);  // simplicial: no BLAS (the supernodal kind is CholmodPermutedBackend)
     if (llt_.info() == Eigen::Success) return {};
     const int status = llt_.cholmod().status;
     if (status < CHOLMOD_OK) {
@@ -232,19 +260,216 @@ class CholmodBackend final : public Backend {
   }
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
-    if (supernodal_) {
-      const BlasSection blas;
-      x = llt_.solve(b);
-    } else {
-      x = llt_.solve(b);
-    }
+    x = llt_.solve(b);
     return llt_.info() == Eigen::Success;
   }
 
  private:
   CholmodLlt<Wrapper> llt_;
   bool ldlt_ = false;
-  bool supernodal_ = false;
+  double flops_ = 0.0;
+  double lnz_ = 0.0;
+  std::string ordering_;
+};
+
+// CHOLMOD's supernodal Cholesky of A (lower triangle given), with the fill-reducing
+// permutation applied here rather than by CHOLMOD. Given a lower triangle and an ordering,
+// cholmod_factorize builds tril(P A P^T) by two transposes of the whole matrix at every
+// factorisation (cholmod_transpose_sym: measured 25 % of the 20x20x4 factorisation, as much
+// as a third of its BLAS time); with the natural ordering and a lower triangle it reads the
+// matrix as given. So the analysis runs twice: once on A for the ordering (AMD, METIS, ...,
+// with CHOLMOD's postorder), then on B = tril(P A P^T) with the natural ordering (the same
+// elimination tree and supernodes); each factorisation gathers A's values into B through a
+// map made once, and each solve permutes the right-hand sides and solutions.
+class CholmodPermutedBackend final : public Backend {
+ public:
+  CholmodPermutedBackend() {
+    cholmod_start(&c_);
+    c_.print = 0;  // report through SolveReport
+    c_.supernodal = CHOLMOD_SUPERNODAL;
+  }
+  ~CholmodPermutedBackend() override {
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
+    cholmod_finish(&c_);
+  }
+  CholmodPermutedBackend(const CholmodPermutedBackend&) = delete;
+  CholmodPermutedBackend& operator=(const CholmodPermutedBackend&) = delete;
+
+  void set_ordering(Ordering ordering) override { ordering_choice_ = ordering; }
+
+  Outcome analyze(const SparseMatrix& a) override {
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
+    const int n = static_cast<int>(a.rows());
+    cholmod_sparse view = lower_view(a, const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()),
+                                     nullptr, CHOLMOD_PATTERN);
+    // 1. The ordering, on A.
+    if (ordering_choice_ == Ordering::kDefault) {
+      c_.nmethods = 0;
+    } else {
+      c_.nmethods = 1;
+      c_.method[0].ordering = ordering_choice_ == Ordering::kAmd     ? CHOLMOD_AMD
+                              : ordering_choice_ == Ordering::kMetis ? CHOLMOD_METIS
+                                                                     : CHOLMOD_NESDIS;
+    }
+    c_.postorder = 1;
+    cholmod_factor* ordering_factor = cholmod_analyze(&view, &c_);
+    if (ordering_factor == nullptr || c_.status < CHOLMOD_OK) {
+      if (ordering_factor != nullptr) cholmod_free_factor(&ordering_factor, &c_);
+      return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis failed (status {})", c_.status)};
+    }
+    flops_ = c_.fl;
+    lnz_ = c_.lnz;
+    const int selected = c_.selected >= 0 && c_.selected < CHOLMOD_MAXMETHODS ? c_.selected : 0;
+    const int used = c_.method[selected].ordering;
+    ordering_ = used == CHOLMOD_NATURAL  ? "natural"
+                : used == CHOLMOD_AMD    ? "amd"
+                : used == CHOLMOD_METIS  ? "metis"
+                : used == CHOLMOD_NESDIS ? "nesdis"
+                : used == CHOLMOD_COLAMD ? "colamd"
+                                         : "given";
+    const int* perm = static_cast<const int*>(ordering_factor->Perm);
+    inverse_.assign(static_cast<std::size_t>(n), 0);
+    for (int k = 0; k < n; ++k) inverse_[static_cast<std::size_t>(perm[k])] = k;
+    cholmod_free_factor(&ordering_factor, &c_);
+
+    // 2. B = tril(P A P^T): entry p of A (row i >= column j) goes to B(max, min) of
+    // (inverse[i], inverse[j]); entries above the diagonal of A (a matrix given with both
+    // triangles) are not read. Columns counted, filled, then each sorted by row.
+    const std::size_t nnz = static_cast<std::size_t>(a.nonZeros());
+    const int* a_col = a.outerIndexPtr();
+    const int* a_row = a.innerIndexPtr();
+    b_col_.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (int j = 0; j < n; ++j)
+      for (int p = a_col[j]; p < a_col[j + 1]; ++p)
+        if (a_row[p] >= j)
+          ++b_col_[static_cast<std::size_t>(std::min(inverse_[static_cast<std::size_t>(a_row[p])],
+                                                     inverse_[static_cast<std::size_t>(j)])) +
+                   1];
+    for (int j = 0; j < n; ++j) b_col_[static_cast<std::size_t>(j) + 1] += b_col_[static_cast<std::size_t>(j)];
+    const std::size_t b_nnz = static_cast<std::size_t>(b_col_[static_cast<std::size_t>(n)]);
+    std::vector<int> next(b_col_.begin(), b_col_.end() - 1);
+    b_row_.assign(b_nnz, 0);
+    map_.assign(nnz, -1);  // -1: an entry above the diagonal
+    std::vector<int> source(b_nnz);  // source[q]: entry of A that B's entry q holds
+    for (int j = 0; j < n; ++j)
+      for (int p = a_col[j]; p < a_col[j + 1]; ++p) {
+        if (a_row[p] < j) continue;
+        const int r = inverse_[static_cast<std::size_t>(a_row[p])], c = inverse_[static_cast<std::size_t>(j)];
+        const int dst = next[static_cast<std::size_t>(std::min(r, c))]++;
+        b_row_[static_cast<std::size_t>(dst)] = std::max(r, c);
+        source[static_cast<std::size_t>(dst)] = p;
+      }
+    std::vector<std::pair<int, int>> column;
+    for (int j = 0; j < n; ++j) {
+      const int q0 = b_col_[static_cast<std::size_t>(j)], q1 = b_col_[static_cast<std::size_t>(j) + 1];
+      column.clear();
+      for (int q = q0; q < q1; ++q)
+        column.emplace_back(b_row_[static_cast<std::size_t>(q)], source[static_cast<std::size_t>(q)]);
+      std::sort(column.begin(), column.end());
+      for (int q = q0; q < q1; ++q) {
+        b_row_[static_cast<std::size_t>(q)] = column[static_cast<std::size_t>(q - q0)].first;
+        map_[static_cast<std::size_t>(column[static_cast<std::size_t>(q - q0)].second)] = q;
+      }
+    }
+    b_val_.assign(b_nnz, 0.0);
+
+    // 3. The supernodal analysis of B in its own order (no postorder: P already has it).
+    cholmod_sparse b_view = lower_view(a, b_col_.data(), b_row_.data(), nullptr, CHOLMOD_PATTERN);
+    c_.nmethods = 1;
+    c_.method[0].ordering = CHOLMOD_NATURAL;
+    c_.postorder = 0;
+    factor_ = cholmod_analyze(&b_view, &c_);
+    c_.postorder = 1;
+    if (factor_ == nullptr || c_.status < CHOLMOD_OK) {
+      if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
+      return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis of the permuted matrix failed (status {})",
+                                           c_.status)};
+    }
+    return {};
+  }
+
+  double factor_flops() const override { return flops_; }
+  double factor_nonzeros() const override { return lnz_; }
+  std::string ordering_used() const override { return ordering_; }
+
+  Outcome factorize(const SparseMatrix& a) override {
+    if (factor_ == nullptr || map_.size() != static_cast<std::size_t>(a.nonZeros()))
+      return {Status::kFailed, "CHOLMOD factorisation without an analysis of this pattern"};
+    const double* values = a.valuePtr();
+    if (b_val_.size() == map_.size()) {  // a lower triangle: every entry has its place
+      for (std::size_t p = 0; p < map_.size(); ++p) b_val_[static_cast<std::size_t>(map_[p])] = values[p];
+    } else {
+      for (std::size_t p = 0; p < map_.size(); ++p)
+        if (map_[p] >= 0) b_val_[static_cast<std::size_t>(map_[p])] = values[p];
+    }
+    cholmod_sparse b_view = lower_view(a, b_col_.data(), b_row_.data(), b_val_.data(), CHOLMOD_REAL);
+    {
+      const BlasSection blas;
+      cholmod_factorize(&b_view, factor_, &c_);
+    }
+    if (c_.status == CHOLMOD_NOT_POSDEF) {
+      return {Status::kSingular, fmt::format("matrix is not positive definite: Cholesky broke down at pivot {} of {} "
+                                             "in elimination order; a symmetric indefinite matrix needs "
+                                             "MatrixProperty::kSymmetricIndefinite",
+                                             factor_->minor + 1, factor_->n)};
+    }
+    if (c_.status < CHOLMOD_OK) {
+      return {Status::kFailed, fmt::format("CHOLMOD numeric factorisation failed (status {}{})", c_.status,
+                                           c_.status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "")};
+    }
+    return {};
+  }
+
+  bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
+    const Eigen::Index n = b.rows();
+    Eigen::MatrixXd pb(n, b.cols());
+    for (Eigen::Index i = 0; i < n; ++i) pb.row(inverse_[static_cast<std::size_t>(i)]) = b.row(i);
+    cholmod_dense bd{};
+    bd.nrow = static_cast<std::size_t>(n);
+    bd.ncol = static_cast<std::size_t>(b.cols());
+    bd.nzmax = bd.nrow * bd.ncol;
+    bd.d = bd.nrow;
+    bd.x = pb.data();
+    bd.xtype = CHOLMOD_REAL;
+    bd.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* xd = nullptr;
+    {
+      const BlasSection blas;
+      xd = cholmod_solve(CHOLMOD_A, factor_, &bd, &c_);
+    }
+    if (xd == nullptr) return false;
+    const Eigen::Map<const Eigen::MatrixXd> px(static_cast<const double*>(xd->x), n, b.cols());
+    x.resize(n, b.cols());
+    for (Eigen::Index i = 0; i < n; ++i) x.row(i) = px.row(inverse_[static_cast<std::size_t>(i)]);
+    cholmod_free_dense(&xd, &c_);
+    return true;
+  }
+
+ private:
+  // A CHOLMOD view (no copy) of a lower triangle with a's size and the given arrays.
+  static cholmod_sparse lower_view(const SparseMatrix& a, int* col, int* row, double* val, int xtype) {
+    cholmod_sparse v{};
+    v.nrow = static_cast<std::size_t>(a.rows());
+    v.ncol = static_cast<std::size_t>(a.cols());
+    v.nzmax = static_cast<std::size_t>(col[a.cols()]);
+    v.p = col;
+    v.i = row;
+    v.x = val;
+    v.stype = -1;
+    v.itype = CHOLMOD_INT;
+    v.xtype = xtype;
+    v.dtype = CHOLMOD_DOUBLE;
+    v.sorted = 1;
+    v.packed = 1;
+    return v;
+  }
+
+  mutable cholmod_common c_{};  // cholmod_solve takes it non-const (status, workspace)
+  cholmod_factor* factor_ = nullptr;
+  Ordering ordering_choice_ = Ordering::kDefault;
+  std::vector<int> inverse_;  // inverse_[i]: position of A's row i in B
+  std::vector<int> b_col_, b_row_, map_;
+  std::vector<double> b_val_;
   double flops_ = 0.0;
   double lnz_ = 0.0;
   std::string ordering_;
@@ -573,11 +798,11 @@ std::unique_ptr<Backend> make_backend(SolverKind kind) {
   switch (kind) {
 #if SF_LINALG_HAVE_SUITESPARSE
     case SolverKind::kCholmod:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>>>(false, true);
+      return std::make_unique<CholmodPermutedBackend>();
     case SolverKind::kCholmodSimplicial:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>(false, false);
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLLT<SparseMatrix, Eigen::Lower>>>(false);
     case SolverKind::kCholmodLdlt:
-      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true, false);
+      return std::make_unique<CholmodBackend<Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower>>>(true);
     case SolverKind::kUmfpack:
       return std::make_unique<UmfpackBackend>();
 #endif

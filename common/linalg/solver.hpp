@@ -5,7 +5,10 @@
 //
 // Back ends
 //   kCholmod    CHOLMOD supernodal Cholesky A = L L^T. Symmetric positive
-//               definite only; reads the lower triangle of A.
+//               definite only; reads the lower triangle of A. The fill-reducing
+//               permutation is applied here (tril(P A P^T) kept with a value map made at
+//               the analysis: 16 bytes per stored entry), not by CHOLMOD's two
+//               transposes per factorisation (solver.cpp, CholmodPermutedBackend).
 //   kUmfpack    UMFPACK LU with partial pivoting. Any square nonsingular A.
 //   kCholmodLdlt CHOLMOD simplicial A = L D L^T (no pivoting): symmetric, definite or
 //               not, as long as no pivot vanishes; reads the lower triangle of A.

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
@@ -383,6 +384,52 @@ TEST(LinalgSolver, EveryCholmodOrderingSolves) {
   }
   EXPECT_GE(factorisation_threads(), 1);
   EXPECT_FALSE(blas_description().empty());
+}
+
+// kCholmod permutes the matrix itself (B = tril(P A P^T) through a map made at the analysis)
+// rather than leaving it to CHOLMOD: an irregular SPD pattern given as its lower triangle and
+// as both triangles, each ordering, and new values on the kept analysis, give the solution
+// of a dense Cholesky of the same matrix; the map is rebuilt when the pattern changes.
+TEST(LinalgSolver, SupernodalCholmodOnItsOwnPermutationMatchesDenseCholesky) {
+  if (!solver_available(SolverKind::kCholmod)) GTEST_SKIP() << "no SuiteSparse";
+  std::mt19937 rng(kSeed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto random_spd = [&](int n, double density, double scale) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
+    std::uniform_real_distribution<double> pick(0.0, 1.0);
+    for (int j = 0; j < n; ++j)
+      for (int i = j + 1; i < n; ++i)
+        if (pick(rng) < density) d(i, j) = d(j, i) = scale * u(rng);
+    for (int i = 0; i < n; ++i) d(i, i) = d.row(i).cwiseAbs().sum() + 1.0 + pick(rng);  // diagonally dominant
+    return d;
+  };
+  const int n = 300;
+  const Eigen::MatrixXd d1 = random_spd(n, 0.03, 1.0);
+  Eigen::MatrixXd d2 = d1;  // same pattern, other values
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (d1(i, j) != 0.0 && i != j) d2(i, j) = d2(j, i) = 0.5 * d1(i, j) * (1.0 + 0.3 * std::sin(i + 2.0 * j + i * j));
+  const Eigen::MatrixXd d3 = random_spd(n - 40, 0.05, 2.0);  // another size and pattern
+  const Eigen::MatrixXd b = Eigen::MatrixXd::NullaryExpr(n, kNumRhs, [&] { return u(rng); });
+  for (const Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis})
+    for (const bool lower_only : {true, false}) {
+      SCOPED_TRACE(to_string(o) + (lower_only ? " lower triangle" : " both triangles"));
+      LinearSolver solver(SolverKind::kCholmod, MatrixProperty::kSymmetricPositiveDefinite);
+      solver.set_ordering(o);
+      int step = 0;
+      for (const Eigen::MatrixXd* d : std::vector<const Eigen::MatrixXd*>{&d1, &d2, &d3}) {
+        SCOPED_TRACE(fmt::format("matrix {}", ++step));
+        const Eigen::MatrixXd full = *d;
+        const SparseMatrix a = lower_only ? SparseMatrix(full.triangularView<Eigen::Lower>().toDenseMatrix().sparseView())
+                                          : SparseMatrix(full.sparseView());
+        ASSERT_TRUE(solver.factorize(a).ok()) << solver.last_report().brief();
+        EXPECT_EQ(solver.last_report().reused_analysis, step == 2);
+        const Eigen::MatrixXd rhs = b.topRows(full.rows());
+        const Eigen::MatrixXd x = solver.solve(rhs);
+        const Eigen::MatrixXd expected = full.llt().solve(rhs);
+        EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm());
+      }
+    }
 }
 
 // UMFPACK takes the orderings too, and every SuiteSparse back end reports the size of its

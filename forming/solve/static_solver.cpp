@@ -32,6 +32,43 @@ constexpr std::size_t kStallWindow = 5;
 constexpr double kBounce = 100.0;
 constexpr int kWatch = 3;
 
+// SF_NEWTON_TRACE: the eigenvalue of K_ff nearest zero, by inverse iteration with the
+// factorisation just made (kInverseSteps solves, x <- K^-1 x / |K^-1 x|; the Rayleigh
+// quotient of K^-1 gives 1 / lambda), as a fraction of max |K_ii|. `spread`: the
+// eigen-residual |K^-1 x - x / lambda| / |K^-1 x| of the last step (small: converged to
+// a real eigenvalue; near 1: a complex pair or close eigenvalues, the estimate is rough).
+// K is unsymmetric in the forming cases (viscous slip), so the estimate is of K itself,
+// not of its symmetric part.
+constexpr int kInverseSteps = 8;
+double nearest_eigenvalue(TangentSolver& solver, const linalg::SparseMatrix& k, double& spread) {
+  const Index n = k.rows();
+  spread = 1.0;
+  if (n == 0) return 0.0;
+  VecX x(n);
+  for (Index i = 0; i < n; ++i) x(i) = 1.0 + 0.5 * std::sin(0.7 * double(i) + 0.3);  // fixed start, not an eigenvector
+  x.normalize();
+  double mu = 0.0;  // 1 / lambda
+  for (int it = 0; it < kInverseSteps; ++it) {
+    const VecX w = solver.solve(x);
+    if (!w.allFinite() || w.norm() == 0.0) return std::numeric_limits<double>::quiet_NaN();
+    mu = x.dot(w);
+    spread = (w - mu * x).norm() / w.norm();
+    x = w.normalized();
+  }
+  const double diag = k.diagonal().cwiseAbs().maxCoeff();
+  return (mu == 0.0 ? std::numeric_limits<double>::infinity() : 1.0 / mu) / std::max(diag, 1e-300);
+}
+
+// The trace line of a tangent: its factorisation, negative pivots (symmetric LDL^T), the
+// sign of its determinant (MUMPS) and the nearest eigenvalue (above).
+void trace_tangent(const char* what, TangentSolver& solver, const linalg::SparseMatrix& k,
+                   const linalg::SolveReport& sr) {
+  double spread = 1.0;
+  const double lambda = nearest_eigenvalue(solver, k, spread);
+  std::fprintf(stderr, "newton:   %s: %s, negative pivots %d, det sign %+d, nearest eigenvalue %.3e max|K_ii| "
+               "(spread %.1e)\n", what, sr.brief().c_str(), sr.negative_pivots, sr.determinant_sign, lambda, spread);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------
@@ -259,6 +296,10 @@ LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, Vec
     rec.failure = "predictor: linear solve " + sr.brief();
     return Predicted::kFailed;
   }
+  static const bool trace_tangents = std::getenv("SF_NEWTON_TRACE") != nullptr;
+  // The tangent at the converged state (before the tools move): its determinant's sign
+  // changing between steps means an odd number of real eigenvalues passed zero.
+  if (trace_tangents) trace_tangent("predictor tangent", *solver_, pattern_->matrix(), sr);
   const VecX dxf = solver_->solve(rhs);
   const VecX dx = free_.expand(dxf);
   xt = x_new + dx;
@@ -368,8 +409,7 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       rec.failure = "linear solve " + sr.brief();
       return;
     }
-    if (trace)
-      std::fprintf(stderr, "newton:   tangent: %s, negative pivots %d\n", sr.brief().c_str(), sr.negative_pivots);
+    if (trace) trace_tangent("tangent", *solver_, pattern_->matrix(), sr);
     const VecX dxf = solver_->solve(-rf);
     ++rec.iterations;
     if (!dxf.allFinite()) {

@@ -95,6 +95,8 @@ class Backend {
   virtual void set_refinement(bool) {}
   // Negative pivots of the last symmetric indefinite factorisation (-1: not known).
   virtual int negative_pivots() const { return -1; }
+  // Sign of det(A) of the last factorisation (0: not known).
+  virtual int determinant_sign() const { return 0; }
   // Working memory allowed a factorisation, megabytes (0: no limit; MUMPS only).
   virtual void set_memory_limit(int) {}
 };
@@ -641,6 +643,7 @@ class MumpsBackend final : public Backend {
     }
     icntl(14) = kWorkspacePercent;
     icntl(23) = memory_limit_mb_;
+    icntl(33) = 1;  // the determinant (O(n) products of the pivots): its sign for SF_NEWTON_TRACE
     for (int attempt = 0;; ++attempt) {
       call(2);
       const int code = id_->infog[0];
@@ -659,6 +662,8 @@ class MumpsBackend final : public Backend {
     const int e = infog(29);  // negative: millions
     entries_ = e >= 0 ? static_cast<double>(e) : -1e6 * static_cast<double>(e);
     negative_pivots_ = symmetric_ ? infog(12) : -1;
+    // det = (RINFOG(12) + i RINFOG(13)) 2^INFOG(34), row and column permutations included.
+    determinant_sign_ = rinfog(12) > 0.0 ? 1 : rinfog(12) < 0.0 ? -1 : 0;
     return {};
   }
 
@@ -676,6 +681,7 @@ class MumpsBackend final : public Backend {
   double factor_nonzeros() const override { return entries_; }
   std::string ordering_used() const override { return ordering_; }
   int negative_pivots() const override { return negative_pivots_; }
+  int determinant_sign() const override { return determinant_sign_; }
   void set_memory_limit(int megabytes) override { memory_limit_mb_ = megabytes; }
 
  private:
@@ -725,6 +731,7 @@ class MumpsBackend final : public Backend {
   double flops_ = 0.0;
   double entries_ = 0.0;
   int negative_pivots_ = -1;
+  int determinant_sign_ = 0;
 };
 
 #endif  // SF_LINALG_HAVE_MUMPS
@@ -1104,6 +1111,7 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   im.report.factor_nonzeros = im.backend->factor_nonzeros();
   im.report.ordering = im.backend->ordering_used();
   im.report.negative_pivots = im.backend->negative_pivots();
+  im.report.determinant_sign = im.backend->determinant_sign();
   im.report.status = outcome.status;
   im.report.message = std::move(outcome.message);
   return im.report;

@@ -147,6 +147,8 @@ struct SolveReport {
   int negative_pivots = -1;             // negative eigenvalues of A (its inertia, Sylvester's law)
                                         // from a symmetric indefinite factorisation that counts them
                                         // (MUMPS LDL^T); -1 when unknown
+  int determinant_sign = 0;             // sign of det(A) (+1 or -1) from a factorisation that
+                                        // computes it (MUMPS, ICNTL(33)); 0 when unknown or singular
 
   bool ok() const { return status == Status::kOk; }
   // One line, e.g. "cholmod n=900 nnz=4380: ok; analyse 0.0004 s, factor 0.0011 s, solve 0.0001 s"

@@ -32,6 +32,72 @@ constexpr std::size_t kStallWindow = 5;
 constexpr double kBounce = 100.0;
 constexpr int kWatch = 3;
 
+// SF_NEWTON_TRACE: the eigenvalue of K_ff nearest zero, by inverse iteration with the
+// factorisation just made (kInverseSteps solves, x <- K^-1 x / |K^-1 x|; the Rayleigh
+// quotient of K^-1 gives 1 / lambda), as a fraction of max |K_ii|. `spread`: the
+// eigen-residual |K^-1 x - x / lambda| / |K^-1 x| of the last step (small: converged to
+// a real eigenvalue; near 1: a complex pair or close eigenvalues, the estimate is rough).
+// K is unsymmetric in the forming cases (viscous slip), so the estimate is of K itself,
+// not of its symmetric part.
+constexpr int kInverseSteps = 8;
+double nearest_eigenvalue(TangentSolver& solver, const linalg::SparseMatrix& k, double& spread, VecX& mode) {
+  const Index n = k.rows();
+  spread = 1.0;
+  if (n == 0) return 0.0;
+  VecX x(n);
+  for (Index i = 0; i < n; ++i) x(i) = 1.0 + 0.5 * std::sin(0.7 * double(i) + 0.3);  // fixed start, not an eigenvector
+  x.normalize();
+  double mu = 0.0;  // 1 / lambda
+  for (int it = 0; it < kInverseSteps; ++it) {
+    const VecX w = solver.solve(x);
+    if (!w.allFinite() || w.norm() == 0.0) return std::numeric_limits<double>::quiet_NaN();
+    mu = x.dot(w);
+    spread = (w - mu * x).norm() / w.norm();
+    x = w.normalized();
+  }
+  mode = x;
+  const double diag = k.diagonal().cwiseAbs().maxCoeff();
+  return (mu == 0.0 ? std::numeric_limits<double>::infinity() : 1.0 / mu) / std::max(diag, 1e-300);
+}
+
+// Where the mode v (all dofs) is largest: the ply (body), the node's position (x, z) and
+// the coordinate of its largest entry, and each ply's share of |v|^2 (in %).
+std::string locate_mode(const Model& model, const VecX& v, const VecX& x) {
+  Index at = 0;
+  v.cwiseAbs().maxCoeff(&at);
+  std::ostringstream os;
+  os.precision(3);
+  for (int b = 0; b < model.n_bodies(); ++b) {
+    const Index end = b + 1 < model.n_bodies() ? model.offset(b + 1) : model.n_dofs();
+    if (at >= model.offset(b) && at < end) {
+      const Index local = at - model.offset(b), node = local / 12;
+      const Index p = model.dof(b, node, 0, 0);
+      os << "largest at ply " << b + 1 << " node " << node << " (x " << x(p) << ", z " << x(p + 2) << ") "
+         << "xyz"[local % 3] << (local % 12 >= 3 ? " (a derivative)" : "") << "; ply shares %";
+    }
+  }
+  const double total = std::max(v.squaredNorm(), 1e-300);
+  for (int b = 0; b < model.n_bodies(); ++b) {
+    const Index end = b + 1 < model.n_bodies() ? model.offset(b + 1) : model.n_dofs();
+    os << " " << std::lround(100.0 * v.segment(model.offset(b), end - model.offset(b)).squaredNorm() / total);
+  }
+  return os.str();
+}
+
+// The trace line of a tangent: its factorisation, negative pivots (symmetric LDL^T), the
+// sign of its determinant (MUMPS) and the nearest eigenvalue (above) with where its mode
+// is largest.
+void trace_tangent(const char* what, TangentSolver& solver, const linalg::SparseMatrix& k,
+                   const linalg::SolveReport& sr, const Model& model, const FreeDofs& free, const VecX& x) {
+  double spread = 1.0;
+  VecX mode;
+  const double lambda = nearest_eigenvalue(solver, k, spread, mode);
+  std::fprintf(stderr, "newton:   %s: %s, negative pivots %d, det sign %+d, nearest eigenvalue %.3e max|K_ii| "
+               "(spread %.1e)\n", what, sr.brief().c_str(), sr.negative_pivots, sr.determinant_sign, lambda, spread);
+  if (mode.size() == free.size() && mode.size() > 0)
+    std::fprintf(stderr, "newton:     its mode: %s\n", locate_mode(model, free.expand(mode), x).c_str());
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------
@@ -46,6 +112,7 @@ void StaticOptions::validate() const {
     bad_option("min_increment", "a value in (0, initial_increment]", min_increment);
   if (!(growth >= 1.0) || !std::isfinite(growth)) bad_option("growth", "a finite factor >= 1", growth);
   if (easy_iterations < 1) bad_option("easy_iterations", "at least 1", easy_iterations);
+  if (regrow_after < 0) bad_option("regrow_after", "at least 0", regrow_after);
   if (max_iterations < 1) bad_option("max_iterations", "at least 1", max_iterations);
   if (max_steps < 1) bad_option("max_steps", "at least 1", max_steps);
   if (!(residual_tol_rel >= 0.0)) bad_option("residual_tol_rel", "a value >= 0", residual_tol_rel);
@@ -259,6 +326,10 @@ LoadStepping::Predicted LoadStepping::predict(double lam_new, const VecX& x, Vec
     rec.failure = "predictor: linear solve " + sr.brief();
     return Predicted::kFailed;
   }
+  static const bool trace_tangents = std::getenv("SF_NEWTON_TRACE") != nullptr;
+  // The tangent at the converged state (before the tools move): its determinant's sign
+  // changing between steps means an odd number of real eigenvalues passed zero.
+  if (trace_tangents) trace_tangent("predictor tangent", *solver_, pattern_->matrix(), sr, model_, free_, x);
   const VecX dxf = solver_->solve(rhs);
   const VecX dx = free_.expand(dxf);
   xt = x_new + dx;
@@ -368,8 +439,7 @@ void LoadStepping::correct(double lam_new, VecX& xt, StepRecord& rec, double& fo
       rec.failure = "linear solve " + sr.brief();
       return;
     }
-    if (trace)
-      std::fprintf(stderr, "newton:   tangent: %s, negative pivots %d\n", sr.brief().c_str(), sr.negative_pivots);
+    if (trace) trace_tangent("tangent", *solver_, pattern_->matrix(), sr, model_, free_, xt);
     const VecX dxf = solver_->solve(-rf);
     ++rec.iterations;
     if (!dxf.allFinite()) {
@@ -512,6 +582,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   if (options.workspace && options.workspace->next_increment > 0.0)
     increment = std::clamp(options.workspace->next_increment, options.min_increment, increment);
   int attempts = 0;
+  int in_a_row = 0;  // steps converged since the last cut-back or growth (regrow_after)
   // StaticOptions::extrapolate: the first predictor starts from the previous increment.
   const double span = options.clock.end - options.clock.start;
   VecX extrapolated;
@@ -547,13 +618,18 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
       x = xt;
       lambda = lam_new;
       steps.converged(lambda, x);
-      if (rec.iterations <= options.easy_iterations)
+      ++in_a_row;
+      if (rec.iterations <= options.easy_iterations ||
+          (options.regrow_after > 0 && in_a_row >= options.regrow_after)) {
         increment = std::min(options.max_increment, increment * options.growth);
+        in_a_row = 0;
+      }
       report.add(std::move(rec));
       continue;
     }
     why = rec.failure;
     report.add(std::move(rec));
+    in_a_row = 0;
     increment *= 0.5;
     if (increment < options.min_increment) {
       report.status = SolveStatus::kStepFailed;

@@ -26,8 +26,9 @@
 // once (after at least eight iterations). A step
 // that fails (too many iterations, divergence, an inverted Gauss point, a singular
 // tangent) is retried from the last converged state with half the load increment;
-// after a step that converges in <= options.easy_iterations the increment grows by
-// options.growth (capped at max_increment); with a shared options.workspace (a run's
+// after a step that converges in <= options.easy_iterations, or after
+// options.regrow_after steps in a row converged since the last cut-back or growth, the
+// increment grows by options.growth (capped at max_increment); with a shared options.workspace (a run's
 // load steps) the next solve starts with the increment this one ended with. Every loop is bounded: the solve ends
 // with a report, never an endless loop, and returns the last converged state.
 //
@@ -71,6 +72,11 @@ struct StaticOptions {
   double min_increment = 1e-6;     // cut back below this -> kStepFailed
   double growth = 1.5;             // increment growth after an easy step, >= 1
   int easy_iterations = 5;         // ... i.e. one converging in at most this many iterations
+  // ... or after this many steps in a row converged at one increment (0: never). Under
+  // contact a sub-step rarely converges in easy_iterations (the active set wanders for
+  // 5-15 iterations at any size: the matched-die bends), so without it one cut-back to 1/8
+  // kept every later step of the run in eighths.
+  int regrow_after = 2;
   int max_iterations = 25;         // Newton iterations per step (predictor included)
   // Start each solve's first predictor from the start state moved by the previous
   // solve's increment, scaled to this solve's process-time span (kept in the workspace):

@@ -229,6 +229,37 @@ TEST(FormingPatch, UnreachableStateEndsWithReportAndLastConvergedState) {
   EXPECT_NEAR(capped.report.load_factor, 0.03, 1e-12);
 }
 
+// After a cut-back (here: a small first increment) the increment grows again after
+// regrow_after converged sub-steps in a row, even when none converges within
+// easy_iterations (under contact none does: the matched-die bends).
+TEST(FormingPatch, IncrementGrowsAgainAfterStepsInARow) {
+  Model model;
+  model.add_ply(distorted_ply(0.0), std::make_shared<NeoHookean>(NeoHookeanParams{1.0, 3.0}));
+  Mat3 F = Mat3::Identity();
+  F(0, 0) = 1.3;
+  F(0, 1) = 0.2;
+  const VecX target = fixtures::affine(model.ply(0), F, Vec3::Zero());
+  StaticOptions options;
+  options.initial_increment = 1.0 / 16.0;
+  options.easy_iterations = 1;  // no step is easy (each takes a few Newton iterations)
+  auto run = [&](int regrow_after) {
+    StaticOptions o = options;
+    o.regrow_after = regrow_after;
+    return solve_static(model, model.reference_positions(), prescribe_boundary(model, target), VecX(), o);
+  };
+  const StaticResult fixed = run(0), regrown = run(2);
+  ASSERT_TRUE(fixed.report.ok()) << fixed.report.brief();
+  ASSERT_TRUE(regrown.report.ok()) << regrown.report.brief();
+  std::printf("increment 1/16: %d steps without regrowth, %d with it (every 2nd step x1.5)\n",
+              fixed.report.n_converged_steps, regrown.report.n_converged_steps);
+  EXPECT_EQ(fixed.report.n_converged_steps, 16);
+  // 1/16 twice, 3/32 twice, 9/64 twice, 27/128 twice: 1 is reached in 8 steps (the last shortened).
+  EXPECT_EQ(regrown.report.n_converged_steps, 8);
+  EXPECT_NEAR(regrown.report.steps[2].increment, 1.5 / 16.0, 1e-12);
+  EXPECT_NEAR(regrown.positions.dot(regrown.positions), fixed.positions.dot(fixed.positions),
+              1e-8 * fixed.positions.squaredNorm());
+}
+
 TEST(FormingPatch, BadOptionsAndInputsAreNamed) {
   StaticOptions o;
   o.max_iterations = 0;

@@ -114,3 +114,13 @@ sf_gsa_cli_test(synth_images_bad_shape
 set(SF_TEST_LABELS long)
 sf_add_test_suite(digitise_long digitise_long sf_gsa)
 unset(SF_TEST_LABELS)
+
+# OpenCV's image codecs (with GDAL, ~120 libraries, 0.06 s) are loaded when an image is
+# read or written, not at every start of gsa (gsa/digitise/image.cpp): the dynamic loader's
+# list of the files it loads for `gsa --version` must not name them.
+add_test(NAME gsa.cli.digitise_codecs_not_loaded_at_start
+         COMMAND ${CMAKE_COMMAND} -E env LD_DEBUG=files $<TARGET_FILE:gsa> --version)
+set_tests_properties(gsa.cli.digitise_codecs_not_loaded_at_start PROPERTIES
+  LABELS "gsa;cli"
+  PASS_REGULAR_EXPRESSION "file=libcholmod"  # the loader's list is there
+  FAIL_REGULAR_EXPRESSION "libopencv_imgcodecs")

@@ -8,6 +8,8 @@
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/property_map.h>
 
+#include <boost/iterator/function_output_iterator.hpp>
+
 #include <iterator>
 #include <utility>
 
@@ -32,6 +34,19 @@ std::vector<Sample> finite_samples(const Points3& points) {
   for (Index p = 0; p < points.rows(); ++p)
     if (points.row(p).allFinite()) s.emplace_back(Point(points(p, 0), points(p, 1), points(p, 2)), p);
   return s;
+}
+
+// The search's output: each point found other than `self` goes straight into `nb`, in the
+// order found (no list of samples per query to copy from).
+struct KeepOthers {  // assignable, as CGAL's search needs of its output iterator
+  std::vector<Index>* nb;
+  Index self;
+  void operator()(const Sample& f) const {
+    if (f.second != self) nb->push_back(f.second);
+  }
+};
+auto keep_others(std::vector<Index>& nb, Index self) {
+  return boost::make_function_output_iterator(KeepOthers{&nb, self});
 }
 
 }  // namespace
@@ -62,11 +77,8 @@ std::vector<std::vector<Index>> neighbours_within(const Points3& points, double 
   tree.build();
   parallel_for(static_cast<Index>(samples.size()), [&](Index i) {
     const Sample& s = samples[static_cast<std::size_t>(i)];
-    std::vector<Sample> found;
-    tree.search(std::back_inserter(found), Sphere(s.first, radius, 0.0));
     std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
-    for (const Sample& f : found)
-      if (f.second != s.second) nb.push_back(f.second);
+    tree.search(keep_others(nb, s.second), Sphere(s.first, radius, 0.0));
   });
   return out;
 }
@@ -83,10 +95,8 @@ std::vector<std::vector<Index>> neighbours_within(const Points3& points, double 
       [&](Index i) {
         const Index p = query[static_cast<std::size_t>(i)];
         if (!points.row(p).allFinite()) return;
-        std::vector<Sample> found;
-        tree.search(std::back_inserter(found), Sphere(Point(points(p, 0), points(p, 1), points(p, 2)), radius, 0.0));
-        for (const Sample& f : found)
-          if (f.second != p) out[static_cast<std::size_t>(i)].push_back(f.second);
+        tree.search(keep_others(out[static_cast<std::size_t>(i)], p),
+                    Sphere(Point(points(p, 0), points(p, 1), points(p, 2)), radius, 0.0));
       },
       16);
   return out;

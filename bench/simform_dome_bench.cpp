@@ -21,6 +21,9 @@
 //   --max-steps N stop cleanly after N steps (the full run can take long)
 //   --case FILE   another case (default: the [0,90]s dome)
 //   --stabilise F solver: {stabilise: {fraction: F}} (viscous stabilisation, calibrated from step 1)
+//   --damping C   solver: {stabilise: {damping: C}} (the damping factor given, N s/mm^4, from
+//                 step 1 on, as in dome_isotropic.yaml); the step table then shows the
+//                 dissipated fraction of the strain energy
 //   --ordering O  fill-reducing ordering of the Newton tangent's solver (default: the
 //                 solvers' own choice; forming/solve/tangent_solver.hpp)
 //   --time-limit S  after S seconds print the figures so far (a snapshot taken while the
@@ -301,6 +304,7 @@ int main(int argc, char** argv) {
   std::string solvers;  // --solvers: ",kind,kind," (empty: all)
   double time_limit = 0.0;
   double stabilise = 0.0;
+  double damping = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
@@ -345,11 +349,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "simform_dome_bench: --stabilise: expected a fraction in (0, 1), found '%s'\n", argv[i]);
         return 2;
       }
+    } else if (a == "--damping" && i + 1 < argc) {
+      damping = std::atof(argv[++i]);
+      if (!(damping > 0.0 && std::isfinite(damping))) {
+        std::fprintf(stderr, "simform_dome_bench: --damping: expected a damping factor > 0 (N s/mm^4), found '%s'\n",
+                     argv[i]);
+        return 2;
+      }
     } else {
       std::fprintf(stderr,
                    "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
                    "[--factor-only [--solvers K,K] | --iterative] [--linear direct|iterative|iterative-ply|auto] "
-                   "[--no-band-pattern] [--time-limit S] [--stabilise FRACTION]\n");
+                   "[--no-band-pattern] [--time-limit S] [--stabilise FRACTION | --damping C]\n");
       return 2;
     }
   }
@@ -381,6 +392,10 @@ int main(int argc, char** argv) {
     if (stabilise > 0.0) {  // solver: {stabilise: {fraction: F}} (forming/solve/stabilisation.hpp)
       spec.solver.stabilise_fraction = stabilise;
       spec.solver.stabilise_damping = 0.0;
+    }
+    if (damping > 0.0) {  // solver: {stabilise: {damping: C}}
+      spec.solver.stabilise_fraction = 0.0;
+      spec.solver.stabilise_damping = damping;
     }
     if (only_factor) return factor_only(spec, iterative, solvers);
     // One folder per process: runs side by side (sizes, orderings) do not collide.
@@ -415,14 +430,21 @@ int main(int argc, char** argv) {
     const io::CsvTable h = io::read_csv((dir / "history.csv").string());
     const auto col = [&](const char* name) { return h.column_index(name); };
     const bool stabilised = h.has_column("stabilisation_ratio");
-    std::printf("%5s %10s %18s %7s %9s%s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks",
-                stabilised ? "  stabilisation_ratio" : "");
-    for (std::size_t row = 1; row < h.n_rows(); ++row)
-      std::printf("%5zu %10.4f %18.12g %7s %9s%s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
+    // The blank holder's force along z (N; positive: the plies push it up): what the
+    // holder's closure (dome_*.yaml) presses the flange with.
+    const bool holder = h.has_column("holder_fz");
+    std::printf("%5s %10s %18s %7s %9s%s%s\n", "step", "punch_uz", "punch_fz", "newton", "cutbacks",
+                holder ? "  holder_fz" : "", stabilised ? "  stabilisation_ratio" : "");
+    for (std::size_t row = 1; row < h.n_rows(); ++row) {
+      char holder_cell[32] = "";
+      if (holder)
+        std::snprintf(holder_cell, sizeof holder_cell, "  %9.4f", std::stod(std::string(h.cell(row, col("holder_fz")))));
+      std::printf("%5zu %10.4f %18.12g %7s %9s%s%s\n", row, std::stod(std::string(h.cell(row, col("punch_uz")))),
                   std::stod(std::string(h.cell(row, col("punch_fz")))),
                   std::string(h.cell(row, col("newton_iterations"))).c_str(),
-                  std::string(h.cell(row, col("cutbacks"))).c_str(),
+                  std::string(h.cell(row, col("cutbacks"))).c_str(), holder_cell,
                   stabilised ? ("  " + std::string(h.cell(row, col("stabilisation_ratio")))).c_str() : "");
+    }
     std::printf("status %s: %d steps, %d Newton iterations, %ld assemblies, %ld factorisations, %ld solves\n",
                 r.ok() ? "ok" : "not converged", r.steps_converged, r.total_iterations, p.assemblies, p.factorizations,
                 p.solves);

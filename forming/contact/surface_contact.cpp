@@ -43,20 +43,21 @@ void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, cons
   // Half pass: rows of the slave side only (its entries come first).
   const int rows = half_pass ? static_cast<int>(slave.dofs.size()) : m;
   for (int a = 0; a < rows; ++a) sums.force(dofs[a]) += coefs[a] * c.force(local[a]);
-  const auto add = [&](const MatX& k, linalg::TripletAssembler* target) {
+  const std::vector<Index> row_dofs(dofs.begin(), dofs.begin() + rows);
+  const auto add = [&](const MatX& k, linalg::TripletAssembler* target, linalg::PatternAssembler* pattern) {
     if (!target || k.size() == 0) return;
     MatX block(rows, m);
     for (int cc = 0; cc < m; ++cc)
       for (int a = 0; a < rows; ++a) block(a, cc) = coefs[a] * coefs[cc] * k(local[a], local[cc]);
-    if (rows == m) {
-      target->add_block(dofs, dofs, block);
+    if (pattern) {  // straight into the kept pattern (InteractionSums::pattern)
+      pattern->add_block(row_dofs, dofs, block.data(), rows);
+      sums.pattern_entries += static_cast<long>(rows) * m;
     } else {
-      const std::vector<Index> row_dofs(dofs.begin(), dofs.begin() + rows);
       target->add_block(row_dofs, dofs, block);
     }
   };
-  add(c.stiffness, sums.stiffness);
-  add(c.damping, sums.damping);
+  add(c.stiffness, sums.stiffness, sums.pattern);
+  add(c.damping, sums.damping, nullptr);
 }
 
 }  // namespace

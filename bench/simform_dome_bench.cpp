@@ -107,8 +107,8 @@ static void print_split(const SolveProfile& p, double total, double cpu, long it
               100 * p.elements_s / total, 100 * p.contact_s / total, 100 * p.factorize_s / total,
               100 * p.solve_s / total, 100 * other / total);
   std::printf(
-      "contact: evaluation (search, laws, local tangents) %.4f s, merge into the pattern %.4f s per iteration; %.0f "
-      "entries merged per assembly\n",
+      "contact: evaluation (search, laws, local tangents, their entries into the kept pattern) %.4f s, merge of "
+      "triplets and pattern growth %.4f s per iteration; %.0f stiffness entries per assembly\n",
       p.contact_eval_s / n_it, p.contact_merge_s / n_it,
       static_cast<double>(p.contact_entries) / static_cast<double>(std::max(1L, p.assemblies)));
   std::printf("linear: %s\n", solve_profile_linear_summary(p).c_str());

@@ -193,6 +193,51 @@ void PatternAssembler::add(const SparseMatrix& m, double scale) {
     for (SparseMatrix::InnerIterator it(m, k); it; ++it) add(it.row(), it.col(), scale * it.value());
 }
 
+void PatternAssembler::add_block(const std::vector<Index>& rows, const std::vector<Index>& cols, const double* block,
+                                 long ld) {
+  const std::size_t nr = rows.size();
+  thread_local std::vector<int> order, unknown;
+  thread_local std::vector<std::int64_t> pos;
+  unknown.resize(nr);
+  pos.resize(nr);
+  order.clear();
+  for (std::size_t a = 0; a < nr; ++a) {
+    const Index i = rows[a];
+    SF_ASSERT(i < n_dofs_, "dof out of range");
+    unknown[a] = i >= 0 ? static_cast<int>(index_[static_cast<std::size_t>(i)]) : -1;
+    if (unknown[a] >= 0) order.push_back(static_cast<int>(a));
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return unknown[a] < unknown[b]; });
+  const int* outer = matrix_.outerIndexPtr();
+  const int* inner = matrix_.innerIndexPtr();
+  double* val = matrix_.valuePtr();
+  const bool lower = storage_ == Storage::kLower;
+  for (std::size_t b = 0; b < cols.size(); ++b) {
+    const Index j = cols[b];
+    if (j < 0) continue;
+    SF_ASSERT(j < n_dofs_, "dof out of range");
+    const Index c = index_[static_cast<std::size_t>(j)];
+    if (c < 0) continue;
+    // Positions of the rows in column c: -1 dropped, -2 outside the pattern.
+    int p = outer[c];
+    const int end = outer[c + 1];
+    for (std::size_t a = 0; a < nr; ++a) pos[a] = -1;
+    for (int a : order) {
+      const int r = unknown[static_cast<std::size_t>(a)];
+      if (lower && r < c) continue;
+      while (p < end && inner[p] < r) ++p;
+      pos[static_cast<std::size_t>(a)] = p < end && inner[p] == r ? p : -2;
+    }
+    const double* col = block + static_cast<long>(b) * ld;
+    for (std::size_t a = 0; a < nr; ++a) {
+      if (pos[a] >= 0)
+        val[pos[a]] += col[a];
+      else if (pos[a] == -2)
+        pending_.push_back({{unknown[a], c}, col[a]});
+    }
+  }
+}
+
 std::vector<std::int64_t> PatternAssembler::positions_of(const SparseMatrix& m) const {
   SF_ASSERT(m.isCompressed(), "positions_of needs a compressed matrix");
   std::vector<std::int64_t> out(static_cast<std::size_t>(m.nonZeros()), -1);

@@ -84,6 +84,14 @@ class PatternAssembler {
   void add(Index i, Index j, double v);
   // Adds scale * m (n_dofs x n_dofs, any pattern) entry by entry, as add().
   void add(const SparseMatrix& m, double scale);
+  // Adds block(a, b) to the entry of global dofs (rows[a], cols[b]) for every a, b, as
+  // add() would, in the same order (column by column, rows in order within a column):
+  // negative dofs are skipped like a TripletAssembler skips them, inactive ones and
+  // kLower's upper triangle are dropped, entries outside the pattern kept aside for
+  // flush(). One walk down each pattern column instead of a search per entry; block is
+  // column-major with leading dimension ld. Not thread-safe. (Contact pairs' blocks,
+  // whose pairs change between iterations: forming/contact/surface_contact.cpp.)
+  void add_block(const std::vector<Index>& rows, const std::vector<Index>& cols, const double* block, long ld);
   // Grows the pattern by the entries add() kept aside (values are kept) and adds them;
   // false when there were none. Call after the last add() of an assembly.
   bool flush();

@@ -1,8 +1,10 @@
 #include "forming/contact/contact_kernel.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/core/error.hpp"
+#include "common/linalg/dense_kernels.hpp"
 
 namespace sf::forming {
 namespace {
@@ -12,32 +14,30 @@ void add_jt(const PointKinematics& k, double scale, const Vec3& v, VecX& out) {
   for (int a = 0; a < k.n; ++a) out.segment<3>(3 * a) += (scale * k.phi[static_cast<std::size_t>(a)]) * v;
 }
 
-// The normal stiffness of a body contact: w (S dg dg^T - p d2g), by 3 x 3 blocks.
-void body_normal_stiffness(const PointKinematics& k, double w, double S, double p, MatX& K) {
-  const Vec3& n = k.normal;
-  const Mat3 nn = n * n.transpose();
-  const Mat2 C = k.M_inv * k.kappa * k.H_inv;
-  const Mat3 Q1 = k.T * C * k.T.transpose();
-  std::array<Vec3, kMaxPointFunctions> q;
-  std::array<Vec2, kMaxPointFunctions> hr;  // H^-1 rho_a
-  for (int a = 0; a < k.n; ++a) {
-    const auto ia = static_cast<std::size_t>(a);
-    hr[ia] = k.H_inv * Vec2(k.rho1[ia], k.rho2[ia]);
-    q[ia] = k.T * hr[ia];
-  }
-  for (int c = 0; c < k.n; ++c) {
-    const auto ic = static_cast<std::size_t>(c);
-    const Vec2 rc(k.rho1[ic], k.rho2[ic]);
-    for (int a = 0; a < k.n; ++a) {
-      const auto ia = static_cast<std::size_t>(a);
-      const double pp = k.phi[ia] * k.phi[ic];
-      // -d2g_ac = pp Q1 + phi_c n q_a^T + phi_a q_c n^T + g (rho_a . H^-1 rho_c) n n^T
-      Mat3 minus_d2g = pp * Q1 + k.phi[ic] * n * q[ia].transpose() + k.phi[ia] * q[ic] * n.transpose() +
-                       (k.gap * hr[ia].dot(rc)) * nn;
-      K.block<3, 3>(3 * a, 3 * c) += w * (S * pp * nn + p * minus_d2g);
+constexpr int kMaxLocal = 3 * kMaxPointFunctions;
+constexpr int kMaxRank = 7;
+// A point's stiffness factors (U, V: 3n x 7) and rows over the local dofs, on the stack.
+using Factors = Eigen::Matrix<double, Eigen::Dynamic, kMaxRank, Eigen::ColMajor, kMaxLocal, kMaxRank>;
+// K += U V^T (m x m, U and V m x rank, all column-major, leading dimension m) by the
+// run-time chosen kernel of common/linalg/dense_kernels.hpp: its lower triangle from
+// U V^T and its upper from the lower triangle of V U^T. (Eigen's own product would
+// start OpenMP threads for these sizes, whose spinning cost more than the product.)
+void add_uvt(int m, int rank, const double* u, const double* v, MatX& K, MatX& lower, MatX& upper) {
+  lower.setZero(m, m);
+  upper.setZero(m, m);
+  linalg::add_atb_lower(m, rank, u, m, v, m, lower.data(), m);
+  linalg::add_atb_lower(m, rank, v, m, u, m, upper.data(), m);
+  for (int j = 0; j < m; ++j) {
+    K(j, j) += lower(j, j);
+    for (int i = j + 1; i < m; ++i) {
+      K(i, j) += lower(i, j);
+      K(j, i) += upper(i, j);
     }
   }
 }
+
+template <int R>
+using LocalRows = Eigen::Matrix<double, R, Eigen::Dynamic, R == 1 ? Eigen::RowMajor : Eigen::ColMajor, R, kMaxLocal>;
 
 }  // namespace
 
@@ -57,20 +57,64 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   // ---- normal
   out.energy += w * law.normal.energy;
   if (p != 0.0) add_jt(k, -w * p, n, out.force);
-  if (tangent && (S != 0.0 || p != 0.0)) {
-    if (k.tool) {
-      const Mat3 block = S * n * k.gap_gradient.transpose() - p * k.dn_dx;
-      for (int c = 0; c < k.n; ++c)
-        for (int a = 0; a < k.n; ++a)
-          out.stiffness.block<3, 3>(3 * a, 3 * c) +=
-              (w * k.phi[static_cast<std::size_t>(a)] * k.phi[static_cast<std::size_t>(c)]) * block;
-    } else {
-      body_normal_stiffness(k, w, S, p, out.stiffness);
+  // Stiffness factors K = U V^T (contact_kernel.hpp): U = [Phi N_h R], V accumulated.
+  const int rank = k.tool ? 3 : kMaxRank;
+  Factors U, V;
+  bool stiff = false;
+  if (tangent) {
+    U.setZero(m, kMaxRank);
+    V.setZero(m, kMaxRank);
+    for (int a = 0; a < k.n; ++a) {
+      const auto ia = static_cast<std::size_t>(a);
+      U.block<3, 3>(3 * a, 0).diagonal().setConstant(k.phi[ia]);
+      if (!k.tool) U.block<3, 2>(3 * a, 3) = n * (k.H_inv * Vec2(k.rho1[ia], k.rho2[ia])).transpose();
     }
   }
+  if (tangent && (S != 0.0 || p != 0.0)) {
+    stiff = true;
+    if (k.tool) {
+      // w phi_a phi_c (S n (dg/dx)^T - p dn/dx) = Phi B Phi^T: V_Phi = Phi B^T.
+      const Mat3 Bt = (w * (S * n * k.gap_gradient.transpose() - p * k.dn_dx)).transpose();
+      for (int c = 0; c < k.n; ++c) V.block<3, 3>(3 * c, 0) += k.phi[static_cast<std::size_t>(c)] * Bt;
+    } else {
+      // w (S dg dg^T - p d2g), -d2g_ac = phi_a phi_c T C T^T + phi_c n q_a^T + phi_a q_c n^T
+      // + g (rho_a . H^-1 rho_c) n n^T, q_a = T H^-1 rho_a (header):
+      //   Phi [A Phi^T + w p T N_h^T] + N_h [w p (Phi T + g N_r)]^T,
+      //   A = w (S n n^T + p T C T^T), N_r = rho_c,l n_j.
+      const Mat3 nn = n * n.transpose();
+      const Mat2 C = k.M_inv * k.kappa * k.H_inv;
+      const Mat3 At = (w * (S * nn + p * (k.T * C * k.T.transpose()))).transpose();
+      const double wp = w * p;
+      for (int c = 0; c < k.n; ++c) {
+        const auto ic = static_cast<std::size_t>(c);
+        const Vec2 rc(k.rho1[ic], k.rho2[ic]);
+        const Vec3 qc = k.T * (k.H_inv * rc);
+        V.block<3, 3>(3 * c, 0) += k.phi[ic] * At + wp * n * qc.transpose();
+        V.block<3, 2>(3 * c, 3) += wp * (k.phi[ic] * k.T + k.gap * n * rc.transpose());
+      }
+    }
+  }
+  const auto finish = [&]() {
+    if (!stiff) return;
+    if (out.deferred) {
+      if (out.rank + rank > out.u.cols()) {
+        const Index cols = std::max<Index>(2 * out.u.cols(), out.rank + rank);
+        out.u.conservativeResize(m, cols);
+        out.v.conservativeResize(m, cols);
+      }
+      out.u.middleCols(out.rank, rank) = U.leftCols(rank);
+      out.v.middleCols(out.rank, rank) = V.leftCols(rank);
+      out.rank += rank;
+    } else {
+      add_uvt(m, rank, U.data(), V.data(), out.stiffness, out.lower, out.upper);
+    }
+  };
 
   // ---- friction
-  if (!law.friction() || !rates.have) return state;
+  if (!law.friction() || !rates.have) {
+    finish();
+    return state;
+  }
   const Mat3 P = Mat3::Identity() - n * n.transpose();
   const Vec3 vt = P * rates.relative;
   const double eps = law.stick_velocity;
@@ -80,7 +124,10 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   state.slip_rate = vt;
   state.shear = -c * vt;
   if (c != 0.0) add_jt(k, w * c, vt, out.force);
-  if (!tangent && out.damping.size() == 0) return state;
+  if (!tangent && out.damping.size() == 0) {
+    finish();
+    return state;
+  }
 
   // J^T v_T, a local vector.
   VecX jt_vt = VecX::Zero(m);
@@ -100,8 +147,8 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   if (!tangent) return state;
 
   // d zeta / du (2 x m, body only) and d n / du (3 x m).
-  MatX dzeta = MatX::Zero(2, m);
-  MatX dn(3, m);
+  LocalRows<2> dzeta = LocalRows<2>::Zero(2, m);
+  LocalRows<3> dn(3, m);
   if (k.tool) {
     for (int cc = 0; cc < k.n; ++cc) dn.middleCols<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.dn_dx;
   } else {
@@ -118,33 +165,55 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
     }
   }
   // d v_rel / du.
-  MatX dw = MatX::Zero(3, m);
+  LocalRows<3> dw = LocalRows<3>::Zero(3, m);
   if (rates.inv_dt > 0.0)
     for (int cc = 0; cc < k.n; ++cc)
-      dw.middleCols<3>(3 * cc) += (k.phi[static_cast<std::size_t>(cc)] * rates.inv_dt) * Mat3::Identity();
+      dw.middleCols<3>(3 * cc).diagonal().setConstant(k.phi[static_cast<std::size_t>(cc)] * rates.inv_dt);
   if (!k.tool) dw -= rates.master_d1 * dzeta.row(0) + rates.master_d2 * dzeta.row(1);
-  const MatX dvt = -n.dot(rates.relative) * dn - n * (rates.relative.transpose() * dn) + P * dw;
-  // (J^T v_T) dc/du.
+  const LocalRows<3> dvt = -n.dot(rates.relative) * dn - n * (rates.relative.transpose() * dn) + P * dw;
+  // Friction stiffness w [ (J^T v_T) dc/du + c J^T dv_T/du + c (dJ^T/du) v_T ]
+  //   = Phi [w (v_T dc + c dv_T)] - R [w c dzeta]   (R = rho_a,l (v_T)_i: body only).
+  LocalRows<3> phi_part = c * dvt;
   if (law.coulomb > 0.0 || law.viscous_slope != 0.0) {
-    Eigen::RowVectorXd dg(m);  // dg/du
+    LocalRows<1> dg(1, m);  // dg/du
     for (int cc = 0; cc < k.n; ++cc)
       dg.segment<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.gap_gradient.transpose();
     // dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du, dp/du = -S dg/du.
-    Eigen::RowVectorXd dc = law.viscous_slope * dg;
+    LocalRows<1> dc = law.viscous_slope * dg;
     if (law.coulomb > 0.0) dc += (-law.coulomb * S / s) * dg - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
-    out.stiffness.noalias() += w * jt_vt * dc;
+    phi_part.noalias() += vt * dc;
   }
-  // c (dJ^T/du) v_T (body: the master functions move with zeta) and c J^T dv_T/du.
-  for (int a = 0; a < k.n; ++a) {
-    const auto ia = static_cast<std::size_t>(a);
-    for (int i = 0; i < 3; ++i) {
-      auto row = out.stiffness.row(3 * a + i);
-      row += (w * c * k.phi[ia]) * dvt.row(i);
-      if (!k.tool && (k.rho1[ia] != 0.0 || k.rho2[ia] != 0.0))
-        row -= (w * c * vt[i]) * (k.rho1[ia] * dzeta.row(0) + k.rho2[ia] * dzeta.row(1));
+  V.leftCols<3>() += w * phi_part.transpose();
+  if (!k.tool) {
+    for (int a = 0; a < k.n; ++a) {
+      const auto ia = static_cast<std::size_t>(a);
+      U.block<3, 2>(3 * a, 5) = vt * Vec2(k.rho1[ia], k.rho2[ia]).transpose();
     }
+    V.middleCols<2>(5) -= (w * c) * dzeta.transpose();
   }
+  stiff = true;
+  finish();
   return state;
+}
+
+}  // namespace sf::forming
+
+namespace sf::forming {
+
+void LocalContribution::defer_stiffness(int points) {
+  deferred = true;
+  rank = 0;
+  const Index m = stiffness.rows();
+  const Index cols = static_cast<Index>(points) * kMaxRank;
+  if (u.rows() != m || u.cols() < cols) {
+    u.resize(m, cols);
+    v.resize(m, cols);
+  }
+}
+
+void LocalContribution::finish_stiffness() {
+  if (rank > 0) add_uvt(static_cast<int>(stiffness.rows()), rank, u.data(), v.data(), stiffness, lower, upper);
+  rank = 0;
 }
 
 }  // namespace sf::forming

@@ -68,6 +68,8 @@ FaceBasis::FaceBasis(BrickFace face) : face_(face) {
       for (int a = 0; a < n_; ++a)
         bezier_(js + ns * jt, a) = to_bezier(s_linear_, js, is_[static_cast<std::size_t>(a)]) *
                                    to_bezier(t_linear_, jt, it_[static_cast<std::size_t>(a)]);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) grid_[static_cast<std::size_t>(i + 3 * j)] = evaluate(0.5 * i, 0.5 * j, false).value;
   for (int c = 0; c < 4; ++c) {
     const Vec3 p = xi(c & 1, c >> 1);
     corners_[static_cast<std::size_t>(c)] =

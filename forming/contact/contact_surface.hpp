@@ -59,6 +59,9 @@ class FaceBasis {
   const MatX& bezier() const { return bezier_; }
   // Face corners (s, t) = (0,0), (1,0), (0,1), (1,1) as brick local nodes (a + 2b + 4c).
   const std::array<int, 4>& corner_nodes() const { return corners_; }
+  // The function values at the 3 x 3 grid (s, t) = (i / 2, j / 2), point i + 3 j, as
+  // evaluate() gives them (the start of every closest-point projection).
+  const std::array<double, 16>& grid_values(int point) const { return grid_[static_cast<std::size_t>(point)]; }
 
  private:
   BrickFace face_;
@@ -70,6 +73,7 @@ class FaceBasis {
   bool s_linear_ = false, t_linear_ = false;
   MatX bezier_;
   std::array<int, 4> corners_{};
+  std::array<std::array<double, 16>, 9> grid_{};
 };
 
 // The model dofs of a face vector: local entry 3 a + i takes coef times dof (one or two

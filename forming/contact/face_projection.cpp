@@ -44,9 +44,9 @@ FaceFoot project_on_face(const FaceBasis& basis, const Eigen::Ref<const MatX>& p
   for (int j = 0; j < 3; ++j)
     for (int i = 0; i < 3; ++i) {
       const Vec2 z(0.5 * i, 0.5 * j);
-      const FaceBasisValues v = basis.evaluate(z[0], z[1], false);
+      const std::array<double, 16>& value = basis.grid_values(i + 3 * j);
       Vec3 x = Vec3::Zero();
-      for (int a = 0; a < v.n; ++a) x += v.value[static_cast<std::size_t>(a)] * pos.row(a).transpose();
+      for (int a = 0; a < basis.n_active(); ++a) x += value[static_cast<std::size_t>(a)] * pos.row(a).transpose();
       const double d = (p - x).squaredNorm();
       if (d < best) {
         best = d;

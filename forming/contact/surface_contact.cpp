@@ -43,20 +43,21 @@ void scatter(const FaceDofs& slave, const FaceDofs* master, int slave_size, cons
   // Half pass: rows of the slave side only (its entries come first).
   const int rows = half_pass ? static_cast<int>(slave.dofs.size()) : m;
   for (int a = 0; a < rows; ++a) sums.force(dofs[a]) += coefs[a] * c.force(local[a]);
-  const auto add = [&](const MatX& k, linalg::TripletAssembler* target) {
+  const std::vector<Index> row_dofs(dofs.begin(), dofs.begin() + rows);
+  const auto add = [&](const MatX& k, linalg::TripletAssembler* target, linalg::PatternAssembler* pattern) {
     if (!target || k.size() == 0) return;
     MatX block(rows, m);
     for (int cc = 0; cc < m; ++cc)
       for (int a = 0; a < rows; ++a) block(a, cc) = coefs[a] * coefs[cc] * k(local[a], local[cc]);
-    if (rows == m) {
-      target->add_block(dofs, dofs, block);
+    if (pattern) {  // straight into the kept pattern (InteractionSums::pattern)
+      pattern->add_block(row_dofs, dofs, block.data(), rows);
+      sums.pattern_entries += static_cast<long>(rows) * m;
     } else {
-      const std::vector<Index> row_dofs(dofs.begin(), dofs.begin() + rows);
       target->add_block(row_dofs, dofs, block);
     }
   };
-  add(c.stiffness, sums.stiffness);
-  add(c.damping, sums.damping);
+  add(c.stiffness, sums.stiffness, sums.pattern);
+  add(c.damping, sums.damping, nullptr);
 }
 
 }  // namespace
@@ -145,7 +146,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
     MatX rate_pos, prev_pos;
     if (rates) rate_pos = slave_.positions(f, *rates);
     if (context.previous) prev_pos = slave_.positions(f, *context.previous);
-    blocks.clear();
+    std::size_t n_blocks = 0;  // blocks in use; the rest keep their storage for the next faces
     for (int q = 0; q < points_per_face(); ++q) {
       const std::size_t id = static_cast<std::size_t>(f * points_per_face() + q);
       const FaceBasisValues& v = point_basis_[static_cast<std::size_t>(f)][static_cast<std::size_t>(q)];
@@ -210,18 +211,24 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       }
       PointState st;
       if (sums) {
-        auto it = std::find_if(blocks.begin(), blocks.end(),
+        const auto end = blocks.begin() + static_cast<std::ptrdiff_t>(n_blocks);
+        auto it = std::find_if(blocks.begin(), end,
                                [&](const PairBlock& b) { return b.master_face == partner.master_face; });
-        if (it == blocks.end()) {
-          PairBlock b;
+        if (it == end) {
+          if (n_blocks == blocks.size()) blocks.emplace_back();
+          PairBlock& b = blocks[n_blocks++];
           b.master_face = partner.master_face;
           b.master_dofs = partner.master_dofs;
           const int m = 3 * k.n;
-          b.local.force = VecX::Zero(m);
-          if (tangent) b.local.stiffness = MatX::Zero(m, m);
-          if (damping) b.local.damping = MatX::Zero(m, m);
-          blocks.push_back(std::move(b));
-          it = blocks.end() - 1;
+          b.local.energy = 0.0;
+          b.local.force.setZero(m);
+          if (tangent) {
+            b.local.stiffness.setZero(m, m);
+            // The points' low-rank factors, multiplied out once per pair (contact_kernel.hpp).
+            b.local.defer_stiffness(points_per_face());
+          }
+          if (damping) b.local.damping.setZero(m, m);
+          it = blocks.begin() + static_cast<std::ptrdiff_t>(n_blocks - 1);
         }
         st = add_contact_point(k, law, pr, weight_[id], it->local);
       } else {
@@ -242,7 +249,9 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       }
     }
     if (sums)
-      for (const PairBlock& b : blocks) {
+      for (std::size_t i = 0; i < n_blocks; ++i) {
+        PairBlock& b = blocks[i];
+        if (tangent) b.local.finish_stiffness();
         sums->energy += options_.half_pass ? 0.5 * b.local.energy : b.local.energy;
         scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, options_.half_pass, *sums);
       }

@@ -24,7 +24,8 @@
 //   force     its force on the dofs with the sign of an internal force: the gradient of
 //             its energy, i.e. the force the bodies exert on it; the residual is
 //             r = f_elements + f_interactions - f_ext (N, n_dofs);
-//   stiffness d force / dx (N/mm) when asked for (non-null), into the model's triplets;
+//   stiffness d force / dx (N/mm) when asked for (non-null), into the model's triplets
+//             (or straight into `pattern` where the assembly gives one);
 //   damping   d force / dv (N s/mm) when asked for (non-null: the solver has velocities).
 // A state the interaction cannot evaluate (e.g. a contact search that fails) is a
 // numerical outcome: set `ok` false and a message, as an inverted element does.
@@ -47,6 +48,7 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/linalg/pattern_assembler.hpp"
 #include "common/linalg/sparse.hpp"
 
 namespace sf::forming {
@@ -69,6 +71,11 @@ struct InteractionSums {
   VecX force;                                     // n_dofs, N
   linalg::TripletAssembler* stiffness = nullptr;  // d force / dx, or null: not wanted
   linalg::TripletAssembler* damping = nullptr;    // d force / dv, or null: not wanted
+  // Where set (with stiffness), an interaction may add its stiffness straight into this
+  // kept pattern (PatternAssembler::add_block: same entries, same order as through the
+  // triplets) instead of into `stiffness`, counting the entries in pattern_entries.
+  linalg::PatternAssembler* pattern = nullptr;
+  long pattern_entries = 0;
 };
 
 // Reaction on a tool: the resultant force the bodies exert on it (N) and where the tool

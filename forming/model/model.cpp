@@ -298,7 +298,9 @@ Assembly Model::assemble_into(const Eigen::Ref<const VecX>& x, const Interaction
   thread_local Index triplet_hint = 0;
   linalg::TripletAssembler stiffness(n_dofs_, n_dofs_);
   if (need_k && triplet_hint > 0) stiffness.reserve(triplet_hint + triplet_hint / 8);
-  const bool added = add_interactions(x, context, need_k, stiffness, out);
+  // Contact pairs' stiffness goes straight into the kept pattern, unless K d is wanted
+  // too (the predictor's direction: then through the triplets).
+  const bool added = add_interactions(x, context, need_k, stiffness, out, direction ? nullptr : tangent);
   if (need_k) triplet_hint = stiffness.n_triplets();
   const auto t_merge = std::chrono::steady_clock::now();
   profile.contact_eval_s += std::chrono::duration<double>(t_merge - t_elements).count();
@@ -384,13 +386,15 @@ Assembly Model::assemble_reference(const Eigen::Ref<const VecX>& x, const Intera
 }
 
 bool Model::add_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent,
-                             linalg::TripletAssembler& stiffness, Assembly& out) const {
+                             linalg::TripletAssembler& stiffness, Assembly& out,
+                             linalg::PatternAssembler* pattern) const {
   SF_ASSERT(!context.velocity || context.velocity->size() == n_dofs_, "velocities must have n_dofs entries");
   linalg::TripletAssembler damping(n_dofs_, n_dofs_);
   InteractionSums sums;
   sums.force = std::move(out.force);
   sums.stiffness = want_tangent ? &stiffness : nullptr;
   sums.damping = want_tangent && context.velocity ? &damping : nullptr;
+  sums.pattern = want_tangent ? pattern : nullptr;
   bool velocity_dependent = false;
   for (const std::shared_ptr<Interaction>& interaction : interactions_) {
     interaction->add_to(x, context, sums);
@@ -403,6 +407,7 @@ bool Model::add_interactions(const Eigen::Ref<const VecX>& x, const InteractionC
     }
     velocity_dependent = velocity_dependent || interaction->needs_velocity();
   }
+  solve_profile().contact_entries += sums.pattern_entries;
   out.energy += sums.energy;
   out.force = std::move(sums.force);
   if (sums.damping && velocity_dependent) out.damping = damping.compress();

@@ -170,8 +170,10 @@ class Model {
   };
   ConstraintTerms element_constraints(const Body& b, Index e) const;
   // Adds the interactions' sums to `out` (elements done); false when one rejects the state.
+  // With `pattern`, interactions may add their stiffness straight into it.
   bool add_interactions(const Eigen::Ref<const VecX>& x, const InteractionContext& context, bool want_tangent,
-                        linalg::TripletAssembler& stiffness, Assembly& out) const;
+                        linalg::TripletAssembler& stiffness, Assembly& out,
+                        linalg::PatternAssembler* pattern = nullptr) const;
   // Interactions' stiffness (and direction product) into the fast assembly.
   // When the pattern must grow it grows for every interaction's pattern_blocks at x as
   // well (contact: every pair within the search band), so pairs closing later inside the

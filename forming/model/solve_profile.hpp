@@ -18,11 +18,12 @@ struct SolveProfile {
   long factorizations = 0;
   long solves = 0;
   // Parts of contact_s: the interactions' own evaluation (search, laws, local tangents,
-  // their triplets) and the merge of those triplets into the tangent pattern (with its
-  // growth when a contact entry falls outside it).
+  // and their entries: added straight into the kept tangent pattern, or as triplets when
+  // the assembly also wants K d) and the merge of the triplets into the tangent pattern
+  // (with its growth when a contact entry falls outside it).
   double contact_eval_s = 0.0;
   double contact_merge_s = 0.0;
-  long contact_entries = 0;    // triplets merged (summed over assemblies)
+  long contact_entries = 0;    // stiffness entries added or merged (summed over assemblies)
   long pattern_growths = 0;    // merges that grew the pattern (the next factorisation re-analyses)
   double band_layout_s = 0.0;  // part of contact_merge_s: laying the grown pattern out for the search band
   // Symbolic analyses (fill-reducing ordering) and their seconds, part of factorize_s.

@@ -18,6 +18,8 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <set>
+#include <vector>
 
 #include "forming/contact/body_contact.hpp"
 #include "forming/contact/tool_contact.hpp"
@@ -246,6 +248,47 @@ class SkewShape final : public ToolShape {
   Vec3 p_{5, 4, 0.7}, a_{Vec3(0.01, 0.005, -1).normalized()}, b_{Vec3(-0.2, 0.1, -1).normalized()};
   Mat3 B_ = (Mat3() << 0.01, 0.02, 0, -0.01, 0.03, 0.01, 0.02, 0, -0.02).finished();
 };
+
+// The solver's path: contact scattered into the kept pattern of the free unknowns
+// (Model::assemble_into, the pattern growing when a pair falls outside it) against the
+// triplet assembly of the same model (Model::assemble_reference), at two states whose
+// contact pairs differ (the upper ply slid 2 mm: the lower ply's points find other
+// master faces, some none), with one pattern assembler across both as in a Newton
+// solve; and the contact tangent at the second state against central differences.
+TEST(ContactTangent, PatternAssembledTangentEqualsTripletsWhenPairsChange) {
+  TwoPlies t = two_plies(test::kSeed + 25);
+  VecX previous;
+  const InteractionContext ctx = quasi_static(t, previous, 0.05);
+  const auto c = ply_contact(t.model, options(0.02, 0.3, 0.05));
+  t.model.add_interaction(c);
+  const Index n = t.model.n_dofs();
+  linalg::PatternAssembler pattern = t.model.make_pattern(std::vector<bool>(static_cast<std::size_t>(n), true), false);
+  const auto pairs = [&](const VecX& x) {
+    std::set<std::vector<Index>> out;
+    c->pattern_blocks(x, ctx, [&](const std::vector<Index>&, const std::vector<Index>& cols) { out.insert(cols); });
+    return out;
+  };
+  VecX slid = t.x;
+  for (Index node = 0; node < t.model.ply(1).n_nodes(); ++node) slid(t.model.dof(1, node, 0, 0)) += 2.0;
+  const auto pairs_before = pairs(t.x), pairs_after = pairs(slid);
+  EXPECT_NE(pairs_before, pairs_after);
+  int state = 0;
+  for (const VecX* x : {&t.x, &slid, &t.x}) {
+    const Assembly a = t.model.assemble_into(*x, ctx, &pattern);
+    const Assembly r = t.model.assemble_reference(*x, ctx, true);
+    ASSERT_TRUE(a.ok && r.ok) << a.message << r.message;
+    const MatX K(pattern.matrix()), R(r.tangent);
+    const double rel = max_abs(K - R) / max_abs(R);
+    EXPECT_LT(rel, 1e-13) << "state " << state;
+    EXPECT_LT(max_abs(a.force - r.force), 1e-13 * max_abs(r.force)) << "state " << state;
+    std::printf("state %d: %zu contact pairs, pattern generation %d, |K_pattern - K_triplets| / |K| %.1e\n", state,
+                (x == &slid ? pairs_after : pairs_before).size(), pattern.generation(), rel);
+    ++state;
+  }
+  const Errors e = finite_differences(*c, n, slid, ctx, false);
+  EXPECT_LT(e.stiffness, kFdRel);
+  std::printf("slid state: FD stiffness %.1e\n", e.stiffness);
+}
 
 TEST(ContactTangent, PlyToolNormalAndFriction) {
   UnderTool t = ply_under_tool(test::kSeed + 24);

@@ -324,22 +324,24 @@ int run_case(int n, int plies, int repeats, bool study = false) {
 
 // --memory N PLIES: where the memory of one case goes, stage by stage. Each stage
 // reports its own peak resident memory (the kernel's high-water mark, reset before the
-// stage), the resident memory and malloc's bytes in use after it, MB. Freed memory stays
-// resident (keep_freed_memory), so a stage's peak above the one before is memory it
-// touched that no earlier stage had.
+// stage), the resident memory and malloc's bytes in use after it, MB, and its wall time.
+// Freed memory stays resident (keep_freed_memory), so a stage's peak above the one before
+// is memory it touched that no earlier stage had.
 int run_memory(int n, int plies) {
   const bool resettable = reset_peak();
   std::printf("# memory by stage, %dx%d x %d plies; MB; peak: the stage's own%s\n", n, n, plies,
               resettable ? "" : " (cannot reset the high-water mark here: peak since start)");
-  std::printf("%-34s %9s %9s %9s %s\n", "stage", "peak", "rss", "heap", "");
+  std::printf("%-34s %9s %9s %9s %9s %8s\n", "stage", "peak", "rss", "heap", "d_heap", "wall_s");
   double heap_before = heap_in_use_mb();
+  auto t_stage = std::chrono::steady_clock::now();
   auto stage = [&](const char* name, const std::string& note = {}) {
     const double heap = heap_in_use_mb();
-    std::printf("%-34s %9.1f %9.1f %9.1f %+9.1f %s\n", name, status_mb("VmHWM"), status_mb("VmRSS"), heap,
-                heap - heap_before, note.c_str());
+    std::printf("%-34s %9.1f %9.1f %9.1f %+9.1f %8.3f %s\n", name, status_mb("VmHWM"), status_mb("VmRSS"), heap,
+                heap - heap_before, seconds_since(t_stage), note.c_str());
     std::fflush(stdout);
     heap_before = heap;
     reset_peak();
+    t_stage = std::chrono::steady_clock::now();
   };
   stage("start");
   auto setup = std::make_unique<Setup>();
@@ -349,8 +351,9 @@ int run_memory(int n, int plies) {
   {
     TangentSolver solver(linalg::SolverKind::kAuto, false);
     linalg::PatternAssembler pattern = model.make_pattern(setup->is_free, solver.lower());
+    stage("pattern and scatter tables");
     solver.lay_out(pattern);
-    stage("pattern and scatter tables",
+    stage("ordered for the Cholesky",
           fmt::format("n {} nnz {} (pattern's own count {:.1f} MB)", pattern.n_active(), pattern.matrix().nonZeros(),
                       pattern.memory_bytes() / 1048576.0));
     model.assemble_into(setup->x, InteractionContext{}, &pattern);

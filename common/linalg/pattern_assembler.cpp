@@ -300,10 +300,12 @@ void PatternAssembler::set_order(const std::vector<int>& order) {
   for (std::size_t k = 0; k < order_.size() && natural; ++k) natural = order_[k] == static_cast<int>(k);
   if (natural) order_.clear();
 
-  // The new layout, the values carried over.
+  // The new layout, the values carried over (none to carry when all are zero: a pattern
+  // not assembled yet).
   const SparseMatrix old = std::move(matrix_);
   build_pattern(extra_);
-  for (int c = 0; c < old.outerSize(); ++c)
+  const bool zero = std::all_of(old.valuePtr(), old.valuePtr() + old.nonZeros(), [](double v) { return v == 0.0; });
+  for (int c = 0; c < (zero ? 0 : static_cast<int>(old.outerSize())); ++c)
     for (int q = old.outerIndexPtr()[c]; q < old.outerIndexPtr()[c + 1]; ++q) {
       const auto [r_new, c_new] = to_new(old.innerIndexPtr()[q], c);
       const std::int64_t p = find(r_new, c_new);

@@ -307,10 +307,25 @@ class CholmodPermutedBackend final : public Backend {
   void set_ordering(Ordering ordering) override { ordering_choice_ = ordering; }
 
   Outcome analyze(const SparseMatrix& a) override {
-    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
     const int n = static_cast<int>(a.rows());
     // kNatural with a lower triangle: A is factorised as given (it is B), read in place by
-    // every factorisation: no ordering, no copy, no map.
+    // every factorisation: no ordering, no copy, no map. When A is the B of the analysis
+    // before (laid out in its permutation: PatternAssembler::set_order), that analysis of B
+    // is kept.
+    if (ordering_choice_ == Ordering::kNatural && factor_ != nullptr && !direct_ &&
+        b_col_.size() == static_cast<std::size_t>(n) + 1 && b_row_.size() == static_cast<std::size_t>(a.nonZeros()) &&
+        std::equal(b_col_.begin(), b_col_.end(), a.outerIndexPtr()) &&
+        std::equal(b_row_.begin(), b_row_.end(), a.innerIndexPtr())) {
+      release(inverse_);
+      release(b_col_);
+      release(b_row_);
+      release(map_);
+      release(b_val_);
+      direct_ = true;
+      ordering_ = "natural";
+      return {};
+    }
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
     direct_ = false;
     if (ordering_choice_ == Ordering::kNatural) {
       bool upper = false;

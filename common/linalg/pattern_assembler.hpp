@@ -113,12 +113,13 @@ class PatternAssembler {
 
  private:
   struct Element {
-    // Entries sorted by unknown, inactive ones dropped: slot (rank of its unknown among
-    // the element's distinct unknowns), coefficient, local index.
+    // Entries sorted by matrix row (the unknown's row in the order of set_order), inactive
+    // ones dropped: slot (rank of its row among the element's distinct rows), coefficient,
+    // local index.
     std::vector<int> slot, local;
     std::vector<double> coef;
     std::vector<int> first_of_slot;  // first sorted entry of each slot (+ end)
-    std::vector<Index> unknowns;     // distinct unknowns, increasing
+    std::vector<Index> unknowns;     // distinct matrix rows of its unknowns, increasing
     std::vector<int> pos;            // positions of slot pairs (packed lower columns, or U x U)
   };
   void build_pattern(const std::vector<std::pair<Index, Index>>& extra);

@@ -16,12 +16,13 @@
 // process (so that its peak memory is its own) and prints one line:
 //   n_dofs, n_free   unknowns, and those left free by the grips (every parameter of the
 //                    nodes at x = 0 and x = L prescribed: a uniaxial 5 % stretch)
-//   layout_s         laying out the free-unknown pattern and the element scatter tables
-//                    (once per model)
+//   layout_s         laying out the free-unknown pattern and the element scatter tables,
+//                    and ordering it for the Cholesky (TangentSolver::lay_out; once per model)
 //   kernel_s         the element kernels alone (force + tangent, all bricks, threaded)
 //   scatter_s        the rest of an assembly with the tangent: writing into the pattern
 //   resid_s          an assembly of the force only (the line search's trial)
-//   fact_s           numeric factorisation of K_ff (symbolic analysis kept; analyse_s once)
+//   fact_s           numeric factorisation of K_ff (symbolic analysis kept; analyse_s once,
+//                    the supernodal analysis: the ordering is in layout_s)
 //   solve_s          one forward/back substitution
 //   iter_s           kernel + scatter + residual + factorisation + solve: one Newton iteration
 //   kern_GF, fact_GF GFLOP/s of the kernel (flops counted from the algorithm,
@@ -29,13 +30,17 @@
 //   newton, static_s Newton iterations and wall time of the whole static solve (stretch
 //                    in two load steps sharing one TangentWorkspace, as a run's steps do)
 //   layouts          times the pattern was laid out in that solve (1: kept across steps)
-//   peak_MB          peak resident memory of the case's process
+//   iter_MB          peak resident memory of the case's process up to the end of the timed
+//                    iteration (model, pattern, factor, solve)
+//   peak_MB          peak resident memory of the whole case (the timed iteration's pattern
+//                    and solver are freed before the static solve, which lays out its own)
 // Times are medians over `repeats` repetitions, wall clock, seconds. The first line says
 // how many threads the element loop uses and which vector instructions the kernel runs.
 //
 // Then the shear-and-stretch ply (bench/cases/shear_stretch_ply.yaml: 200 mm square ply,
 // 40 x 40 elements, fibres at 30 degrees, clamped on x0, x1 moved 4 mm across and 2 mm
 // along in two load steps): Newton iterations and cut-backs per step, and time.
+#include <malloc.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -49,6 +54,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <omp.h>
 
 #include "common/core/memory.hpp"
@@ -73,6 +79,38 @@ double peak_mb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return u.ru_maxrss / 1024.0;
+}
+
+// A field of /proc/self/status in MB (VmRSS, VmHWM), -1 when not there (not Linux).
+double status_mb(const char* field) {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return -1.0;
+  char line[256];
+  double mb = -1.0;
+  const std::size_t len = std::strlen(field);
+  while (std::fgets(line, sizeof line, f))
+    if (std::strncmp(line, field, len) == 0 && line[len] == ':') mb = std::atof(line + len + 1) / 1024.0;
+  std::fclose(f);
+  return mb;
+}
+
+// Resets the kernel's peak resident memory (VmHWM) to the current one: each stage of
+// --memory then reports its own peak. False when the kernel does not allow it.
+bool reset_peak() {
+  FILE* f = std::fopen("/proc/self/clear_refs", "w");
+  if (!f) return false;
+  const bool ok = std::fputs("5", f) >= 0;
+  return std::fclose(f) == 0 && ok;
+}
+
+// Heap bytes malloc has handed out and not had back, MB (glibc).
+double heap_in_use_mb() {
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+  const struct mallinfo2 m = mallinfo2();
+  return (m.uordblks + m.hblkhd) / 1048576.0;
+#else
+  return -1.0;
+#endif
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -131,8 +169,16 @@ void factorisation_study(const linalg::SparseMatrix& k, int repeats) {
 // or "umfpack". Empty: the symmetric path (Cholesky).
 std::string g_lu;
 
-int run_case(int n, int plies, int repeats, bool study = false) {
+// The stretched plies of one case: the model, the grips and a deformed state.
+struct Setup {
   Model model;
+  VecX X, x;
+  std::vector<PrescribedDof> bcs;
+  std::vector<bool> is_free;
+};
+
+void make_setup(int n, int plies, Setup& setup) {
+  Model& model = setup.model;
   for (int k = 0; k < plies; ++k) {
     PlyMesh ply(mesh::make_rectangle_mesh(Vec3(0.0, 0.0, k * kH), Vec3::UnitX(), Vec3::UnitY(), kL, kL, n, n), kH,
                 k % 2 == 0 ? 0.0 : 90.0);
@@ -140,10 +186,11 @@ int run_case(int n, int plies, int repeats, bool study = false) {
     model.add_ply(std::move(ply), material);
   }
   const Index nd = model.n_dofs();
-  const VecX X = model.reference_positions();
+  const VecX& X = setup.X = model.reference_positions();
   // Grips: every parameter of the nodes at x = 0 (held) and x = L (x -> 1.05 x).
-  std::vector<PrescribedDof> bcs;
-  std::vector<bool> is_free(static_cast<std::size_t>(nd), true);
+  std::vector<PrescribedDof>& bcs = setup.bcs;
+  std::vector<bool>& is_free = setup.is_free;
+  is_free.assign(static_cast<std::size_t>(nd), true);
   VecX target = X;
   for (int b = 0; b < model.n_bodies(); ++b) {
     const PlyMesh& ply = model.ply(b);
@@ -164,13 +211,31 @@ int run_case(int n, int plies, int repeats, bool study = false) {
     }
   }
   // A deformed state for the timing: the affine stretch everywhere.
-  VecX x = X;
-  for (Index p = 0; p < nd / 3; ++p) x(3 * p) *= kStretch;
+  setup.x = X;
+  for (Index p = 0; p < nd / 3; ++p) setup.x(3 * p) *= kStretch;
+}
+
+int run_case(int n, int plies, int repeats, bool study = false) {
+  Setup setup;
+  make_setup(n, plies, setup);
+  Model& model = setup.model;
+  const Index nd = model.n_dofs();
+  const VecX& X = setup.X;
+  const VecX& x = setup.x;
+  const std::vector<PrescribedDof>& bcs = setup.bcs;
+  const std::vector<bool>& is_free = setup.is_free;
 
   const bool unsym = !g_lu.empty();
-  TangentSolver solver(unsym ? linalg::parse_solver_kind(g_lu, "--lu") : linalg::SolverKind::kAuto, unsym);
+  // Held by pointers: freed before the static solve, which makes its own (its peak is then
+  // its own, not on top of this iteration's).
+  auto solver_held = std::make_unique<TangentSolver>(
+      unsym ? linalg::parse_solver_kind(g_lu, "--lu") : linalg::SolverKind::kAuto, unsym);
+  TangentSolver& solver = *solver_held;
   auto t0 = std::chrono::steady_clock::now();
-  linalg::PatternAssembler pattern = model.make_pattern(is_free, solver.lower());
+  auto pattern_held = std::make_unique<linalg::PatternAssembler>(model.make_pattern(is_free, solver.lower()));
+  linalg::PatternAssembler& pattern = *pattern_held;
+  // As TangentWorkspace lays it out: in the Cholesky's order (the study wants the natural one).
+  if (!study) solver.lay_out(pattern);
   const double layout_s = seconds_since(t0);
   if (study) {
     if (!model.assemble_into(x, InteractionContext{}, &pattern).ok) return 1;
@@ -227,6 +292,10 @@ int run_case(int n, int plies, int repeats, bool study = false) {
     if (!sol.allFinite()) std::printf("# warning: non-finite solution\n");
   });
   const double iter_s = asm_s + resid_s + fact_s + solve_s;
+  const double iter_mb = peak_mb();
+  const Index n_free = pattern.n_active();
+  pattern_held.reset();
+  solver_held.reset();
 
   // The stretch in two load steps, as a run takes them: one workspace (pattern, scatter
   // tables, symbolic factorisation) for both, so the second step lays nothing out.
@@ -244,11 +313,75 @@ int run_case(int n, int plies, int repeats, bool study = false) {
 
   const double kern_gf = n_el * model.kernel().tangent_flops() / kernel_s / 1e9;
   std::printf(
-      "%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %7d %8.2f %8.1f\n", n, n,
-      plies, static_cast<long>(nd), static_cast<long>(pattern.n_active()), layout_s, kernel_s, asm_s - kernel_s,
+      "%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %7d %8.2f %8.1f %8.1f\n", n,
+      n,
+      plies, static_cast<long>(nd), static_cast<long>(n_free), layout_s, kernel_s, asm_s - kernel_s,
       resid_s, analyse_s, fact_s, solve_s, iter_s, kern_gf, flops / fact_s / 1e9, newton, so.workspace->layouts(),
-      static_s, peak_mb());
+      static_s, iter_mb, peak_mb());
   std::fflush(stdout);
+  return 0;
+}
+
+// --memory N PLIES: where the memory of one case goes, stage by stage. Each stage
+// reports its own peak resident memory (the kernel's high-water mark, reset before the
+// stage), the resident memory and malloc's bytes in use after it, MB, and its wall time.
+// Freed memory stays resident (keep_freed_memory), so a stage's peak above the one before
+// is memory it touched that no earlier stage had.
+int run_memory(int n, int plies) {
+  const bool resettable = reset_peak();
+  std::printf("# memory by stage, %dx%d x %d plies; MB; peak: the stage's own%s\n", n, n, plies,
+              resettable ? "" : " (cannot reset the high-water mark here: peak since start)");
+  std::printf("%-34s %9s %9s %9s %9s %8s\n", "stage", "peak", "rss", "heap", "d_heap", "wall_s");
+  double heap_before = heap_in_use_mb();
+  auto t_stage = std::chrono::steady_clock::now();
+  auto stage = [&](const char* name, const std::string& note = {}) {
+    const double heap = heap_in_use_mb();
+    std::printf("%-34s %9.1f %9.1f %9.1f %+9.1f %8.3f %s\n", name, status_mb("VmHWM"), status_mb("VmRSS"), heap,
+                heap - heap_before, seconds_since(t_stage), note.c_str());
+    std::fflush(stdout);
+    heap_before = heap;
+    reset_peak();
+    t_stage = std::chrono::steady_clock::now();
+  };
+  stage("start");
+  auto setup = std::make_unique<Setup>();
+  make_setup(n, plies, *setup);
+  const Model& model = setup->model;
+  stage("model", fmt::format("{} dofs, {} elements", model.n_dofs(), model.element_entries().size()));
+  {
+    TangentSolver solver(linalg::SolverKind::kAuto, false);
+    linalg::PatternAssembler pattern = model.make_pattern(setup->is_free, solver.lower());
+    stage("pattern and scatter tables");
+    solver.lay_out(pattern);
+    stage("ordered for the Cholesky",
+          fmt::format("n {} nnz {} (pattern's own count {:.1f} MB)", pattern.n_active(), pattern.matrix().nonZeros(),
+                      pattern.memory_bytes() / 1048576.0));
+    model.assemble_into(setup->x, InteractionContext{}, &pattern);
+    stage("assembly (force and tangent)");
+    const linalg::SolveReport first = solver.factorize(pattern.matrix());
+    stage("analysis and factorisation",
+          fmt::format("{}; nnz(L) {:.0f} ({:.1f} MB of values)", first.ok() ? "ok" : first.brief(),
+                      first.factor_nonzeros, first.factor_nonzeros * 8 / 1048576.0));
+    model.assemble_into(setup->x, InteractionContext{}, &pattern);
+    stage("assembly again");
+    solver.factorize(pattern.matrix());
+    stage("factorisation again");
+    const VecX rhs = VecX::Ones(pattern.n_active());
+    const VecX sol = solver.solve(rhs);
+    stage("solve");
+    model.assemble_into(setup->x, InteractionContext{}, nullptr);
+    stage("assembly (force only)");
+  }
+  stage("pattern and solver freed");
+  StaticOptions so;
+  so.workspace = std::make_shared<TangentWorkspace>();
+  std::vector<PrescribedDof> half = setup->bcs;
+  for (PrescribedDof& p : half) p.value = 0.5 * (p.value + setup->X(p.dof));
+  const StaticResult res1 = solve_static(model, setup->X, half, VecX(), so);
+  stage("static solve, step 1", fmt::format("{} Newton iterations", res1.report.total_iterations));
+  const StaticResult res = solve_static(model, res1.positions, setup->bcs, VecX(), so);
+  stage("static solve, step 2", fmt::format("{} Newton iterations", res.report.total_iterations));
+  std::printf("# process peak %.1f MB\n", peak_mb());
   return 0;
 }
 
@@ -315,6 +448,7 @@ int main(int argc, char** argv) {
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);
     if (argc >= 4 && std::strcmp(argv[1], "--factorisation") == 0)
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3, true);
+    if (argc >= 4 && std::strcmp(argv[1], "--memory") == 0) return run_memory(std::atoi(argv[2]), std::atoi(argv[3]));
     if (argc >= 3 && std::strcmp(argv[1], "--shear-stretch") == 0) return run_shear_stretch(argv[2]);
     const int max_n = argc > 1 ? std::atoi(argv[1]) : 40;
     const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
@@ -335,9 +469,9 @@ int main(int argc, char** argv) {
     std::printf(
         "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
         repeats);
-    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %7s %8s %8s\n", "n x n", "plies", "n_dofs",
-                "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s", "iter_s",
-                "kern_GF", "fact_GF", "newton", "layouts", "static_s", "peak_MB");
+    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %7s %8s %8s %8s\n", "n x n", "plies",
+                "n_dofs", "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s",
+                "iter_s", "kern_GF", "fact_GF", "newton", "layouts", "static_s", "iter_MB", "peak_MB");
     std::fflush(stdout);
     const std::string self = argv[0];
     for (int n : {10, 20, 40}) {

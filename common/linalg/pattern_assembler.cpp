@@ -42,6 +42,7 @@ PatternAssembler::PatternAssembler(Index n_dofs, const std::vector<bool>& active
       active_dofs_.push_back(d);
     }
   SF_ASSERT(n_active() <= std::numeric_limits<int>::max(), "too many unknowns for int indices");
+  place_ = index_;  // natural order: matrix row = unknown
 
   elements_.resize(elements.size());
   std::vector<int> order;
@@ -178,7 +179,7 @@ std::int64_t PatternAssembler::find(Index row, Index col) const {
 
 void PatternAssembler::add(Index i, Index j, double v) {
   SF_ASSERT(i >= 0 && i < n_dofs_ && j >= 0 && j < n_dofs_, "dof out of range");
-  const Index r = index_[static_cast<std::size_t>(i)], c = index_[static_cast<std::size_t>(j)];
+  const Index r = place_[static_cast<std::size_t>(i)], c = place_[static_cast<std::size_t>(j)];
   if (r < 0 || c < 0 || (storage_ == Storage::kLower && r < c)) return;
   const std::int64_t p = find(r, c);
   if (p >= 0)
@@ -244,7 +245,7 @@ std::vector<std::int64_t> PatternAssembler::positions_of(const SparseMatrix& m) 
   std::size_t t = 0;
   for (int k = 0; k < m.outerSize(); ++k)
     for (SparseMatrix::InnerIterator it(m, k); it; ++it, ++t) {
-      const Index r = index_[static_cast<std::size_t>(it.row())], c = index_[static_cast<std::size_t>(it.col())];
+      const Index r = place_[static_cast<std::size_t>(it.row())], c = place_[static_cast<std::size_t>(it.col())];
       if (r < 0 || c < 0 || (storage_ == Storage::kLower && r < c)) continue;
       out[t] = find(r, c);
     }
@@ -274,9 +275,96 @@ bool PatternAssembler::flush() {
   return true;
 }
 
+void PatternAssembler::set_order(const std::vector<int>& order) {
+  SF_ASSERT(pending_.empty(), "set_order: flush() the entries kept aside first");
+  const Index n = n_active();
+  const std::size_t un = static_cast<std::size_t>(n);
+  // New row of each unknown.
+  std::vector<Index> row_of(un);
+  if (order.empty()) {
+    std::iota(row_of.begin(), row_of.end(), Index{0});
+  } else {
+    SF_ASSERT(static_cast<Index>(order.size()) == n, "set_order: one entry per unknown");
+    std::fill(row_of.begin(), row_of.end(), Index{-1});
+    for (std::size_t k = 0; k < un; ++k) {
+      const int u = order[k];
+      SF_ASSERT(u >= 0 && u < n && row_of[static_cast<std::size_t>(u)] < 0, "set_order: not a permutation");
+      row_of[static_cast<std::size_t>(u)] = static_cast<Index>(k);
+    }
+  }
+  // Old matrix row -> new one.
+  std::vector<Index> moved(un);
+  for (std::size_t r = 0; r < un; ++r)
+    moved[r] = row_of[order_.empty() ? r : static_cast<std::size_t>(order_[r])];
+  const bool lower = storage_ == Storage::kLower;
+  auto to_new = [&](Index r, Index c) {
+    Index a = moved[static_cast<std::size_t>(r)], b = moved[static_cast<std::size_t>(c)];
+    if (lower && a < b) std::swap(a, b);
+    return std::make_pair(a, b);
+  };
+
+  // Each element's entries sorted by their new rows; ties (a dof repeated in an element)
+  // keep their order, as the constructor would have made them.
+  std::vector<int> idx;
+  std::vector<Index> key;
+  for (Element& el : elements_) {
+    const std::size_t m = el.slot.size();
+    key.resize(m);
+    idx.resize(m);
+    for (std::size_t a = 0; a < m; ++a) {
+      key[a] = moved[static_cast<std::size_t>(el.unknowns[static_cast<std::size_t>(el.slot[a])])];
+      idx[a] = static_cast<int>(a);
+    }
+    std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return key[a] < key[b]; });
+    Element out;
+    out.slot.reserve(m);
+    out.local.reserve(m);
+    out.coef.reserve(m);
+    out.unknowns.reserve(el.unknowns.size());
+    out.first_of_slot.reserve(el.first_of_slot.size());
+    for (int a : idx) {
+      if (out.unknowns.empty() || out.unknowns.back() != key[a]) {
+        out.unknowns.push_back(key[a]);
+        out.first_of_slot.push_back(static_cast<int>(out.slot.size()));
+      }
+      out.slot.push_back(static_cast<int>(out.unknowns.size()) - 1);
+      out.local.push_back(el.local[static_cast<std::size_t>(a)]);
+      out.coef.push_back(el.coef[static_cast<std::size_t>(a)]);
+    }
+    out.first_of_slot.push_back(static_cast<int>(out.slot.size()));
+    el = std::move(out);
+  }
+  for (auto& rc : extra_) rc = to_new(rc.first, rc.second);
+  std::sort(extra_.begin(), extra_.end());
+  for (Index d = 0; d < n_dofs_; ++d) {
+    const Index u = index_[static_cast<std::size_t>(d)];
+    place_[static_cast<std::size_t>(d)] = u < 0 ? -1 : row_of[static_cast<std::size_t>(u)];
+  }
+  order_ = order;
+  bool natural = true;
+  for (std::size_t k = 0; k < order_.size() && natural; ++k) natural = order_[k] == static_cast<int>(k);
+  if (natural) order_.clear();
+
+  // The new layout, the values carried over (none to carry when all are zero: a pattern
+  // not assembled yet).
+  const SparseMatrix old = std::move(matrix_);
+  build_pattern(extra_);
+  const bool zero = std::all_of(old.valuePtr(), old.valuePtr() + old.nonZeros(), [](double v) { return v == 0.0; });
+  for (int c = 0; c < (zero ? 0 : static_cast<int>(old.outerSize())); ++c)
+    for (int q = old.outerIndexPtr()[c]; q < old.outerIndexPtr()[c + 1]; ++q) {
+      const auto [r_new, c_new] = to_new(old.innerIndexPtr()[q], c);
+      const std::int64_t p = find(r_new, c_new);
+      SF_ASSERT(p >= 0, "set_order: an entry lost in the new layout");
+      matrix_.valuePtr()[p] = old.valuePtr()[q];
+    }
+  build_tables();
+  ++generation_;
+}
+
 std::size_t PatternAssembler::memory_bytes() const {
   std::size_t bytes = static_cast<std::size_t>(matrix_.nonZeros()) * (sizeof(double) + sizeof(int)) +
-                      static_cast<std::size_t>(matrix_.outerSize() + 1) * sizeof(int) + index_.size() * sizeof(Index) +
+                      static_cast<std::size_t>(matrix_.outerSize() + 1) * sizeof(int) +
+                      (index_.size() + place_.size()) * sizeof(Index) + order_.size() * sizeof(int) +
                       active_dofs_.size() * sizeof(Index);
   for (const Element& el : elements_)
     bytes += el.pos.size() * sizeof(int) + el.slot.size() * (2 * sizeof(int) + sizeof(double)) +

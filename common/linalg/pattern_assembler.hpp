@@ -9,7 +9,8 @@
 // Numbering
 //   Global dofs 0 .. n_dofs - 1 (the caller's). active[d] makes dof d an unknown: the
 //   matrix is n_active x n_active, unknown j = the j-th active dof in increasing order
-//   (active_index(d)); rows and columns of inactive dofs are dropped.
+//   (active_index(d)); rows and columns of inactive dofs are dropped. The matrix's rows
+//   and columns are the unknowns in that order unless set_order() gave another one.
 //
 // Elements
 //   Element e lists its entries a = 0 .. m_e - 1: global dof dofs[a] (or -1: none),
@@ -101,17 +102,32 @@ class PatternAssembler {
   // would place them, -1 for dropped entries and for entries outside the pattern.
   std::vector<std::int64_t> positions_of(const SparseMatrix& m) const;
 
+  // Lays the matrix out with its rows and columns in `order`: row (and column) k of
+  // matrix() holds unknown order[k], so for kLower matrix() is tril(P A P^T) with A the
+  // matrix in the natural order and P the permutation matrix of `order` ((P A P^T)(k, l) =
+  // A(order[k], order[l])). A fill-reducing order from a solver's analysis of the natural
+  // pattern so makes matrix() the matrix that solver factorises, written in place by the
+  // assembly (LinearSolver with Ordering::kNatural: no permuted copy, no value map).
+  // Empty: the natural order. Values and extra entries are carried over; the element
+  // tables are laid out again, generation() increases. Everything addressed by global
+  // dofs (add, positions_of) keeps working; vectors in unknown order are permuted by the
+  // caller (x_matrix(k) = x(order[k])). Requires no pending entries (flush() first).
+  void set_order(const std::vector<int>& order);
+  // The order of the matrix's rows and columns (see set_order); empty: natural.
+  const std::vector<int>& order() const { return order_; }
+
   // Memory held by the pattern, the values and the element tables, bytes.
   std::size_t memory_bytes() const;
 
  private:
   struct Element {
-    // Entries sorted by unknown, inactive ones dropped: slot (rank of its unknown among
-    // the element's distinct unknowns), coefficient, local index.
+    // Entries sorted by matrix row (the unknown's row in the order of set_order), inactive
+    // ones dropped: slot (rank of its row among the element's distinct rows), coefficient,
+    // local index.
     std::vector<int> slot, local;
     std::vector<double> coef;
     std::vector<int> first_of_slot;  // first sorted entry of each slot (+ end)
-    std::vector<Index> unknowns;     // distinct unknowns, increasing
+    std::vector<Index> unknowns;     // distinct matrix rows of its unknowns, increasing
     std::vector<int> pos;            // positions of slot pairs (packed lower columns, or U x U)
   };
   void build_pattern(const std::vector<std::pair<Index, Index>>& extra);
@@ -121,6 +137,8 @@ class PatternAssembler {
   Index n_dofs_ = 0;
   Storage storage_ = Storage::kLower;
   std::vector<Index> active_dofs_, index_;
+  std::vector<Index> place_;  // dof -> row of matrix_ (index_ permuted by order_), -1 when inactive
+  std::vector<int> order_;    // row k of matrix_ holds unknown order_[k]; empty: natural
   std::vector<Element> elements_;
   std::vector<std::vector<Index>> colours_;
   std::vector<std::pair<Index, Index>> extra_;                       // merged entries beyond the elements' pattern

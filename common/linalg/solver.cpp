@@ -99,6 +99,11 @@ class Backend {
   virtual int determinant_sign() const { return 0; }
   // Working memory allowed a factorisation, megabytes (0: no limit; MUMPS only).
   virtual void set_memory_limit(int) {}
+  // Fill-reducing order of the current analysis (row perm[k] of A eliminated k-th); empty
+  // when the back end does not give it.
+  virtual std::vector<int> permutation() const { return {}; }
+  // Bytes the library holds (factor, symbolic analysis, workspace); 0: unknown.
+  virtual double library_bytes() const { return 0.0; }
 };
 
 // OpenBLAS's thread control, looked up at run time (any BLAS may be installed as
@@ -195,12 +200,14 @@ class CholmodBackend final : public Backend {
 
   void set_ordering(Ordering ordering) override {
     cholmod_common& c = llt_.cholmod();
+    c.postorder = ordering == Ordering::kNatural ? 0 : 1;
     if (ordering == Ordering::kDefault) {
       c.nmethods = 0;
       return;
     }
     c.nmethods = 1;
-    c.method[0].ordering = ordering == Ordering::kAmd     ? CHOLMOD_AMD
+    c.method[0].ordering = ordering == Ordering::kNatural ? CHOLMOD_NATURAL
+                           : ordering == Ordering::kAmd   ? CHOLMOD_AMD
                            : ordering == Ordering::kMetis ? CHOLMOD_METIS
                                                           : CHOLMOD_NESDIS;
   }
@@ -300,12 +307,48 @@ class CholmodPermutedBackend final : public Backend {
   void set_ordering(Ordering ordering) override { ordering_choice_ = ordering; }
 
   Outcome analyze(const SparseMatrix& a) override {
-    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
     const int n = static_cast<int>(a.rows());
+    // kNatural with a lower triangle: A is factorised as given (it is B), read in place by
+    // every factorisation: no ordering, no copy, no map. When A is the B of the analysis
+    // before (laid out in its permutation: PatternAssembler::set_order), that analysis of B
+    // is kept.
+    if (ordering_choice_ == Ordering::kNatural && factor_ != nullptr && !direct_ &&
+        b_col_.size() == static_cast<std::size_t>(n) + 1 && b_row_.size() == static_cast<std::size_t>(a.nonZeros()) &&
+        std::equal(b_col_.begin(), b_col_.end(), a.outerIndexPtr()) &&
+        std::equal(b_row_.begin(), b_row_.end(), a.innerIndexPtr())) {
+      release(inverse_);
+      release(b_col_);
+      release(b_row_);
+      release(map_);
+      release(b_val_);
+      direct_ = true;
+      ordering_ = "natural";
+      return {};
+    }
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
+    direct_ = false;
+    if (ordering_choice_ == Ordering::kNatural) {
+      bool upper = false;
+      for (int j = 0; j < n && !upper; ++j)
+        upper = a.outerIndexPtr()[j + 1] > a.outerIndexPtr()[j] && a.innerIndexPtr()[a.outerIndexPtr()[j]] < j;
+      if (!upper) {
+        release(inverse_);
+        release(b_col_);
+        release(b_row_);
+        release(map_);
+        release(b_val_);
+        direct_ = true;
+        ordering_ = "natural";
+        return analyze_b(a, const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()), true);
+      }
+    }
     cholmod_sparse view = lower_view(a, const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()),
                                      nullptr, CHOLMOD_PATTERN);
-    // 1. The ordering, on A.
-    if (ordering_choice_ == Ordering::kDefault) {
+    // 1. The ordering, on A (none for kNatural: A given with both triangles).
+    if (ordering_choice_ == Ordering::kNatural) {
+      c_.nmethods = 1;
+      c_.method[0].ordering = CHOLMOD_NATURAL;
+    } else if (ordering_choice_ == Ordering::kDefault) {
       c_.nmethods = 0;
     } else {
       c_.nmethods = 1;
@@ -313,7 +356,7 @@ class CholmodPermutedBackend final : public Backend {
                               : ordering_choice_ == Ordering::kMetis ? CHOLMOD_METIS
                                                                      : CHOLMOD_NESDIS;
     }
-    c_.postorder = 1;
+    c_.postorder = ordering_choice_ == Ordering::kNatural ? 0 : 1;
     cholmod_factor* ordering_factor = cholmod_analyze(&view, &c_);
     if (ordering_factor == nullptr || c_.status < CHOLMOD_OK) {
       if (ordering_factor != nullptr) cholmod_free_factor(&ordering_factor, &c_);
@@ -375,8 +418,14 @@ class CholmodPermutedBackend final : public Backend {
     }
     b_val_.assign(b_nnz, 0.0);
 
-    // 3. The supernodal analysis of B in its own order (no postorder: P already has it).
-    cholmod_sparse b_view = lower_view(a, b_col_.data(), b_row_.data(), nullptr, CHOLMOD_PATTERN);
+    // 3. The supernodal analysis of B in its own order.
+    return analyze_b(a, b_col_.data(), b_row_.data(), false);
+  }
+
+  // The supernodal analysis of B (a's size, the given columns and rows) in its own order
+  // (no postorder: P already has it, or the caller laid B out in its order).
+  Outcome analyze_b(const SparseMatrix& a, int* col, int* row, bool counts) {
+    cholmod_sparse b_view = lower_view(a, col, row, nullptr, CHOLMOD_PATTERN);
     c_.nmethods = 1;
     c_.method[0].ordering = CHOLMOD_NATURAL;
     c_.postorder = 0;
@@ -387,24 +436,40 @@ class CholmodPermutedBackend final : public Backend {
       return {Status::kFailed, fmt::format("CHOLMOD symbolic analysis of the permuted matrix failed (status {})",
                                            c_.status)};
     }
+    if (counts) {
+      flops_ = c_.fl;
+      lnz_ = c_.lnz;
+    }
     return {};
   }
+
+  std::vector<int> permutation() const override {
+    std::vector<int> perm(inverse_.size());
+    for (std::size_t i = 0; i < inverse_.size(); ++i) perm[static_cast<std::size_t>(inverse_[i])] = static_cast<int>(i);
+    return perm;
+  }
+  double library_bytes() const override { return static_cast<double>(c_.memory_inuse); }
 
   double factor_flops() const override { return flops_; }
   double factor_nonzeros() const override { return lnz_; }
   std::string ordering_used() const override { return ordering_; }
 
   Outcome factorize(const SparseMatrix& a) override {
-    if (factor_ == nullptr || map_.size() != static_cast<std::size_t>(a.nonZeros()))
+    if (factor_ == nullptr || (!direct_ && map_.size() != static_cast<std::size_t>(a.nonZeros())))
       return {Status::kFailed, "CHOLMOD factorisation without an analysis of this pattern"};
     const double* values = a.valuePtr();
-    if (b_val_.size() == map_.size()) {  // a lower triangle: every entry has its place
+    if (direct_) {
+      // B is a itself.
+    } else if (b_val_.size() == map_.size()) {  // a lower triangle: every entry has its place
       for (std::size_t p = 0; p < map_.size(); ++p) b_val_[static_cast<std::size_t>(map_[p])] = values[p];
     } else {
       for (std::size_t p = 0; p < map_.size(); ++p)
         if (map_[p] >= 0) b_val_[static_cast<std::size_t>(map_[p])] = values[p];
     }
-    cholmod_sparse b_view = lower_view(a, b_col_.data(), b_row_.data(), b_val_.data(), CHOLMOD_REAL);
+    cholmod_sparse b_view =
+        direct_ ? lower_view(a, const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()),
+                             const_cast<double*>(values), CHOLMOD_REAL)
+                : lower_view(a, b_col_.data(), b_row_.data(), b_val_.data(), CHOLMOD_REAL);
     {
       const BlasSection blas;
       cholmod_factorize(&b_view, factor_, &c_);
@@ -424,6 +489,7 @@ class CholmodPermutedBackend final : public Backend {
 
   bool solve(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const override {
     const Eigen::Index n = b.rows();
+    if (direct_) return solve_b(b, x);
     Eigen::MatrixXd pb(n, b.cols());
     for (Eigen::Index i = 0; i < n; ++i) pb.row(inverse_[static_cast<std::size_t>(i)]) = b.row(i);
     cholmod_dense bd{};
@@ -448,6 +514,31 @@ class CholmodPermutedBackend final : public Backend {
   }
 
  private:
+  // x = B^-1 b (kNatural, lower triangle given: B is A).
+  bool solve_b(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
+    cholmod_dense bd{};
+    bd.nrow = static_cast<std::size_t>(b.rows());
+    bd.ncol = static_cast<std::size_t>(b.cols());
+    bd.nzmax = bd.nrow * bd.ncol;
+    bd.d = bd.nrow;
+    bd.x = const_cast<double*>(b.data());  // read only (cholmod_solve copies it)
+    bd.xtype = CHOLMOD_REAL;
+    bd.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* xd = nullptr;
+    {
+      const BlasSection blas;
+      xd = cholmod_solve(CHOLMOD_A, factor_, &bd, &c_);
+    }
+    if (xd == nullptr) return false;
+    x = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(xd->x), b.rows(), b.cols());
+    cholmod_free_dense(&xd, &c_);
+    return true;
+  }
+  template <class T>
+  static void release(std::vector<T>& v) {
+    std::vector<T>().swap(v);
+  }
+
   // A CHOLMOD view (no copy) of a lower triangle with a's size and the given arrays.
   static cholmod_sparse lower_view(const SparseMatrix& a, int* col, int* row, double* val, int xtype) {
     cholmod_sparse v{};
@@ -469,6 +560,7 @@ class CholmodPermutedBackend final : public Backend {
   mutable cholmod_common c_{};  // cholmod_solve takes it non-const (status, workspace)
   cholmod_factor* factor_ = nullptr;
   Ordering ordering_choice_ = Ordering::kDefault;
+  bool direct_ = false;       // kNatural with a lower triangle: B is A (no map, no copy)
   std::vector<int> inverse_;  // inverse_[i]: position of A's row i in B
   std::vector<int> b_col_, b_row_, map_;
   std::vector<double> b_val_;
@@ -490,7 +582,9 @@ class UmfpackBackend final : public Backend {
   // kMetis METIS; kNesdis (CHOLMOD's) is not UMFPACK's, so METIS stands in for it.
   void set_ordering(Ordering ordering) override {
     lu_.umfpackControl()(UMFPACK_ORDERING) =
-        ordering == Ordering::kMetis || ordering == Ordering::kNesdis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+        ordering == Ordering::kNatural                                ? UMFPACK_ORDERING_NONE
+        : ordering == Ordering::kMetis || ordering == Ordering::kNesdis ? UMFPACK_ORDERING_METIS
+                                                                      : UMFPACK_ORDERING_AMD;
   }
 
   void set_refinement(bool on) override { lu_.umfpackControl()(UMFPACK_IRSTEP) = on ? 2 : 0; }
@@ -578,7 +672,9 @@ class MumpsBackend final : public Backend {
   // not METIS, and picks AMF at the dome's sizes); kAmd: AMD; kMetis and kNesdis: SCOTCH's
   // nested dissection (the nested dissection Debian's MUMPS has).
   void set_ordering(Ordering ordering) override {
-    ordering_choice_ = ordering == Ordering::kAmd ? 0 : ordering == Ordering::kDefault ? 7 : 3;
+    ordering_choice_ = ordering == Ordering::kAmd                                          ? 0
+                       : ordering == Ordering::kDefault || ordering == Ordering::kNatural ? 7
+                                                                                          : 3;
   }
 
   Outcome analyze(const SparseMatrix& a) override {
@@ -903,15 +999,17 @@ std::string to_string(Ordering ordering) {
       return "metis";
     case Ordering::kNesdis:
       return "nesdis";
+    case Ordering::kNatural:
+      return "natural";
   }
   return "unknown";
 }
 
 Ordering parse_ordering(const std::string& name, const std::string& where) {
-  for (Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis})
+  for (Ordering o : {Ordering::kDefault, Ordering::kAmd, Ordering::kMetis, Ordering::kNesdis, Ordering::kNatural})
     if (name == to_string(o)) return o;
   std::string message =
-      fmt::format("unknown fill-reducing ordering '{}' (expected one of: default, amd, metis, nesdis)", name);
+      fmt::format("unknown fill-reducing ordering '{}' (expected one of: default, amd, metis, nesdis, natural)", name);
   if (!where.empty()) message = where + ": " + message;
   throw InputError(message);
 }
@@ -978,9 +1076,46 @@ struct LinearSolver::Impl {
   MatrixProperty property = MatrixProperty::kSymmetricPositiveDefinite;
   std::unique_ptr<Backend> backend;
   // Own compressed copy of the last analysed/factorised A: the pattern to
-  // compare against, and the matrix UMFPACK reads during solve().
+  // compare against, and the matrix UMFPACK reads during solve(). Without a copy
+  // (keep_copy false): the caller's A (view) and its pattern (outer, inner).
   SparseMatrix matrix;
+  bool keep_copy = true;
+  const SparseMatrix* view = nullptr;
+  std::vector<int> outer, inner;
   bool analysed = false;
+
+  // The last analysed/factorised A.
+  const SparseMatrix& a() const { return view ? *view : matrix; }
+  // Takes a (compressed) as the current A: a copy, or a view and a copy of its pattern.
+  void take(const SparseMatrix& a_new) {
+    if (keep_copy || !a_new.isCompressed()) {
+      view = nullptr;
+      release_pattern();
+      matrix = a_new;
+      matrix.makeCompressed();
+      return;
+    }
+    matrix = SparseMatrix();
+    view = &a_new;
+    view_rows = a_new.rows();
+    outer.assign(a_new.outerIndexPtr(), a_new.outerIndexPtr() + a_new.outerSize() + 1);
+    inner.assign(a_new.innerIndexPtr(), a_new.innerIndexPtr() + a_new.nonZeros());
+  }
+  void release_pattern() {
+    std::vector<int>().swap(outer);
+    std::vector<int>().swap(inner);
+  }
+  // a has the pattern of the current A (both compressed).
+  bool same_as_current(const SparseMatrix& a_new) const {
+    if (!view) return same_pattern(a_new, matrix);
+    if (a_new.rows() != view_rows || a_new.cols() != view_rows ||
+        static_cast<std::size_t>(a_new.nonZeros()) != inner.size() ||
+        static_cast<std::size_t>(a_new.outerSize()) + 1 != outer.size())
+      return false;
+    return std::equal(outer.begin(), outer.end(), a_new.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), a_new.innerIndexPtr());
+  }
+  Index view_rows = 0;
   Ordering ordering = Ordering::kDefault;
   SolveReport report;
 
@@ -1002,7 +1137,7 @@ struct LinearSolver::Impl {
   // Analyses `matrix` and fills the report's analysis fields; false on failure.
   bool analyse() {
     const auto start = std::chrono::steady_clock::now();
-    Outcome outcome = backend->analyze(matrix);
+    Outcome outcome = backend->analyze(a());
     report.analyze_seconds = seconds_since(start);
     analysed = outcome.status == Status::kOk;
     if (!analysed) {
@@ -1042,10 +1177,9 @@ const SolveReport& LinearSolver::analyze_pattern(const SparseMatrix& a) {
   SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
   Impl& im = *impl_;
   if (!im.begin_report(a)) return im.report;
-  im.matrix = a;
-  im.matrix.makeCompressed();
+  im.take(a);
   im.analysed = false;
-  if (im.matrix.rows() == 0 || im.analyse()) {
+  if (im.a().rows() == 0 || im.analyse()) {
     im.report.status = Status::kNotFactorized;
     im.report.message = "pattern analysed; not factorised yet";
   }
@@ -1086,16 +1220,23 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
 
   // Same pattern as the analysed matrix (the Newton case): copy the values only.
   bool reuse = false;
-  if (im.analysed && a.isCompressed() && same_pattern(a, im.matrix)) {
-    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), im.matrix.valuePtr());
+  if (im.analysed && a.isCompressed() && im.same_as_current(a)) {
+    if (im.view)
+      im.view = &a;
+    else
+      std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), im.matrix.valuePtr());
     reuse = true;
+  } else if (!im.keep_copy && a.isCompressed()) {
+    im.take(a);  // a pattern that differs: analysed anew
   } else {
     SparseMatrix copy = a;
     copy.makeCompressed();
-    reuse = im.analysed && same_pattern(copy, im.matrix);
+    reuse = im.analysed && im.same_as_current(copy);
+    im.view = nullptr;
+    im.release_pattern();
     im.matrix = std::move(copy);
   }
-  if (im.matrix.rows() == 0) {  // nothing to factorise; solve() returns 0 x n_rhs
+  if (im.a().rows() == 0) {  // nothing to factorise; solve() returns 0 x n_rhs
     im.analysed = false;
     im.report.status = Status::kOk;
     return im.report;
@@ -1105,10 +1246,11 @@ const SolveReport& LinearSolver::factorize(const SparseMatrix& a) {
   if (!reuse && !im.analyse()) return im.report;
 
   const auto start = std::chrono::steady_clock::now();
-  Outcome outcome = im.backend->factorize(im.matrix);
+  Outcome outcome = im.backend->factorize(im.a());
   im.report.factor_seconds = seconds_since(start);
   im.report.factor_flops = im.backend->factor_flops();
   im.report.factor_nonzeros = im.backend->factor_nonzeros();
+  im.report.library_bytes = im.backend->library_bytes();
   im.report.ordering = im.backend->ordering_used();
   im.report.negative_pivots = im.backend->negative_pivots();
   im.report.determinant_sign = im.backend->determinant_sign();
@@ -1121,11 +1263,11 @@ Eigen::MatrixXd LinearSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) 
   SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
   Impl& im = *impl_;
   SF_ASSERT(im.report.ok(), "LinearSolver::solve() needs a successful factorize()");
-  SF_ASSERT(b.rows() == im.matrix.rows(), "right-hand side has the wrong number of rows");
-  if (!im.report.ok() || b.rows() != im.matrix.rows()) {
-    return nan_matrix(im.matrix.rows(), b.cols());
+  SF_ASSERT(b.rows() == im.a().rows(), "right-hand side has the wrong number of rows");
+  if (!im.report.ok() || b.rows() != im.a().rows()) {
+    return nan_matrix(im.a().rows(), b.cols());
   }
-  if (im.matrix.rows() == 0 || b.cols() == 0) return Eigen::MatrixXd(im.matrix.rows(), b.cols());
+  if (im.a().rows() == 0 || b.cols() == 0) return Eigen::MatrixXd(im.a().rows(), b.cols());
 
   const auto start = std::chrono::steady_clock::now();
   const Eigen::MatrixXd rhs = b;  // contiguous column-major, as the libraries expect
@@ -1135,7 +1277,7 @@ Eigen::MatrixXd LinearSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b) 
   if (!solved) {
     im.report.status = Status::kFailed;
     im.report.message = fmt::format("{} reported an error while solving", to_string(im.kind));
-    return nan_matrix(im.matrix.rows(), b.cols());
+    return nan_matrix(im.a().rows(), b.cols());
   }
   return x;
 }
@@ -1144,15 +1286,15 @@ Eigen::MatrixXd LinearSolver::residual(const Eigen::Ref<const Eigen::MatrixXd>& 
                                        const Eigen::Ref<const Eigen::MatrixXd>& x) const {
   SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
   const Impl& im = *impl_;
-  SF_ASSERT(b.rows() == im.matrix.rows() && x.rows() == b.rows() && x.cols() == b.cols(), "residual: wrong sizes");
+  SF_ASSERT(b.rows() == im.a().rows() && x.rows() == b.rows() && x.cols() == b.cols(), "residual: wrong sizes");
   const bool lower = reads_lower_triangle(im.kind);
   // A back end that reads the lower triangle may have been given both: read only that one.
   bool upper = false;
   if (lower)
-    for (Eigen::Index j = 0; j < im.matrix.outerSize() && !upper; ++j)
-      for (SparseMatrix::InnerIterator it(im.matrix, j); it && !upper; ++it) upper = it.row() < it.col();
-  const SparseMatrix lower_copy = upper ? SparseMatrix(im.matrix.triangularView<Eigen::Lower>()) : SparseMatrix();
-  const SparseMatrix& a = upper ? lower_copy : im.matrix;
+    for (Eigen::Index j = 0; j < im.a().outerSize() && !upper; ++j)
+      for (SparseMatrix::InnerIterator it(im.a(), j); it && !upper; ++it) upper = it.row() < it.col();
+  const SparseMatrix lower_copy = upper ? SparseMatrix(im.a().triangularView<Eigen::Lower>()) : SparseMatrix();
+  const SparseMatrix& a = upper ? lower_copy : im.a();
   Eigen::MatrixXd r(b.rows(), b.cols());
   Eigen::VectorXd ax(b.rows());
   for (Eigen::Index c = 0; c < b.cols(); ++c) {
@@ -1164,7 +1306,26 @@ Eigen::MatrixXd LinearSolver::residual(const Eigen::Ref<const Eigen::MatrixXd>& 
 
 const SparseMatrix& LinearSolver::matrix() const {
   SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
-  return impl_->matrix;
+  return impl_->a();
+}
+
+void LinearSolver::keep_copy(bool keep) {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  Impl& im = *impl_;
+  if (im.keep_copy == keep) return;
+  im.keep_copy = keep;
+  // The current A as the new setting keeps it (a view becomes a copy; a copy stays until
+  // the next factorize() gives a matrix to view).
+  if (keep && im.view) {
+    im.matrix = *im.view;
+    im.view = nullptr;
+    im.release_pattern();
+  }
+}
+
+std::vector<int> LinearSolver::permutation() const {
+  SF_ASSERT(impl_ != nullptr, "use of a moved-from LinearSolver");
+  return impl_->analysed ? impl_->backend->permutation() : std::vector<int>();
 }
 
 const SolveReport& LinearSolver::last_report() const {

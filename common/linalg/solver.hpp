@@ -8,7 +8,9 @@
 //               definite only; reads the lower triangle of A. The fill-reducing
 //               permutation is applied here (tril(P A P^T) kept with a value map made at
 //               the analysis: 16 bytes per stored entry), not by CHOLMOD's two
-//               transposes per factorisation (solver.cpp, CholmodPermutedBackend).
+//               transposes per factorisation (solver.cpp, CholmodPermutedBackend). With
+//               Ordering::kNatural and a lower triangle none of that: A is read in place
+//               (lay it out in the order of permutation(): PatternAssembler::set_order).
 //   kUmfpack    UMFPACK LU with partial pivoting. Any square nonsingular A.
 //   kCholmodLdlt CHOLMOD simplicial A = L D L^T (no pivoting): symmetric, definite or
 //               not, as long as no pivot vanishes; reads the lower triangle of A.
@@ -83,11 +85,16 @@ bool reads_lower_triangle(SolverKind kind);
 //   kAmd      approximate minimum degree
 //   kMetis    METIS nested dissection (through CHOLMOD)
 //   kNesdis   CHOLMOD's nested dissection (METIS partitions, constrained minimum degree)
+//   kNatural  none: A is factorised in the order given (a matrix already laid out in a
+//             fill-reducing order, e.g. by PatternAssembler::set_order with the
+//             permutation() of an earlier analysis). kCholmod with a lower triangle then
+//             reads A in place at every factorisation (no permuted copy, no value map).
 // UMFPACK: kDefault and kAmd give its AMD / COLAMD, kMetis and kNesdis its METIS.
 // MUMPS: kDefault its own choice (AMF or SCOTCH by size: Debian's build has no METIS), kAmd
-// AMD, kMetis and kNesdis SCOTCH's nested dissection.
-enum class Ordering { kDefault, kAmd, kMetis, kNesdis };
-// "default", "amd", "metis", "nesdis".
+// AMD, kMetis and kNesdis SCOTCH's nested dissection. kNatural: CHOLMOD's natural ordering
+// (no postorder), UMFPACK's none; MUMPS and the Eigen back ends take their default.
+enum class Ordering { kDefault, kAmd, kMetis, kNesdis, kNatural };
+// "default", "amd", "metis", "nesdis", "natural".
 std::string to_string(Ordering ordering);
 // Inverse of to_string(Ordering); sf::InputError otherwise (message starts with `where`).
 Ordering parse_ordering(const std::string& name, const std::string& where = "");
@@ -149,6 +156,8 @@ struct SolveReport {
                                         // (MUMPS LDL^T); -1 when unknown
   int determinant_sign = 0;             // sign of det(A) (+1 or -1) from a factorisation that
                                         // computes it (MUMPS, ICNTL(33)); 0 when unknown or singular
+  double library_bytes = 0.0;           // bytes the library holds after the factorisation (factor,
+                                        // analysis, workspace: CHOLMOD's memory_inuse); 0 when unknown
 
   bool ok() const { return status == Status::kOk; }
   // One line, e.g. "cholmod n=900 nnz=4380: ok; analyse 0.0004 s, factor 0.0011 s, solve 0.0001 s"
@@ -196,8 +205,20 @@ class LinearSolver {
   // Numeric factorisation of a. Analyses first when no analysis exists or when
   // a's pattern (size, column pointers, row indices) differs from the analysed
   // one; otherwise reuses it (report.reused_analysis). The solver keeps its own
-  // copy of a, so a may be a temporary.
+  // copy of a, so a may be a temporary (unless keep_copy(false)).
   const SolveReport& factorize(const SparseMatrix& a);
+
+  // keep_copy(false): analyze_pattern() and factorize() keep a copy of a compressed a's
+  // pattern only (4 bytes per entry, for the comparison above), not of its values
+  // (8 more): the solver reads a itself, so a must stay alive, with the same values,
+  // while solve(), residual() and matrix() of that factorisation are used (a
+  // PatternAssembler's matrix between assemblies). Default true: a copy of a.
+  void keep_copy(bool keep);
+  // The fill-reducing order of the current analysis: row perm[k] of A is eliminated k-th
+  // (kCholmod; empty for the other back ends and before an analysis). With
+  // PatternAssembler::set_order(perm) the assembler lays out the matrix a kNatural
+  // solver factorises as it is.
+  std::vector<int> permutation() const;
 
   // X (n x n_rhs) with A X = B for B (n x n_rhs), all columns from the current
   // factorisation. Precondition: last_report().ok() and B.rows() == n
@@ -211,7 +232,8 @@ class LinearSolver {
   // right-hand side of a refinement step, X += solve(B - A X).
   Eigen::MatrixXd residual(const Eigen::Ref<const Eigen::MatrixXd>& b,
                            const Eigen::Ref<const Eigen::MatrixXd>& x) const;
-  // The solver's own copy of the last analysed or factorised A (compressed).
+  // The solver's own copy of the last analysed or factorised A (compressed), or the
+  // caller's A itself after keep_copy(false).
   const SparseMatrix& matrix() const;
 
   // Report of the last analyze_pattern / factorize (and solve timing).

@@ -69,6 +69,7 @@ TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric, LinearMo
     spd_ = std::make_unique<linalg::LinearSolver>(SolverKind::kCholmod,
                                                   linalg::MatrixProperty::kSymmetricPositiveDefinite);
     spd_->set_ordering(ordering);
+    spd_ordering_ = ordering;
     // Where Cholesky breaks down: MUMPS's LDL^T with pivoting on the same lower triangle
     // (see the header), checked by the residual of each solution.
     if (linalg::solver_available(SolverKind::kMumpsLdlt)) {
@@ -109,7 +110,75 @@ TangentSolver::TangentSolver(linalg::SolverKind kind, bool unsymmetric, LinearMo
   if (use_iterative_) general_->set_refinement(false);  // a preconditioner: GMRES refines
 }
 
+bool TangentSolver::lay_out(linalg::PatternAssembler& pattern) {
+  pattern_ = nullptr;
+  order_.clear();
+  if (!spd_ || use_iterative_ || pattern.storage() != linalg::Storage::kLower || pattern.has_pending()) {
+    if (!pattern.order().empty() && !pattern.has_pending()) pattern.set_order({});
+    return false;
+  }
+  pattern_ = &pattern;
+  reorder();
+  return true;
+}
+
+void TangentSolver::reorder() {
+  linalg::PatternAssembler& p = *pattern_;
+  // The ordering from the natural pattern, as factorize() of the natural matrix would
+  // choose it (so the factor, and every result, is the same), then the pattern in it.
+  if (!p.order().empty()) p.set_order({});
+  spd_->keep_copy(false);
+  spd_->set_ordering(spd_ordering_);
+  const linalg::SolveReport& r = spd_->analyze_pattern(p.matrix());
+  std::vector<int> perm = r.status == linalg::SolveReport::Status::kNotFactorized ? spd_->permutation()
+                                                                                  : std::vector<int>();
+  order_name_ = r.ordering;
+  spd_->set_ordering(linalg::Ordering::kNatural);  // drops that analysis (and its map)
+  if (!perm.empty()) p.set_order(perm);
+  order_ = p.order();
+  pattern_generation_ = p.generation();
+}
+
+const linalg::SparseMatrix& TangentSolver::natural(const linalg::SparseMatrix& k) {
+  if (order_.empty()) return k;
+  // tril(P^T B P) of the lower triangle B (row r of B is unknown order_[r]).
+  const int n = static_cast<int>(k.rows());
+  std::vector<int> count(static_cast<std::size_t>(n) + 1, 0);
+  const int* col = k.outerIndexPtr();
+  const int* row = k.innerIndexPtr();
+  const double* val = k.valuePtr();
+  auto unknown = [&](int r) { return order_[static_cast<std::size_t>(r)]; };
+  for (int c = 0; c < n; ++c)
+    for (int q = col[c]; q < col[c + 1]; ++q) ++count[static_cast<std::size_t>(std::min(unknown(row[q]), unknown(c))) + 1];
+  for (int c = 0; c < n; ++c) count[static_cast<std::size_t>(c) + 1] += count[static_cast<std::size_t>(c)];
+  natural_.resize(n, n);
+  natural_.resizeNonZeros(k.nonZeros());
+  std::copy(count.begin(), count.end(), natural_.outerIndexPtr());
+  std::vector<std::pair<int, double>> column;
+  std::vector<int> next(count.begin(), count.end() - 1);
+  for (int c = 0; c < n; ++c)
+    for (int q = col[c]; q < col[c + 1]; ++q) {
+      const int a = unknown(row[q]), b = unknown(c);
+      const int dst = next[static_cast<std::size_t>(std::min(a, b))]++;
+      natural_.innerIndexPtr()[dst] = std::max(a, b);
+      natural_.valuePtr()[dst] = val[q];
+    }
+  for (int c = 0; c < n; ++c) {
+    const int q0 = count[static_cast<std::size_t>(c)], q1 = count[static_cast<std::size_t>(c) + 1];
+    column.clear();
+    for (int q = q0; q < q1; ++q) column.emplace_back(natural_.innerIndexPtr()[q], natural_.valuePtr()[q]);
+    std::sort(column.begin(), column.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (int q = q0; q < q1; ++q) {
+      natural_.innerIndexPtr()[q] = column[static_cast<std::size_t>(q - q0)].first;
+      natural_.valuePtr()[q] = column[static_cast<std::size_t>(q - q0)].second;
+    }
+  }
+  return natural_;
+}
+
 const linalg::SolveReport& TangentSolver::factorize(const linalg::SparseMatrix& k) {
+  if (pattern_ && &k == &pattern_->matrix() && pattern_->generation() != pattern_generation_)
+    reorder();  // the pattern grew (contact pairs): ordered anew
   if (!use_iterative_) return factorize_direct(k);
   const auto t0 = std::chrono::steady_clock::now();
   SolveProfile& profile = solve_profile();
@@ -157,7 +226,7 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
     double& to;
     ~AddTime() { to += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
   } timer{t0, profile.factorize_s};
-  const auto record = [&profile](const linalg::SolveReport& r) {
+  const auto record = [&profile, this](const linalg::SolveReport& r) {
     if (!r.reused_analysis) {
       ++profile.analyses;
       profile.analyse_s += r.analyze_seconds;
@@ -167,7 +236,7 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
     profile.factor_nnz = r.factor_nonzeros;
     profile.factor_flops = r.factor_flops;
     profile.solver = linalg::to_string(r.used);
-    profile.ordering = r.ordering;
+    profile.ordering = r.used == linalg::SolverKind::kCholmod && !order_.empty() ? order_name_ : r.ordering;
   };
   if (!ordering_chosen_) {
     // UMFPACK's default AMD against METIS on the dome's start tangent (bench/
@@ -192,8 +261,11 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
     skip_cholesky_ = 4;
   }
   if (spd_) ++n_indefinite_;
+  // The other solvers get the matrix in the natural order, as without the Cholesky's
+  // layout (their own orderings, so the same results).
+  const linalg::SparseMatrix& kn = natural(k);
   if (indefinite_) {
-    const linalg::SolveReport& r = indefinite_->factorize(k);
+    const linalg::SolveReport& r = indefinite_->factorize(kn);
     record(r);
     ++profile.indefinite_factorizations;
     if (r.ok()) {
@@ -205,13 +277,13 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
   if (lower_ && !linalg::reads_lower_triangle(general_->kind())) {
     // Both triangles for the LU; the same lower pattern expands to the same full one, so
     // its analysis is kept as well.
-    expanded_ = k.selfadjointView<Eigen::Lower>();
+    expanded_ = kn.selfadjointView<Eigen::Lower>();
     const linalg::SolveReport& r = general_->factorize(expanded_);
     record(r);
     active_ = r.ok() ? general_.get() : nullptr;
     return r;
   }
-  const linalg::SolveReport& r = general_->factorize(k);
+  const linalg::SolveReport& r = general_->factorize(kn);
   record(r);
   if (r.ok() || !lu_fallback_) {
     active_ = r.ok() ? general_.get() : nullptr;
@@ -221,7 +293,7 @@ const linalg::SolveReport& TangentSolver::factorize_direct(const linalg::SparseM
   // says which when it fails as well.
   ++n_lu_fallbacks_;
   ++profile.lu_fallbacks;
-  const linalg::SolveReport& fr = lu_fallback_->factorize(k);
+  const linalg::SolveReport& fr = lu_fallback_->factorize(kn);
   record(fr);
   active_ = fr.ok() ? lu_fallback_.get() : nullptr;
   return fr;
@@ -239,6 +311,15 @@ Eigen::MatrixXd TangentSolver::solve(const Eigen::Ref<const Eigen::MatrixXd>& b)
 }
 
 Eigen::MatrixXd TangentSolver::solve_direct(const Eigen::Ref<const Eigen::MatrixXd>& b) {
+  if (active_ == spd_.get() && !order_.empty()) {  // the matrix in the pattern's order
+    const Index n = b.rows();
+    Eigen::MatrixXd pb(n, b.cols());
+    for (Index r = 0; r < n; ++r) pb.row(r) = b.row(order_[static_cast<std::size_t>(r)]);
+    const Eigen::MatrixXd px = active_->solve(pb);
+    Eigen::MatrixXd x(n, b.cols());
+    for (Index r = 0; r < n; ++r) x.row(order_[static_cast<std::size_t>(r)]) = px.row(r);
+    return x;
+  }
   Eigen::MatrixXd x = active_->solve(b);
   if (active_ == indefinite_.get()) check_indefinite(b, x);
   if (lu_fallback_ && active_ == general_.get()) check_lu(b, x);
@@ -408,6 +489,7 @@ void TangentWorkspace::prepare(const Model& model, const std::vector<bool>& is_f
   solver_ = std::make_unique<TangentSolver>(kind, unsymmetric);
   lay_out(model);
   make_solver(model);
+  solver_->lay_out(*pattern_);
 }
 
 void TangentWorkspace::make_unsymmetric(const Model& model) {
@@ -415,6 +497,7 @@ void TangentWorkspace::make_unsymmetric(const Model& model) {
   unsymmetric_ = true;
   lay_out(model);
   make_solver(model);
+  solver_->lay_out(*pattern_);
 }
 
 std::vector<int> ply_groups(const Model& model, const std::vector<Index>& active_dofs) {

@@ -89,6 +89,17 @@ class TangentSolver {
                 std::vector<int> group = {});
   // True when factorize() expects the lower triangle only.
   bool lower() const { return lower_; }
+  // Lays `pattern` (made for this solver: lower() storage) out for the direct Cholesky:
+  // the fill-reducing order of its natural pattern (the ordering factorize() would choose)
+  // becomes the pattern's order (PatternAssembler::set_order), so CHOLMOD factorises
+  // pattern.matrix() in place: no copy of it, no permuted copy, no value map. The pattern
+  // must outlive the solver's use of it (TangentWorkspace keeps both); factorize() then
+  // takes pattern.matrix() (or any matrix in the same order), orders anew when the pattern
+  // has grown, and solve() takes and returns vectors in the natural order as always. The
+  // indefinite and LU fallbacks get the matrix back in the natural order (a copy, made
+  // only when Cholesky fails). False (the pattern left in, or put back to, the natural
+  // order) for the iterative mode, unsymmetric tangents and builds without CHOLMOD.
+  bool lay_out(linalg::PatternAssembler& pattern);
   const linalg::SolveReport& factorize(const linalg::SparseMatrix& k);
   // dx with K dx = b for the last factorize()d K. Not const: a solution that fails its
   // residual check factorises the LU fallback, and an aged preconditioner is refactorised.
@@ -121,6 +132,10 @@ class TangentSolver {
 
  private:
   const linalg::SolveReport& factorize_direct(const linalg::SparseMatrix& k);
+  // The ordering of pattern_ from its natural pattern, and the pattern laid out in it.
+  void reorder();
+  // k (in the order order_) in the natural order: k itself when order_ is empty, else natural_.
+  const linalg::SparseMatrix& natural(const linalg::SparseMatrix& k);
   bool factorize_preconditioner();
   Eigen::MatrixXd solve_iterative(const Eigen::Ref<const Eigen::MatrixXd>& b);
   // The active direct solver's solution, checked (and redone by the fallback) as its path says.
@@ -157,6 +172,15 @@ class TangentSolver {
   static constexpr double kTolerance = 1e-10;     // GMRES: |K dx + r| <= kTolerance |r|
   const linalg::LinearSolver* active_ = nullptr;
   bool lower_ = false;
+  // lay_out(): the pattern laid out in the Cholesky's order, its generation then, that
+  // order (row r of the matrices factorize() gets is unknown order_[r]; empty: natural),
+  // the ordering that made it, the natural-order copy for the fallbacks.
+  linalg::PatternAssembler* pattern_ = nullptr;
+  int pattern_generation_ = -1;
+  std::vector<int> order_;
+  std::string order_name_;
+  linalg::Ordering spd_ordering_ = linalg::Ordering::kDefault;
+  linalg::SparseMatrix natural_;
   // From this many unknowns up the LU orders by METIS (nested dissection) rather than
   // UMFPACK's AMD, unless set_default_ordering() chose one.
   static constexpr Index kMetisFrom = 5000;

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
+#include <numeric>
 #include <random>
 #include <string>
 #include <thread>
@@ -24,6 +25,7 @@
 
 #include "common/core/error.hpp"
 #include "common/core/memory.hpp"
+#include "common/linalg/pattern_assembler.hpp"
 #include "common/linalg/solver.hpp"
 #include "common/linalg/sparse.hpp"
 
@@ -637,6 +639,193 @@ TEST(LinalgSolver, SimplicialCholmodSolversRunConcurrently) {
     other.join();
   }
   for (std::size_t k = 0; k < matrices.size(); ++k) EXPECT_EQ(sequential[k], concurrent[k]) << "system " << k;
+}
+
+}  // namespace
+}  // namespace sf::linalg
+
+namespace sf::linalg {
+namespace {
+
+// Elements of 2..6 random dofs (some repeated: a collapsed element) over n_dofs dofs, with
+// symmetric positive semidefinite element matrices (B^T B) plus a diagonal on every dof
+// so the assembled matrix is positive definite.
+struct RandomElements {
+  Index n_dofs = 0;
+  std::vector<ElementEntries> entries;
+  std::vector<bool> active;
+  RandomElements(Index n, int n_elements, unsigned seed) : n_dofs(n) {
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<Index> dof(0, n - 1);
+    std::uniform_int_distribution<int> size(2, 6);
+    std::uniform_real_distribution<double> coef(0.5, 1.5);
+    for (int e = 0; e < n_elements; ++e) {
+      ElementEntries en;
+      const int m = size(rng);
+      for (int a = 0; a < m; ++a) {
+        en.dofs.push_back(a == m - 1 && m > 3 ? en.dofs[0] : dof(rng));  // some dofs twice
+        en.coefs.push_back(coef(rng));
+        en.local.push_back(a);
+      }
+      entries.push_back(en);
+    }
+    for (Index d = 0; d < n; ++d) {  // a diagonal element on every dof
+      ElementEntries en;
+      en.dofs = {d};
+      en.coefs = {1.0};
+      en.local = {0};
+      entries.push_back(en);
+    }
+    active.assign(static_cast<std::size_t>(n), true);
+    for (Index d = 0; d < n; d += 7) active[static_cast<std::size_t>(d)] = false;  // held dofs
+  }
+  // Element e's matrix for value set `set` (exactly symmetric).
+  Eigen::MatrixXd k(std::size_t e, int set) const {
+    const int m = static_cast<int>(entries[e].dofs.size());
+    Eigen::MatrixXd b(m, m);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < m; ++j) b(i, j) = std::sin(1.0 + i + 2.0 * j + 0.1 * e + 0.7 * set);
+    Eigen::MatrixXd k = b.transpose() * b;
+    k = 0.5 * (k + k.transpose()).eval();
+    if (m == 1) k(0, 0) = 4.0 + set;
+    return k;
+  }
+  void assemble(PatternAssembler& pa, int set) const {
+    pa.set_zero();
+    for (std::size_t e = 0; e < entries.size(); ++e) {
+      const Eigen::MatrixXd ke = k(e, set);
+      pa.add_element(static_cast<Index>(e), ke.data(), static_cast<int>(ke.rows()));
+    }
+  }
+  // The dense matrix of the active unknowns (natural order).
+  Eigen::MatrixXd dense(const PatternAssembler& pa, int set) const {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(pa.n_active(), pa.n_active());
+    for (std::size_t e = 0; e < entries.size(); ++e) {
+      const Eigen::MatrixXd ke = k(e, set);
+      const ElementEntries& en = entries[e];
+      for (std::size_t a = 0; a < en.dofs.size(); ++a)
+        for (std::size_t b = 0; b < en.dofs.size(); ++b) {
+          const Index r = pa.active_index(en.dofs[a]), c = pa.active_index(en.dofs[b]);
+          if (r >= 0 && c >= 0) d(r, c) += en.coefs[a] * en.coefs[b] * ke(en.local[a], en.local[b]);
+        }
+    }
+    return d;
+  }
+};
+
+// PatternAssembler::set_order lays out tril(P A P^T): entry (k, l) holds A(order[k],
+// order[l]) with the same values; entries added by global dofs land in their permuted
+// places; set_order({}) gives back the natural layout, values kept.
+TEST(LinalgPatternOrder, PermutedLayoutHoldsThePermutedMatrixAndComesBack) {
+  const RandomElements el(120, 150, kSeed);
+  for (const Storage storage : {Storage::kLower, Storage::kFull}) {
+    SCOPED_TRACE(storage == Storage::kLower ? "lower" : "full");
+    PatternAssembler natural(el.n_dofs, el.active, el.entries, storage);
+    PatternAssembler permuted(el.n_dofs, el.active, el.entries, storage);
+    const int n = static_cast<int>(natural.n_active());
+    std::vector<int> order(static_cast<std::size_t>(n));
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), std::mt19937(kSeed + 1));
+    el.assemble(permuted, 0);
+    permuted.set_order(order);  // values carried over
+    EXPECT_EQ(permuted.order(), order);
+    EXPECT_EQ(permuted.generation(), 1);
+    el.assemble(natural, 0);
+    const Eigen::MatrixXd a = Eigen::MatrixXd(natural.matrix());
+    auto expect_permuted = [&](const char* what) {
+      SCOPED_TRACE(what);
+      const Eigen::MatrixXd b = Eigen::MatrixXd(permuted.matrix());
+      for (int k = 0; k < n; ++k)
+        for (int l = 0; l < n; ++l) {
+          const int r = order[static_cast<std::size_t>(k)], c = order[static_cast<std::size_t>(l)];
+          // The lower storage keeps each entry once, in the lower triangle of its own layout.
+          const double want = storage == Storage::kFull ? a(r, c) : (k >= l ? (r >= c ? a(r, c) : a(c, r)) : 0.0);
+          ASSERT_EQ(b(k, l), want) << k << ", " << l;
+        }
+    };
+    expect_permuted("values carried over");
+    el.assemble(permuted, 0);
+    expect_permuted("assembled in the permuted layout");
+    // An entry outside the elements' pattern, by global dofs (both triangles, as a symmetric
+    // caller adds it): kept aside, then merged.
+    Index i = -1, j = -1;
+    for (Index d = 0; d < el.n_dofs && j < 0; ++d)
+      if (el.active[static_cast<std::size_t>(d)]) (i < 0 ? i : j) = d;
+    for (PatternAssembler* pa : {&natural, &permuted}) {
+      for (int t = 0; t < 2; ++t) {  // twice: the first may grow the pattern
+        el.assemble(*pa, 0);
+        pa->add(i, j + 50, 0.25);
+        pa->add(j + 50, i, 0.25);
+        pa->flush();
+      }
+    }
+    const Eigen::MatrixXd a2 = Eigen::MatrixXd(natural.matrix());
+    permuted.set_order({});
+    EXPECT_TRUE(permuted.order().empty());
+    EXPECT_EQ(Eigen::MatrixXd(permuted.matrix()), a2);
+    EXPECT_EQ(permuted.matrix().nonZeros(), natural.matrix().nonZeros());
+  }
+}
+
+// The Cholesky fed from a pattern laid out in its own fill-reducing order: CHOLMOD reads
+// the assembler's matrix in place (kNatural, no copy of the values) and solves as the
+// dense Cholesky of the natural matrix does, for new values of the same pattern too; the
+// second factorisation of a pattern reuses the analysis and allocates nothing that stays
+// (the library's memory in use and malloc's bytes in use are the same after it).
+TEST(LinalgSolver, CholmodFedFromThePatternInItsOrderMatchesDenseCholesky) {
+  if (!solver_available(SolverKind::kCholmod)) GTEST_SKIP() << "no SuiteSparse";
+  const RandomElements el(400, 700, kSeed + 2);
+  PatternAssembler pa(el.n_dofs, el.active, el.entries, Storage::kLower);
+  const Index n = pa.n_active();
+  // The order: CHOLMOD's analysis of the natural pattern.
+  LinearSolver orderer(SolverKind::kCholmod);
+  ASSERT_EQ(orderer.analyze_pattern(pa.matrix()).status, SolveReport::Status::kNotFactorized);
+  const std::vector<int> order = orderer.permutation();
+  ASSERT_EQ(static_cast<Index>(order.size()), n);
+  EXPECT_TRUE(LinearSolver(SolverKind::kUmfpack).permutation().empty());
+  pa.set_order(order);
+
+  LinearSolver solver(SolverKind::kCholmod);
+  solver.set_ordering(Ordering::kNatural);
+  solver.keep_copy(false);
+  std::mt19937 rng(kSeed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::MatrixXd b = Eigen::MatrixXd::NullaryExpr(n, kNumRhs, [&] { return u(rng); });
+  double lib_bytes = 0.0;
+  for (int set = 0; set < 3; ++set) {
+    SCOPED_TRACE(fmt::format("values {}", set));
+    el.assemble(pa, set);
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+    const std::size_t heap_before = mallinfo2().uordblks;
+#endif
+    const SolveReport& r = solver.factorize(pa.matrix());
+    ASSERT_TRUE(r.ok()) << r.brief();
+    EXPECT_EQ(r.reused_analysis, set > 0);
+    EXPECT_EQ(r.ordering, "natural");
+    EXPECT_GT(r.library_bytes, 0.0);
+    if (set > 0) {
+      EXPECT_EQ(r.library_bytes, lib_bytes) << "CHOLMOD holds more after a refactorisation";
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33))
+      EXPECT_EQ(mallinfo2().uordblks, heap_before) << "a refactorisation kept memory it allocated";
+#endif
+    }
+    lib_bytes = r.library_bytes;
+    EXPECT_EQ(&solver.matrix(), &pa.matrix()) << "the solver reads the pattern's matrix, no copy";
+    // In the order: y = B^-1 (P b), x = P^T y against the dense Cholesky of the natural A.
+    Eigen::MatrixXd pb(n, b.cols());
+    for (Index k = 0; k < n; ++k) pb.row(k) = b.row(order[static_cast<std::size_t>(k)]);
+    const Eigen::MatrixXd y = solver.solve(pb);
+    Eigen::MatrixXd x(n, b.cols());
+    for (Index k = 0; k < n; ++k) x.row(order[static_cast<std::size_t>(k)]) = y.row(k);
+    const Eigen::MatrixXd expected = el.dense(pa, set).llt().solve(b);
+    EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm());
+    // And as the default path solves the natural matrix (its own permuted copy).
+    PatternAssembler nat(el.n_dofs, el.active, el.entries, Storage::kLower);
+    el.assemble(nat, set);
+    LinearSolver reference(SolverKind::kCholmod);
+    ASSERT_TRUE(reference.factorize(nat.matrix()).ok());
+    EXPECT_LT((reference.solve(b) - x).norm(), 1e-13 * x.norm());
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // direct one on a contact laminate: the [0,90]s dome case at 3 x 3 bricks a ply (four
 // plies touching each other, the die and the holder; viscous inter-ply slip, so the
 // tangent is unsymmetric).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -320,6 +321,82 @@ TEST(FormingTangentSolver, MumpsLuSolutionFailingTheCheckGoesToUmfpack) {
   EXPECT_LE(solve_profile().lu_refinements, TangentSolver::kRefinementSteps);
   EXPECT_EQ(strict.active()->kind(), linalg::SolverKind::kUmfpack);
   EXPECT_LT((x - t.umfpack_solution(b)).norm(), 1e-12 * x.norm());
+}
+
+}  // namespace
+}  // namespace sf::forming
+
+namespace sf::forming {
+namespace {
+
+// TangentSolver::lay_out: the lower-triangle tangent laid out in the Cholesky's own order
+// (CHOLMOD reads it in place) gives the solutions of the natural layout: the same back end
+// on the dome's tangents (Cholesky, or the indefinite fallback that gets the matrix back in
+// the natural order), across a pattern that grows after the layout (contact pairs).
+TEST(FormingTangentSolver, PatternInTheCholeskysOrderGivesTheNaturalSolutions) {
+  const SmallDome d;
+  const Model& model = d.problem.model;
+  linalg::PatternAssembler natural = model.make_pattern(d.is_free, true);
+  linalg::PatternAssembler laid = model.make_pattern(d.is_free, true);
+  TangentSolver reference(linalg::SolverKind::kAuto, false);
+  TangentSolver solver(linalg::SolverKind::kAuto, false);
+  ASSERT_TRUE(solver.lay_out(laid));
+  EXPECT_FALSE(laid.order().empty());
+  const Eigen::VectorXd b = smooth_rhs(natural.n_active());
+  // No clock: no viscous slip, so the tangents are symmetric (the lower triangle is the
+  // whole of them whatever the order; an unsymmetric tangent is stored with both).
+  const InteractionContext still{};
+  linalg::PatternAssembler full = model.make_pattern(d.is_free, false);
+  ASSERT_TRUE(model.assemble_into(d.x1, still, &full).ok);
+  const linalg::SparseMatrix kt = full.matrix().transpose();
+  ASSERT_LT(linalg::SparseMatrix(full.matrix() - kt).norm(), 1e-12 * full.matrix().norm());
+  int step = 0;
+  for (const VecX* x : {&d.x0, &d.x1, &d.x0}) {
+    SCOPED_TRACE(fmt::format("tangent {}", ++step));
+    ASSERT_TRUE(model.assemble_into(*x, still, &natural).ok);
+    const int generation = laid.generation();
+    ASSERT_TRUE(model.assemble_into(*x, still, &laid).ok);
+    if (step == 1) {
+      EXPECT_GT(laid.generation(), generation) << "the contacts grow the pattern after the layout";
+    }
+    const linalg::SolveReport& r0 = reference.factorize(natural.matrix());
+    const linalg::SolveReport& r1 = solver.factorize(laid.matrix());
+    ASSERT_EQ(r0.ok(), r1.ok());
+    ASSERT_TRUE(r1.ok()) << r1.brief();
+    EXPECT_EQ(r1.used, r0.used) << r0.brief() << " / " << r1.brief();
+    EXPECT_EQ(laid.matrix().nonZeros(), natural.matrix().nonZeros());
+    const Eigen::VectorXd x0 = reference.solve(b), x1 = solver.solve(b);
+    EXPECT_LT((x1 - x0).norm(), 1e-12 * x0.norm());
+    EXPECT_LT(relative_residual(natural.matrix(), linalg::Storage::kLower, x1, b), 1e-9);
+  }
+  EXPECT_EQ(solver.n_indefinite(), reference.n_indefinite());
+  // Indefinite (the diagonal lowered by a third of its mean, the same in any order): the
+  // LDL^T and LU fallbacks get the matrix back in the natural order, the same solutions.
+  double mean = 0.0;
+  for (int c = 0; c < natural.matrix().outerSize(); ++c) mean += natural.matrix().coeff(c, c);
+  mean /= natural.matrix().outerSize();
+  for (linalg::PatternAssembler* pa : {&natural, &laid})
+    for (int c = 0; c < pa->matrix().outerSize(); ++c) pa->matrix().coeffRef(c, c) -= 0.37 * mean;
+  for (const double tolerance : {TangentSolver::kResidualTolerance, 0.0}) {  // 0: every solve to the LU
+    SCOPED_TRACE(fmt::format("residual tolerance {}", tolerance));
+    reference.set_residual_tolerance(tolerance);
+    solver.set_residual_tolerance(tolerance);
+    const linalg::SolveReport& r0 = reference.factorize(natural.matrix());
+    const linalg::SolveReport& r1 = solver.factorize(laid.matrix());
+    ASSERT_TRUE(r0.ok() && r1.ok()) << r0.brief() << " / " << r1.brief();
+    EXPECT_NE(r1.used, linalg::SolverKind::kCholmod);
+    EXPECT_EQ(r1.used, r0.used);
+    const Eigen::VectorXd x0 = reference.solve(b), x1 = solver.solve(b);
+    EXPECT_EQ(solver.active()->kind(), reference.active()->kind());
+    EXPECT_LT((x1 - x0).norm(), 1e-12 * x0.norm());
+  }
+  EXPECT_EQ(solver.n_indefinite(), reference.n_indefinite());
+  EXPECT_EQ(solver.n_residual_fallbacks(), reference.n_residual_fallbacks());
+  // The iterative mode and unsymmetric tangents keep the natural layout.
+  TangentSolver iterative(linalg::SolverKind::kAuto, false, LinearMode::kIterative,
+                          ply_groups(model, laid.active_dofs()));
+  EXPECT_FALSE(iterative.lay_out(laid));
+  EXPECT_TRUE(laid.order().empty());
 }
 
 }  // namespace

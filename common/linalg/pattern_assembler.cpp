@@ -205,7 +205,7 @@ void PatternAssembler::add_block(const std::vector<Index>& rows, const std::vect
   for (std::size_t a = 0; a < nr; ++a) {
     const Index i = rows[a];
     SF_ASSERT(i < n_dofs_, "dof out of range");
-    unknown[a] = i >= 0 ? static_cast<int>(index_[static_cast<std::size_t>(i)]) : -1;
+    unknown[a] = i >= 0 ? static_cast<int>(place_[static_cast<std::size_t>(i)]) : -1;
     if (unknown[a] >= 0) order.push_back(static_cast<int>(a));
   }
   std::sort(order.begin(), order.end(), [&](int a, int b) { return unknown[a] < unknown[b]; });
@@ -217,7 +217,7 @@ void PatternAssembler::add_block(const std::vector<Index>& rows, const std::vect
     const Index j = cols[b];
     if (j < 0) continue;
     SF_ASSERT(j < n_dofs_, "dof out of range");
-    const Index c = index_[static_cast<std::size_t>(j)];
+    const Index c = place_[static_cast<std::size_t>(j)];
     if (c < 0) continue;
     // Positions of the rows in column c: -1 dropped, -2 outside the pattern.
     int p = outer[c];

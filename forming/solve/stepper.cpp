@@ -145,10 +145,14 @@ class LoadStepper final : public Stepper {
         again.clock = {reached * T, lambda * T, nullptr, 0.0};
         again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
         const std::string before = r.report.message;
+        const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
         r = solve_static_constrained(problem_.model, moved, targets, step_load, problem_.loads.follower, again,
                                      settings_.uzawa, &uzawa);
         out.multiplier_updates += uzawa.updates;
         out.total_iterations += r.report.total_iterations;
+        // The step's counts: its failed attempts' too.
+        r.report.total_iterations += spent;
+        r.report.n_cutbacks += cut;
         if (!r.report.ok())
           r.report.message = before + "; after a branch switch at load factor " + std::to_string(reached) + ": " +
                              r.report.message;

@@ -191,6 +191,8 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.stabilise.damping = s.stabilise_damping;
   out.stabilise.warn_ratio = s.stabilise_warn_ratio;
   out.stabilise.validate();
+  out.branch_switch.amplitude = s.branch_switch_amplitude;
+  out.branch_switch.validate();
 
   if (s.dynamic) {
     DynamicOptions& d = out.dynamics;

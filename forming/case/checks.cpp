@@ -38,6 +38,14 @@ void check_solver_rules(const FormingCase& spec, std::vector<CaseProblem>& probl
       add(ProblemKind::kUnsupported, spec.solver.stabilise_place,
           "solver stabilise: load control only (not with control: arc_length)");
   }
+  if (spec.solver.branch_switch_amplitude > 0.0) {
+    if (spec.solver.dynamic)
+      add(ProblemKind::kUnsupported, spec.solver.branch_switch_place,
+          "solver branch_switch: load control only (analysis: dynamic follows the branch by inertia)");
+    if (spec.solver.arc_length > 0.0)
+      add(ProblemKind::kUnsupported, spec.solver.branch_switch_place,
+          "solver branch_switch: load control only (not with control: arc_length)");
+  }
   if (spec.solver.dynamic) {
     const SourcePlace at = spec.solver.analysis_place;
     for (const CaseMaterial& m : spec.materials) {

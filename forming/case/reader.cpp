@@ -460,7 +460,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   if (!r.mapping(n, "solver",
                  {"steps", "max_iterations", "tolerance", "line_search", "min_increment", "constraint_tolerance",
                   "analysis", "end_time", "time_step", "integrator", "rho_inf", "control", "arc_length",
-                  "stop_displacement", "process_time", "predictor", "linear", "stabilise"}))
+                  "stop_displacement", "process_time", "predictor", "linear", "stabilise", "branch_switch"}))
     return;
   bool arc = false;
   s.control_place = place_of(n["control"]);
@@ -601,6 +601,17 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
         if (const auto v = r.positive(st["warn_ratio"], "solver stabilise warn_ratio",
                                       "dissipated over strain energy, e.g. 0.05"))
           s.stabilise_warn_ratio = *v;
+    }
+  }
+  if (const YAML::Node bs = n["branch_switch"]; bs.IsDefined()) {
+    s.branch_switch_place = place_of(bs);
+    if (r.mapping(bs, "solver branch_switch", {"amplitude"})) {
+      if (!bs["amplitude"].IsDefined())
+        r.problem(ProblemKind::kMissing, bs,
+                  "solver branch_switch: give amplitude (mm, the largest nodal displacement of the imperfection "
+                  "along the critical mode, e.g. a tenth of a ply thickness)");
+      else if (const auto v = r.positive(bs["amplitude"], "solver branch_switch amplitude", "mm"))
+        s.branch_switch_amplitude = *v;
     }
   }
   if (n["line_search"].IsDefined())
@@ -769,6 +780,8 @@ void flatten(const YAML::Node& node, const std::string& path, std::vector<std::p
     for (auto it = node.begin(); it != node.end(); ++it) {
       const std::string key = case_yaml::is_scalar(it->first) ? it->first.Scalar() : "?";
       if (path.empty() && key == "output") continue;  // output settings may change for a restart
+      // and so may branch switching (switched on from the restart's step onwards)
+      if (path == "solver" && key == "branch_switch") continue;
       flatten(it->second, path.empty() ? key : path + "." + key, out);
     }
   } else if (case_yaml::is_sequence(node)) {

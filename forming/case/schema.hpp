@@ -180,6 +180,11 @@ struct CaseSolver {
   double stabilise_damping = 0.0;    // N s/mm^4
   double stabilise_warn_ratio = 0.05;
   SourcePlace stabilise_place;  // of the "stabilise" key's value; 0: not given
+  // branch_switch (load control): {amplitude: A} moves an unstable converged state (and a
+  // failed step's last converged sub-step) by A mm along its tangent's nearest-zero mode
+  // (forming/solve/branch_switch.hpp). 0: off (the default). May change for a restart.
+  double branch_switch_amplitude = 0.0;  // mm
+  SourcePlace branch_switch_place;       // of the "branch_switch" key's value; 0: not given
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given
 };

@@ -99,6 +99,8 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
     j["solver"]["stabilise"] = {{"fraction", spec.solver.stabilise_fraction},
                                 {"damping", spec.solver.stabilise_damping},
                                 {"warn_ratio", spec.solver.stabilise_warn_ratio}};
+  if (spec.solver.branch_switch_amplitude > 0.0)
+    j["solver"]["branch_switch"] = {{"amplitude", spec.solver.branch_switch_amplitude}};
   j["output"] = {{"every", spec.output.every},
                  {"samples", {spec.output.samples_inplane, spec.output.samples_thickness}}};
   j["model"] = {{"dofs", model.n_dofs()},
@@ -148,6 +150,7 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
                           {"max_ratio", run.stabilisation_max_ratio},
                           {"warn_ratio", spec.solver.stabilise_warn_ratio},
                           {"quasi_static", run.stabilisation_max_ratio <= spec.solver.stabilise_warn_ratio}};
+  if (spec.solver.branch_switch_amplitude > 0.0) j["branch_switches"] = run.branch_switches;
   j["units"] = {{"length", "mm"}, {"force", "N"}, {"stress", "MPa"}, {"energy", "N mm"}, {"note", spec.units}};
   return j;
 }

@@ -54,6 +54,8 @@ struct RunSummary {
   bool stabilised = false;
   double stabilisation_energy = 0.0, stabilisation_damping = 0.0;
   double stabilisation_ratio = 0.0, stabilisation_max_ratio = 0.0;
+  // Branch switches (solver branch_switch) of this run, one object each (recorder.cpp).
+  nlohmann::json branch_switches = nlohmann::json::array();
 };
 
 // The "parameters" block.

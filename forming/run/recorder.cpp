@@ -1,6 +1,7 @@
 #include "forming/run/recorder.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -148,6 +149,27 @@ StepAction RunRecorder::on_step(const StepInfo& step, const SteppingState& state
                                       "): the results are not quasi-static; give a smaller fraction or damping");
     }
   }
+  for (const BranchSwitch& b : step.branch_switches) {
+    nlohmann::json shares = nlohmann::json::array();
+    for (const double sh : b.place.shares) shares.push_back(std::round(10.0 * sh) / 10.0);
+    branch_switches_.push_back({{"step", b.step},
+                                {"load_factor", b.load_factor},
+                                {"time", b.load_factor * spec_.solver.process_time},
+                                {"after_failure", b.after_failure},
+                                {"determinant_sign", b.determinant_sign},
+                                {"eigenvalue", b.eigenvalue},
+                                {"spread", b.spread},
+                                {"amplitude", b.amplitude},
+                                {"ply", b.place.ply},
+                                {"x", b.place.x},
+                                {"z", b.place.z},
+                                {"ply_shares_percent", shares}});
+    cli::status(options_.quiet, "simform: branch switch " + std::string(b.after_failure ? "in" : "after") +
+                                    " step " + std::to_string(b.step) + " at load factor " + sci(b.load_factor) +
+                                    ": det sign " + std::to_string(b.determinant_sign) + ", eigenvalue " +
+                                    sci(b.eigenvalue) + " max|K_ii|, moved " + sci(b.amplitude) + " mm along the mode " +
+                                    describe(b.place));
+  }
   report_.max_displacement = largest_displacement(problem_.model, state.x, X_);
   report_.steps_converged = step.index;
   report_.load_factor = step.load_factor;
@@ -269,6 +291,7 @@ RunReport RunRecorder::finish(const SteppingReport& stepping, double seconds_bui
   s.stabilisation_damping = damping_;
   s.stabilisation_ratio = ratio_;
   s.stabilisation_max_ratio = max_ratio_;
+  s.branch_switches = branch_switches_;
   nlohmann::json summary = summary_json(spec_, problem_.model, s);
   summary["forming"] = forming_summary(spec_, problem_.model, last_.x, spec_.output.samples_inplane);
   io::write_json(out_.path("summary.json"), summary);

@@ -18,6 +18,7 @@
 // contact parts too); a `--restart` after a clean stop links the committed OUT into it.
 // Committing replaces OUT whole (the outputs of an older run never stay beside these).
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "common/core/types.hpp"
@@ -79,6 +80,7 @@ class RunRecorder final : public StepObserver {
   // (N s/mm^4), ratio to the strain energy, the largest ratio and whether the run warned.
   bool stabilised_ = false;
   double stabilisation_energy_ = 0.0, damping_ = 0.0, ratio_ = 0.0, max_ratio_ = 0.0;
+  nlohmann::json branch_switches_ = nlohmann::json::array();  // summary.json "branch_switches"
   bool warned_ = false;
 };
 

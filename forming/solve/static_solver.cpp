@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "common/core/error.hpp"
+#include "forming/solve/branch_switch.hpp"
 #include "forming/solve/line_search.hpp"
 #include "forming/solve/messages.hpp"
 #include "forming/solve/tangent_solver.hpp"
@@ -32,61 +33,9 @@ constexpr std::size_t kStallWindow = 5;
 constexpr double kBounce = 100.0;
 constexpr int kWatch = 3;
 
-// SF_NEWTON_TRACE: the eigenvalue of K_ff nearest zero, by inverse iteration with the
-// factorisation just made (kInverseSteps solves, x <- K^-1 x / |K^-1 x|; the Rayleigh
-// quotient of K^-1 gives 1 / lambda), as a fraction of max |K_ii|. `spread`: the
-// eigen-residual |K^-1 x - x / lambda| / |K^-1 x| of the last step (small: converged to
-// a real eigenvalue; near 1: a complex pair or close eigenvalues, the estimate is rough).
-// K is unsymmetric in the forming cases (viscous slip), so the estimate is of K itself,
-// not of its symmetric part.
-constexpr int kInverseSteps = 8;
-double nearest_eigenvalue(TangentSolver& solver, const linalg::SparseMatrix& k, double& spread, VecX& mode) {
-  const Index n = k.rows();
-  spread = 1.0;
-  if (n == 0) return 0.0;
-  VecX x(n);
-  for (Index i = 0; i < n; ++i) x(i) = 1.0 + 0.5 * std::sin(0.7 * double(i) + 0.3);  // fixed start, not an eigenvector
-  x.normalize();
-  double mu = 0.0;  // 1 / lambda
-  for (int it = 0; it < kInverseSteps; ++it) {
-    const VecX w = solver.solve(x);
-    if (!w.allFinite() || w.norm() == 0.0) return std::numeric_limits<double>::quiet_NaN();
-    mu = x.dot(w);
-    spread = (w - mu * x).norm() / w.norm();
-    x = w.normalized();
-  }
-  mode = x;
-  const double diag = k.diagonal().cwiseAbs().maxCoeff();
-  return (mu == 0.0 ? std::numeric_limits<double>::infinity() : 1.0 / mu) / std::max(diag, 1e-300);
-}
-
-// Where the mode v (all dofs) is largest: the ply (body), the node's position (x, z) and
-// the coordinate of its largest entry, and each ply's share of |v|^2 (in %).
-std::string locate_mode(const Model& model, const VecX& v, const VecX& x) {
-  Index at = 0;
-  v.cwiseAbs().maxCoeff(&at);
-  std::ostringstream os;
-  os.precision(3);
-  for (int b = 0; b < model.n_bodies(); ++b) {
-    const Index end = b + 1 < model.n_bodies() ? model.offset(b + 1) : model.n_dofs();
-    if (at >= model.offset(b) && at < end) {
-      const Index local = at - model.offset(b), node = local / 12;
-      const Index p = model.dof(b, node, 0, 0);
-      os << "largest at ply " << b + 1 << " node " << node << " (x " << x(p) << ", z " << x(p + 2) << ") "
-         << "xyz"[local % 3] << (local % 12 >= 3 ? " (a derivative)" : "") << "; ply shares %";
-    }
-  }
-  const double total = std::max(v.squaredNorm(), 1e-300);
-  for (int b = 0; b < model.n_bodies(); ++b) {
-    const Index end = b + 1 < model.n_bodies() ? model.offset(b + 1) : model.n_dofs();
-    os << " " << std::lround(100.0 * v.segment(model.offset(b), end - model.offset(b)).squaredNorm() / total);
-  }
-  return os.str();
-}
-
 // The trace line of a tangent: its factorisation, negative pivots (symmetric LDL^T), the
-// sign of its determinant (MUMPS) and the nearest eigenvalue (above) with where its mode
-// is largest.
+// sign of its determinant (MUMPS) and the nearest eigenvalue (forming/solve/branch_switch.hpp)
+// with where its mode is largest.
 void trace_tangent(const char* what, TangentSolver& solver, const linalg::SparseMatrix& k,
                    const linalg::SolveReport& sr, const Model& model, const FreeDofs& free, const VecX& x) {
   double spread = 1.0;
@@ -95,7 +44,7 @@ void trace_tangent(const char* what, TangentSolver& solver, const linalg::Sparse
   std::fprintf(stderr, "newton:   %s: %s, negative pivots %d, det sign %+d, nearest eigenvalue %.3e max|K_ii| "
                "(spread %.1e)\n", what, sr.brief().c_str(), sr.negative_pivots, sr.determinant_sign, lambda, spread);
   if (mode.size() == free.size() && mode.size() > 0)
-    std::fprintf(stderr, "newton:     its mode: %s\n", locate_mode(model, free.expand(mode), x).c_str());
+    std::fprintf(stderr, "newton:     its mode: %s\n", describe(mode_place(model, free.expand(mode), x)).c_str());
 }
 
 }  // namespace

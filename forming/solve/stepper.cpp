@@ -79,18 +79,29 @@ class LoadStepper final : public Stepper {
     const int first = first_step_after(state.load_factor, n);
     out.nothing_left = first > n;
     const double lambda_start = state.load_factor;
+    const double T = settings_.process_time;
+    // Branch switching: a restart's start state is checked as a step's end is (its rates
+    // at rest over one step's time).
+    std::vector<BranchSwitch> pending;
+    if (settings_.branch_switch.active() && first > 1 && first <= n) {
+      const double t0 = state.load_factor * T;
+      switch_branch(state.x, state.load_factor, first - 1, false,
+                    InteractionContext{t0, nullptr, &state.x, t0 - T / n}, pending);
+    }
     for (int k = first; k <= n; ++k) {
       const double lambda = double(k) / n;
       // Within the step the solver's factor s in [0, 1] runs from the previous load
-      // factor to this one.
+      // factor to this one (from_lambda: where a retry after a branch switch starts).
       const double lambda_prev = k == first ? lambda_start : double(k - 1) / n;
+      double from_lambda = lambda_prev;
       const LoadFunction step_load = [&](double s, const VecX& xs, bool want_tangent) {
-        return problem_.loads.at(problem_.model, lambda_prev + s * (lambda - lambda_prev), xs, want_tangent);
+        return problem_.loads.at(problem_.model, from_lambda + s * (lambda - from_lambda), xs, want_tangent);
       };
       // Process time over the step: tools move with it, rates are taken over it.
-      const double T = settings_.process_time;
       StaticOptions statics = settings_.statics;
       statics.clock = {lambda_prev * T, lambda * T, nullptr, 0.0};
+      std::vector<BranchSwitch> switches = std::move(pending);
+      pending.clear();
       const std::vector<PrescribedDof> targets = problem_.prescriptions.at(lambda);
       // Stabilised: the converged sub-steps, for the energy they dissipate.
       std::vector<SubStep> substeps;
@@ -115,6 +126,36 @@ class LoadStepper final : public Stepper {
           out.multiplier_updates += uzawa.updates;
           out.total_iterations += r.report.total_iterations;
         }
+      }
+      // Branch switching: the failed step once more from its last converged sub-step,
+      // moved along that state's nearest-zero mode.
+      for (int retry = 0; !r.report.ok() && settings_.branch_switch.active() && !needs_calibration() &&
+                          retry < settings_.branch_switch_retries;
+           ++retry) {
+        const double reached = from_lambda + r.report.load_factor * (lambda - from_lambda);
+        const double t_reached = reached * T;
+        const InteractionContext at_reached =
+            t_reached > lambda_prev * T ? InteractionContext{t_reached, nullptr, &state.x, lambda_prev * T}
+                                        : InteractionContext{t_reached, nullptr, &r.positions, t_reached - T / n};
+        const VecX x_reached = r.positions;
+        VecX moved = switch_branch(x_reached, reached, k, true, at_reached, switches);
+        if (moved.size() == 0) break;
+        from_lambda = reached;
+        StaticOptions again = statics;
+        again.clock = {reached * T, lambda * T, nullptr, 0.0};
+        again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
+        const std::string before = r.report.message;
+        const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
+        r = solve_static_constrained(problem_.model, moved, targets, step_load, problem_.loads.follower, again,
+                                     settings_.uzawa, &uzawa);
+        out.multiplier_updates += uzawa.updates;
+        out.total_iterations += r.report.total_iterations;
+        // The step's counts: its failed attempts' too.
+        r.report.total_iterations += spent;
+        r.report.n_cutbacks += cut;
+        if (!r.report.ok())
+          r.report.message = before + "; after a branch switch at load factor " + std::to_string(reached) + ": " +
+                             r.report.message;
       }
       if (!r.report.ok()) {
         if (needs_calibration() && r.report.load_factor <= 0.0)
@@ -155,6 +196,7 @@ class LoadStepper final : public Stepper {
         if (needs_calibration()) calibrate(state.x, r.positions, (lambda - lambda_prev) * T);
       }
       commit_interactions(problem_.model, r.positions, at_end);
+      const VecX step_start = state.x;
       state.x = r.positions;
       state.load_factor = lambda;
       StepInfo info{
@@ -165,15 +207,60 @@ class LoadStepper final : public Stepper {
         info.stabilisation_energy = dissipated_;
         info.damping = stabilisation_->damping();
       }
+      // Branch switching after the step: its tangent over the step's rates (as Newton's
+      // last one); the observer sees the converged state, the next step starts moved.
+      VecX moved;
+      if (settings_.branch_switch.active() && k < n)
+        moved = switch_branch(state.x, lambda, k, false, InteractionContext{lambda * T, nullptr, &step_start, lambda_prev * T},
+                              switches);
+      info.branch_switches = switches;
       if (observer.on_step(info, state, r.reactions) == StepAction::kStop) {
         out.status = SteppingReport::Status::kStopped;
         return out;
       }
+      if (moved.size() == state.x.size()) state.x = moved;
     }
     return out;
   }
 
  private:
+  // Branch switching (forming/solve/branch_switch.hpp) at the converged state x (load
+  // factor lambda) of step k: when its tangent under `context` is unstable (det K < 0 or
+  // negative pivots), or always after a failure, x moved along the nearest-zero mode,
+  // recorded in `log`; empty when x stays.
+  VecX switch_branch(const VecX& x, double lambda, int k, bool after_failure, const InteractionContext& context,
+                     std::vector<BranchSwitch>& log) {
+    const std::vector<PrescribedDof> fixed = problem_.prescriptions.at(lambda);
+    const ExternalLoad load = problem_.loads.at(problem_.model, lambda, x, problem_.loads.follower);
+    const TangentMode tm = tangent_mode(problem_.model, x, fixed, context, &load.tangent, mode_workspace_,
+                                        settings_.branch_switch.inverse_steps);
+    if (!tm.ok) return VecX();
+    const bool unstable = tm.determinant_sign < 0 || tm.negative_pivots > 0;
+    if (!after_failure) {
+      // A step's end still unstable right after a switch: Newton went back to the
+      // unstable path (the imperfection was inside its basin), so the next switch is
+      // twice as large, up to kMaxEscalation times the amplitude.
+      escalation_ = unstable && switched_last_ ? std::min(2.0 * escalation_, kMaxEscalation) : 1.0;
+      switched_last_ = unstable;
+    }
+    if (!(unstable || after_failure)) return VecX();
+    const double amplitude = escalation_ * settings_.branch_switch.amplitude;
+    int sign = 0;
+    VecX moved = perturbed(problem_.model, x, tm.mode, amplitude, context, sign);
+    if (moved.size() == 0) return moved;
+    BranchSwitch b;
+    b.step = k;
+    b.load_factor = lambda;
+    b.after_failure = after_failure;
+    b.determinant_sign = tm.determinant_sign;
+    b.eigenvalue = tm.eigenvalue;
+    b.spread = tm.spread;
+    b.place = tm.place;
+    b.amplitude = sign * amplitude;
+    log.push_back(std::move(b));
+    return moved;
+  }
+
   struct SubStep {
     VecX from, to;
     double dt = 0.0;  // s
@@ -195,6 +282,10 @@ class LoadStepper final : public Stepper {
   StepperSettings settings_;
   ViscousStabilisation* stabilisation_ = nullptr;  // owned by the model; null: not stabilised
   double dissipated_ = 0.0;                        // N mm, from the run's start
+  TangentWorkspace mode_workspace_;                // branch switching's tangents (apart from Newton's)
+  static constexpr double kMaxEscalation = 8.0;
+  double escalation_ = 1.0;     // the next switch's amplitude / the given one
+  bool switched_last_ = false;  // the last step's end was switched
 };
 
 class DynamicStepper final : public Stepper {

@@ -12,6 +12,11 @@
 //                     (ProcessClock); interactions with multipliers (augmented-Lagrangian
 //                     contact) are updated and the step solved again until each reports
 //                     its constraint met (at most max_multiplier_updates times);
+//                     with branch switching (forming/solve/branch_switch.hpp) a step
+//                     whose converged tangent is unstable hands the next step its state
+//                     moved along the nearest-zero mode, and a failed step is tried again
+//                     from its last converged sub-step so moved (at most
+//                     branch_switch_retries times);
 //   DynamicStepper    implicit dynamics: step k integrates the output interval
 //                     [(k - 1) T / n, k T / n] with solve_dynamic (time steps cut back
 //                     and regrown inside); load factor t / T, starting at rest;
@@ -30,10 +35,12 @@
 // the step's start state as `previous`), before the observer sees the step.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/core/types.hpp"
 #include "forming/model/problem.hpp"
 #include "forming/solve/arc_length.hpp"
+#include "forming/solve/branch_switch.hpp"
 #include "forming/solve/dynamic_solver.hpp"
 #include "forming/solve/static_solver.hpp"
 #include "forming/solve/stabilisation.hpp"
@@ -54,6 +61,11 @@ struct StepperSettings {
   // load stepper uses the model's ViscousStabilisation interaction, adding one when the
   // model has none; with `fraction` it calibrates c from the first step.
   StabiliseOptions stabilise;
+  // kLoad: branch switching at a bifurcation (forming/solve/branch_switch.hpp): after a
+  // converged step whose tangent is unstable, and once more for a failed step (at most
+  // `retries` times a step), the state moves along the nearest-zero eigenmode.
+  BranchSwitchOptions branch_switch;
+  int branch_switch_retries = 2;
   DynamicOptions dynamics;          // kDynamic: per output interval (its times are set per step)
   double end_time = 1.0;            // kDynamic, s
   ArcLengthOptions arc;             // kArcLength
@@ -65,6 +77,18 @@ struct SteppingState {
   VecX x;                    // positions (n_dofs, mm)
   VecX v;                    // velocities (n_dofs, mm/s); used by dynamic runs
   double load_factor = 0.0;  // of x
+};
+
+// A branch switch (forming/solve/branch_switch.hpp): where, and along which mode.
+struct BranchSwitch {
+  int step = 0;              // the step it belongs to
+  double load_factor = 0.0;  // of the state moved
+  bool after_failure = false;  // a failed step's last converged sub-step (else: the step's end)
+  int determinant_sign = 0;    // of that state's tangent
+  double eigenvalue = 0.0;     // nearest zero, / max |K_ii|
+  double spread = 1.0;         // its eigen-residual (small: a real eigenvalue)
+  ModePlace place;             // where the mode is largest, each ply's share
+  double amplitude = 0.0;      // mm, signed (the side of lower stored energy)
 };
 
 // A converged step as the observer sees it.
@@ -82,6 +106,10 @@ struct StepInfo {
   bool stabilised = false;
   double stabilisation_energy = 0.0;
   double damping = 0.0;
+  // Branch switches of this step: after a failed attempt (the step then converged) and
+  // after its end (the next step starts from the moved state; the step's own results are
+  // the unmoved converged state's).
+  std::vector<BranchSwitch> branch_switches{};
 };
 
 enum class StepAction { kContinue, kStop };

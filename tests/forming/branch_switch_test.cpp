@@ -1,0 +1,135 @@
+// Branch switching at a bifurcation (forming/solve/branch_switch.hpp, the case key
+// solver: {branch_switch: {amplitude: A}}): a straight plane-strain strip, clamped at
+// one end and pushed axially at the other past its buckling load. Load control on the
+// perfect strip stays on the straight (symmetric) path, which is an equilibrium but an
+// unstable one past the critical shortening (a negative eigenvalue of the tangent). With
+// branch switching the run moves onto the buckled branch: the strip deflects, its end
+// state is stable (no negative pivot) and stores less energy than the straight one at the
+// same end shortening.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "forming/case/build.hpp"
+#include "forming/case/reader.hpp"
+#include "forming/solve/branch_switch.hpp"
+#include "forming/solve/stepper.hpp"
+#include "forming/solve/tangent_solver.hpp"
+
+namespace sf::forming {
+namespace {
+
+// L = 20 mm, h = 1 mm, neo-Hookean E 1000 MPa, both ends clamped: Euler shortening
+// 4 pi^2 h^2 / (12 L) = 0.16 mm; pushed 0.6 mm in 4 steps (0.15 mm at step 1: stable,
+// 0.3 mm at step 2: past it). Buckled: w = A (1 - cos 2 pi x / L) / 2 with the excess
+// shortening pi^2 A^2 / (4 L), A about 1.9 mm at the end.
+std::string strip_case(double amplitude) {
+  std::string text = R"(units: "mm, N, MPa"
+materials:
+  rubber: {neo_hookean: {E: 1000, nu: 0.3}}
+plies:
+  - {name: strip, size: [20, 1], thickness: 1, elements: [10, 1], angle: 0, material: rubber, plane_strain: true}
+boundary_conditions:
+  - clamp: {ply: strip, edge: x0}
+  - displacement: {ply: strip, edge: x1, value: [-0.6, ~, 0], ramp: linear}
+solver: {steps: 4, max_iterations: 30, tolerance: 1.0e-9)";
+  if (amplitude > 0.0) text += ", branch_switch: {amplitude: " + std::to_string(amplitude) + "}";
+  return text + "}\n";
+}
+
+struct Collected final : public StepObserver {
+  StepAction on_step(const StepInfo& step, const SteppingState&, const VecX&) override {
+    for (const BranchSwitch& b : step.branch_switches) switches.push_back(b);
+    return StepAction::kContinue;
+  }
+  std::vector<BranchSwitch> switches;
+};
+
+struct Outcome {
+  SteppingReport report;
+  VecX x;
+  double deflection = 0.0;  // max |u_z|, mm
+  double energy = 0.0;      // stored, N mm
+  TangentMode tangent;      // at the end
+  std::vector<BranchSwitch> switches;
+};
+
+Outcome run(double amplitude) {
+  const CaseCheck check = check_case_text(strip_case(amplitude), "strip.yaml");
+  EXPECT_TRUE(check.ok()) << (check.ok() ? "" : check.located(0));
+  Outcome out;
+  if (!check.ok()) return out;
+  Problem problem = build_problem(check.spec);
+  const StepperSettings settings = stepper_settings(check.spec);
+  const VecX X = problem.model.reference_positions();
+  SteppingState state{X, VecX::Zero(X.size()), 0.0};
+  Collected observer;
+  out.report = make_stepper(problem, settings)->run(state, observer);
+  out.x = state.x;
+  for (int b = 0; b < problem.model.n_bodies(); ++b)
+    for (Index node = 0; node < problem.model.ply(b).n_nodes(); ++node) {
+      const Index d = problem.model.dof(b, node, 0, 2);
+      out.deflection = std::max(out.deflection, std::abs(state.x(d) - X(d)));
+    }
+  out.energy = problem.model.assemble(state.x, false).energy;
+  TangentWorkspace workspace;
+  out.tangent = tangent_mode(problem.model, state.x, problem.prescriptions.at(1.0), InteractionContext{}, nullptr,
+                             workspace, 30);
+  out.switches = observer.switches;
+  return out;
+}
+
+TEST(BranchSwitch, StraightStripPastBucklingLoadFindsTheBuckledBranch) {
+  const Outcome straight = run(0.0);
+  // A fifth of the thickness: 0.05 and 0.1 mm lie inside the straight path's basin (the
+  // next step's Newton goes back to it; the escalation's second switch then follows the
+  // nearest-zero mode of two below zero, the antisymmetric one).
+  const Outcome buckled = run(0.2);
+  ASSERT_EQ(straight.report.status, SteppingReport::Status::kFinished) << straight.report.message;
+  ASSERT_EQ(buckled.report.status, SteppingReport::Status::kFinished) << buckled.report.message;
+  ASSERT_TRUE(straight.tangent.ok) << straight.tangent.message;
+  ASSERT_TRUE(buckled.tangent.ok) << buckled.tangent.message;
+  std::printf("[ measured ] straight path: max |u_z| %.3e mm, energy %.6f N mm, negative pivots %d, det sign %+d, "
+              "nearest eigenvalue %.3e\n",
+              straight.deflection, straight.energy, straight.tangent.negative_pivots,
+              straight.tangent.determinant_sign, straight.tangent.eigenvalue);
+  std::printf("[ measured ] with branch switching: max |u_z| %.3e mm, energy %.6f N mm, negative pivots %d, "
+              "det sign %+d, nearest eigenvalue %.3e; %zu switches\n",
+              buckled.deflection, buckled.energy, buckled.tangent.negative_pivots, buckled.tangent.determinant_sign,
+              buckled.tangent.eigenvalue, buckled.switches.size());
+  for (const BranchSwitch& b : buckled.switches)
+    std::printf("  switch after step %d (load factor %.3g): eigenvalue %.3e, %s\n", b.step, b.load_factor,
+                b.eigenvalue, describe(b.place).c_str());
+  // The perfect strip stays straight and unstable: one eigenvalue below zero.
+  EXPECT_LT(straight.deflection, 0.02);
+  EXPECT_TRUE(straight.tangent.negative_pivots > 0 || straight.tangent.determinant_sign < 0);
+  EXPECT_LT(straight.tangent.eigenvalue, 0.0);
+  // With branch switching: buckled, stable, lower energy; the switch was made where the
+  // straight path first became unstable and along a transverse mode.
+  ASSERT_FALSE(buckled.switches.empty());
+  EXPECT_EQ(buckled.switches.front().step, 2);
+  EXPECT_EQ(buckled.switches.front().place.coordinate, 'z');
+  EXPECT_GT(buckled.deflection, 1.5);
+  EXPECT_FALSE(buckled.tangent.negative_pivots > 0 || buckled.tangent.determinant_sign < 0);
+  EXPECT_GT(buckled.tangent.eigenvalue, 0.0);
+  EXPECT_LT(buckled.energy, 0.9 * straight.energy);
+}
+
+TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
+  std::string text = strip_case(0.05);
+  text.replace(text.find("amplitude: 0.05"), 19, "amplitude: -1");
+  const CaseCheck bad = check_case_text(text, "bad.yaml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.located(0).find("branch_switch amplitude"), std::string::npos) << bad.located(0);
+  EXPECT_NE(bad.located(0).find("bad.yaml:9:"), std::string::npos) << bad.located(0);
+  const CaseCheck off = check_case_text(strip_case(0.0), "a.yaml"), on = check_case_text(strip_case(0.05), "a.yaml");
+  ASSERT_TRUE(off.ok() && on.ok());
+  EXPECT_EQ(off.spec.fingerprint, on.spec.fingerprint);
+  EXPECT_DOUBLE_EQ(on.spec.solver.branch_switch_amplitude, 0.05);
+}
+
+}  // namespace
+}  // namespace sf::forming

@@ -32,6 +32,7 @@ struct DeformedStages {
   DeformedFit fit;
   SmoothingChoice choice;
   NoiseEstimate noise;   // of the deformed data (noise-model rule)
+  NoiseEstimate noise_displacement;  // exact blank: from the displacement (noise-model rule)
   LocalSmoothing local;  // element multipliers (noise-model rule with local smoothing)
 };
 DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const FitMarks& marks,
@@ -64,7 +65,18 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       out.choice = choose_smoothing_gcv(problem, so, d);
     } else {
       const auto tn = Clock::now();
-      out.noise = deformed_noise(problem, marks, setup, undeformed_noise);
+      // Reference positions without noise (nominal subset centres of a 2-D DIC export, a
+      // grid placed by --pitch): the blank gives no correlation length; the displacement's
+      // own estimate does where its quadratic and quartic local fits agree
+      // (gsa/noise_model.hpp, displacement_noise), and the deformed pilots then fit the
+      // amplitudes with that length, its correlated amplitude as the floor.
+      const bool exact_blank = !(undeformed_noise.sigma_total() > 0.0);
+      NoiseEstimate& from_displacement = out.noise_displacement;
+      if (exact_blank)
+        from_displacement = displacement_noise(marks.undeformed, problem.position(), problem.weight(), d);
+      const bool exact_correlated = exact_blank && from_displacement.correlated_over(d);
+      out.noise = exact_correlated ? deformed_noise(problem, marks, setup, undeformed_noise, &from_displacement)
+                                   : deformed_noise(problem, marks, setup, undeformed_noise);
       // Reported only (summary.json): the relaxation test with each component in its own
       // level did not see the ARAMIS crack band either (docs/usage.md, "Real exports").
       estimate_two_levels(out.noise, setup, und, out.fit.fit.parameters, MatX(problem.data()) - out.fit.fit.fitted,
@@ -76,7 +88,7 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       // over a spacing or more, or neighbouring marks correlated by 0.3 or more (a length
       // estimated just under the spacing: GCV there chose a gauge of 0.6 spacings and
       // 3.3 x the 24-neighbour fit's error on the rubber strip, gsa_realdata_bench).
-      const bool correlated = undeformed_noise.correlated_over(d);
+      const bool correlated = exact_blank ? exact_correlated : undeformed_noise.correlated_over(d);
       const MatX probes = correlated ? noise_probes(out.noise, marks.undeformed, kCpNoiseProbes) : MatX();
       const double noise_s = seconds_since(tn);
       times.noise += noise_s;
@@ -396,6 +408,7 @@ AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid,
   res.times.strain = seconds_since(ts);
   res.noise_undeformed = u.noise;
   res.noise = def.noise;
+  res.noise_displacement = def.noise_displacement;
   res.element_multiplier = def.local.multiplier;
   res.relaxed_elements = def.local.relaxed();
   if (res.relaxed_elements > 0) {

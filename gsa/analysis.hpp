@@ -130,6 +130,10 @@ struct AnalysisResult {
   // Noise-model smoothing (gsa/noise_estimate.hpp): the undeformed estimate (correlation
   // length) and the deformed data's; all zero with another rule.
   NoiseEstimate noise_undeformed, noise;
+  // Exact blank (the undeformed estimate zero: nominal positions): the estimate from the
+  // displacement's local fits (displacement_noise, gsa/noise_model.hpp); its length is the
+  // deformed estimate's where it is confirmed (correlation_length > 0). Zero otherwise.
+  NoiseEstimate noise_displacement;
   std::vector<double> element_multiplier;  // local smoothing: penalty multiplier per element (1: global weight)
   Index relaxed_elements = 0;              // elements with a multiplier below 1
   double local_gauge_length = 0.0;         // gauge length in the relaxed elements (units; 0: none)

@@ -277,7 +277,17 @@ NoiseEstimate deformed_ladder(DeformedProblem& problem, const FitMarks& marks, c
 }  // namespace
 
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
-                             const NoiseEstimate& undeformed) {
+                             const NoiseEstimate& undeformed, const NoiseEstimate* displacement) {
+  if (displacement) {
+    // An exact blank: the displacement's length, and its correlated amplitude (of the
+    // deformed noise alone) as the floor. Light pilots take up noise correlated over a
+    // few spacings themselves (below); measured: rubber strip, noise over one spacing,
+    // the displacement's model alone 1.34 x the best fixed smoothing's error, with the
+    // pilots' amplitudes 1.00 x (docs/theory/strain.md, "A blank without noise").
+    NoiseEstimate e = deformed_ladder(problem, marks, setup, *displacement);
+    if (e.correlation_length > 0) e.sigma_correlated = std::max(e.sigma_correlated, displacement->sigma_correlated);
+    return e;
+  }
   NoiseEstimate e = deformed_ladder(problem, marks, setup, undeformed);
   // The blank's correlated amplitude as a floor: the deformed data hold both states'
   // noise, and the blank's heavy pilots see noise correlated over several spacings, where

@@ -31,8 +31,11 @@ class DeformedProblem;
 
 NoiseEstimate undeformed_noise(const FrameAndMesh& setup, const FitMarks& marks, const UndeformedFit& undeformed);
 
+// `displacement`: the estimate from the displacement where the blank is exact
+// (displacement_noise, gsa/noise_model.hpp): its length is used instead of the blank's
+// and its correlated amplitude is the floor.
 NoiseEstimate deformed_noise(DeformedProblem& problem, const FitMarks& marks, const FrameAndMesh& setup,
-                             const NoiseEstimate& undeformed);
+                             const NoiseEstimate& undeformed, const NoiseEstimate* displacement = nullptr);
 
 // The two levels of the deformed data's noise (NoiseEstimate::sigma_tangent, sigma_normal):
 // the residuals of the deformed fit `parameters` (data - fitted, m x 3) at the marks with

@@ -1,7 +1,9 @@
 #include "gsa/noise_model.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -420,6 +422,192 @@ MatX noise_probes(const NoiseEstimate& noise, const Points3& positions, int coun
       for (int c = 0; c < 3 && 3 * f + c < count; ++c) P(k, 3 * f + c) += noise.sigma_white * normal(rng);
   }
   return P;
+}
+
+}  // namespace sf::gsa
+
+namespace sf::gsa {
+
+namespace {
+// Radii of the local quadratic fits (spacings) of displacement_noise, and the fewest
+// points a fit needs (6 parameters, kept well determined).
+constexpr double kLocalRadii[] = {1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0};
+// The longest correlation length tried (spacings): a local quadratic sees noise level off
+// only at radii a few times its length.
+constexpr double kLocalLongest = 3.2;
+// The local fits: quadratic (6 terms) and quartic (15), each with at least 2 points a term.
+constexpr int kLocalDegree[2] = {2, 4};
+constexpr int kLocalTerms[2] = {6, 15};
+constexpr int kLocalFewest[2] = {12, 30};
+// The quartic fits' correlated amplitude and length agree with the quadratic ones' within
+// this fraction (the length plus half a spacing).
+constexpr double kLocalAgreement = 0.35;
+constexpr int kLocalQueries = 3000;
+}  // namespace
+
+NoiseEstimate displacement_noise(const Points3& undeformed, const Points3& deformed, const VecX& weight,
+                                 double spacing) {
+  NoiseEstimate out;
+  const Index m = undeformed.rows();
+  const double d = spacing;
+  const int nr = static_cast<int>(std::size(kLocalRadii));
+  const double max_radius = kLocalRadii[nr - 1] * d;
+  Points3 pts = undeformed;
+  std::vector<Index> query;
+  for (Index p = 0; p < m; ++p) {
+    if (!(weight[p] > 0) || !undeformed.row(p).allFinite() || !deformed.row(p).allFinite())
+      pts.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
+    else
+      query.push_back(p);
+  }
+  if (query.size() < 20) return out;
+  std::mt19937_64 rng(4243);
+  if (static_cast<int>(query.size()) > kLocalQueries) {
+    std::shuffle(query.begin(), query.end(), rng);
+    query.resize(static_cast<std::size_t>(kLocalQueries));
+  }
+  const std::vector<std::vector<Index>> nb = mesh::neighbours_within(pts, max_radius, query);
+  // The rows any fit uses: the probes are needed there only.
+  std::vector<int> slot(static_cast<std::size_t>(m), -1);
+  std::vector<Index> rows;
+  auto take = [&](Index p) {
+    if (slot[static_cast<std::size_t>(p)] < 0) {
+      slot[static_cast<std::size_t>(p)] = static_cast<int>(rows.size());
+      rows.push_back(p);
+    }
+  };
+  for (std::size_t i = 0; i < query.size(); ++i) {
+    take(query[i]);
+    for (Index q : nb[i]) take(q);
+  }
+  Points3 at(static_cast<Index>(rows.size()), 3);
+  MatX values(static_cast<Index>(rows.size()), 3);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    at.row(static_cast<Index>(i)) = undeformed.row(rows[i]);
+    values.row(static_cast<Index>(i)) = deformed.row(rows[i]) - undeformed.row(rows[i]);
+  }
+  ProbeBank bank = make_probe_bank(at, d);
+  const int white = 1 + static_cast<int>(bank.lengths.size());  // the white probes' column triple in `all`
+  int nl = static_cast<int>(bank.lengths.size());
+  while (nl > 1 && bank.lengths[static_cast<std::size_t>(nl - 1)] > kLocalLongest * d) --nl;
+  const Index cols = 3 + bank.probes.cols();
+  MatX all(values.rows(), cols);
+  all << values, bank.probes;
+  // Squared residual norms per degree, radius, column triple (data, probes), query point.
+  const int triples = static_cast<int>(cols / 3);
+  using Table = std::vector<std::vector<std::vector<double>>>;
+  std::array<Table, 2> sq;
+  for (Table& t : sq)
+    t.assign(static_cast<std::size_t>(nr), std::vector<std::vector<double>>(static_cast<std::size_t>(triples)));
+  for (std::size_t i = 0; i < query.size(); ++i) {
+    const Vec3 c = undeformed.row(query[i]).transpose();
+    const std::vector<Index>& around = nb[i];
+    if (static_cast<int>(around.size()) + 1 < kLocalFewest[0]) continue;
+    // Local tangent plane: the principal directions of the neighbourhood.
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (Index q : around) {
+      const Vec3 r = undeformed.row(q).transpose() - c;
+      cov += r * r.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
+    for (int k = 0; k < nr; ++k) {
+      const double rho = kLocalRadii[k] * d;
+      std::vector<Index> in{query[i]};
+      for (Index q : around)
+        if ((undeformed.row(q).transpose() - c).norm() <= rho * (1.0 + 1e-9)) in.push_back(q);
+      for (int g = 0; g < 2; ++g) {
+        const int np = kLocalTerms[g];
+        if (static_cast<int>(in.size()) < kLocalFewest[g]) continue;
+        MatX A(static_cast<Index>(in.size()), np);
+        for (std::size_t j = 0; j < in.size(); ++j) {
+          const Vec3 r = (undeformed.row(in[j]).transpose() - c) / rho;
+          const double u = r.dot(e1), v = r.dot(e2);
+          int col = 0;
+          for (int deg = 0; deg <= kLocalDegree[g]; ++deg)
+            for (int a = deg; a >= 0; --a) A(static_cast<Index>(j), col++) = std::pow(u, a) * std::pow(v, deg - a);
+        }
+        const Eigen::ColPivHouseholderQR<MatX> qr(A);
+        if (qr.rank() < np) continue;
+        // The fit's value at the point (u = v = 0) is h^T y, h = A (A^T A)^-1 e_1.
+        const MatX ata = A.transpose() * A;
+        const VecX h = A * ata.ldlt().solve(VecX::Unit(np, 0));
+        Eigen::RowVectorXd res = all.row(slot[static_cast<std::size_t>(query[i])]);
+        for (std::size_t j = 0; j < in.size(); ++j)
+          res -= h[static_cast<Index>(j)] * all.row(slot[static_cast<std::size_t>(in[j])]);
+        for (int tr = 0; tr < triples; ++tr)
+          sq[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)][static_cast<std::size_t>(tr)].push_back(
+              res.segment(3 * tr, 3).squaredNorm());
+      }
+    }
+  }
+  // The model fitted to one degree's statistics.
+  auto fit_degree = [&](int g) {
+    NoiseEstimate e;
+    const Table& t = sq[static_cast<std::size_t>(g)];
+    auto stat = [&](int k, int tr) {
+      std::vector<double> v = t[static_cast<std::size_t>(k)][static_cast<std::size_t>(tr)];
+      const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+      std::nth_element(v.begin(), mid, v.end());
+      return *mid / chi2_median(3);
+    };
+    std::vector<int> used;
+    for (int k = 0; k < nr; ++k)
+      if (t[static_cast<std::size_t>(k)][0].size() >= 20) used.push_back(k);
+    const Index nb_used = static_cast<Index>(used.size());
+    if (nb_used < 4) return e;
+    VecX y(nb_used), w(nb_used), trend(nb_used), vw(nb_used);
+    std::vector<VecX> vl(static_cast<std::size_t>(nl), VecX(nb_used));
+    for (Index b = 0; b < nb_used; ++b) {
+      const int k = used[static_cast<std::size_t>(b)];
+      y[b] = stat(k, 0);
+      w[b] = 1.0 / std::max(y[b] * y[b], 1e-300);
+      trend[b] = std::pow(kLocalRadii[k] / kLocalRadii[nr - 1], 2 * (kLocalDegree[g] + 2));
+      for (int l = 0; l < nl; ++l) vl[static_cast<std::size_t>(l)][b] = stat(k, 1 + l);
+      vw[b] = stat(k, white);
+      e.lag.push_back(kLocalRadii[k] * d);
+      e.gamma.push_back(y[b]);
+      e.count.push_back(static_cast<int>(t[static_cast<std::size_t>(k)][0].size()));
+    }
+    ModelFit best;
+    double best_L = 0.0;
+    for (int l = 0; l < nl; ++l) {
+      const int steps = l + 1 < nl ? 4 : 1;
+      for (int s = 0; s < steps; ++s) {
+        const double f = s / 4.0;
+        MatX A(nb_used, 3);
+        A.col(0) = vw;
+        A.col(1) = (1.0 - f) * vl[static_cast<std::size_t>(l)] + f * vl[static_cast<std::size_t>(std::min(l + 1, nl - 1))];
+        A.col(2) = trend;
+        const ModelFit fit = nonnegative_fit(A, y, w);
+        if (fit.sse < best.sse) {
+          best = fit;
+          const double la = bank.lengths[static_cast<std::size_t>(l)];
+          const double lb = bank.lengths[static_cast<std::size_t>(std::min(l + 1, nl - 1))];
+          best_L = la * std::pow(lb / la, f);
+        }
+      }
+    }
+    e.sigma_white = std::sqrt(best.c[0]);
+    e.sigma_correlated = std::sqrt(best.c[1]);
+    e.correlation_length = best.c[1] > 0 ? best_L : 0.0;
+    e.bias_slope = best.c[2] / std::pow(max_radius, 2 * (kLocalDegree[g] + 2));
+    return e;
+  };
+  out = fit_degree(0);
+  // Confirmed by the quartic fits: noise gives the same model whatever the fit (the probes
+  // correct for what each fit takes up), while the misfit of a smooth shape (a dome, a neck's
+  // flanks) shrinks by orders once the fit follows quartic terms.
+  const NoiseEstimate quartic = fit_degree(1);
+  const double sc = out.sigma_correlated, sq4 = quartic.sigma_correlated;
+  const double l2 = out.effective_length(), l4 = quartic.effective_length();
+  const bool confirmed = sc > 0 && sq4 > 0 && std::abs(sc - sq4) <= kLocalAgreement * std::max(sc, sq4) &&
+                         std::abs(l2 - l4) <= kLocalAgreement * std::max(l2, l4) + 0.5 * d;
+  if (!confirmed) {
+    out.sigma_white = out.sigma_total();
+    out.sigma_correlated = out.correlation_length = 0.0;
+  }
+  return out;
 }
 
 }  // namespace sf::gsa

@@ -138,6 +138,24 @@ ProbeBank make_probe_bank(const Points3& positions, double spacing, double fixed
 NoiseEstimate fit_noise_model(const VariogramPairs& pairs, const std::vector<double>& observed, const ProbeBank& bank,
                               const std::function<MatX(const MatX&, const std::vector<Index>&)>& smooth_residual);
 
+// Reference positions without noise (nominal: the subset centres of a 2-D DIC export, a
+// grid placed by --pitch) give the blank's estimate no correlation length, and the
+// deformed fit's pilots cannot tell correlated noise from the misfit of a smooth shape
+// (docs/theory/strain.md, "A blank without noise"). This estimate uses the displacement
+// u = deformed - undeformed at the points with weight > 0 instead: at up to 3000 of them
+// (fixed seed) the residual at the point of a local quadratic least-squares fit of u, in
+// the local tangent plane of the undeformed points within radius rho, for rho = 1.5 .. 7
+// spacings. A smooth displacement leaves a residual growing like rho^4 (the quadratic's
+// bias; squared rho^8), noise one that levels off at its variance once rho is well past
+// its correlation length. Per radius the median squared residual (chi-square scaled,
+// robust to a neck or an edge) is fitted as
+//   R(rho) = s_c V_L(rho) + s_w V_w(rho) + a rho^8,
+// V_L, V_w the same statistic of the bank's unit probes (correlated, length L; white), by
+// non-negative least squares, L the best of the bank's lengths. Returns the model per
+// coordinate (units of the points), bias_slope = a; lag/gamma = rho and R(rho).
+NoiseEstimate displacement_noise(const Points3& undeformed, const Points3& deformed, const VecX& weight,
+                                 double spacing);
+
 // Probes for a trace estimate tr(H Sigma): `count` columns, each a draw of the
 // noise at the points (n x count; three independent columns per random field,
 // 64 Fourier modes each: unbiased, E[w w^T] = Sigma), fixed seed.

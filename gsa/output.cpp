@@ -328,12 +328,16 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& r, const
       };
       params["noise_model"] = {{"undeformed", model(r.noise_undeformed)},
                                {"deformed", model(r.noise)},
+                               {"displacement", model(r.noise_displacement)},
                                {"meaning",
                                 "per coordinate; covariance sigma_correlated^2 exp(-r^2 / (2 L^2)) + "
                                 "sigma_white^2 [same point], L = correlation_length; deformed: of the "
                                 "displacement noise, both states together; sigma_tangent, sigma_normal: per "
                                 "tangential component and along the fitted surface's normal, from the deformed "
-                                "fit's residuals (0: not estimated)"}};
+                                "fit's residuals (0: not estimated); displacement: where the undeformed positions are exact "
+                                "(undeformed all 0), the estimate from local quadratic and quartic fits of the "
+                                "displacement, its correlation length used where both fits agree (else 0: "
+                                "independent noise)"}};
     }
     nlohmann::json flagged = nlohmann::json::array();
     for (std::size_t p = 0; p < r.points.size(); ++p) {

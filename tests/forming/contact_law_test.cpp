@@ -8,7 +8,7 @@
 //  * the energy is continuous across the band's ends too (a potential, so the Newton
 //    tangent of a frictionless tool contact is symmetric).
 // Why: the dome's Newton iterations were suspected to cycle through a jump of the law
-// at the band's ends (data/forming/processes/README.md); these pin the law's smoothness.
+// at the band's ends (data/forming/processes/notes/studies.md); these pin the law's smoothness.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -492,19 +492,7 @@ class CholmodPermutedBackend final : public Backend {
     if (direct_) return solve_b(b, x);
     Eigen::MatrixXd pb(n, b.cols());
     for (Eigen::Index i = 0; i < n; ++i) pb.row(inverse_[static_cast<std::size_t>(i)]) = b.row(i);
-    cholmod_dense bd{};
-    bd.nrow = static_cast<std::size_t>(n);
-    bd.ncol = static_cast<std::size_t>(b.cols());
-    bd.nzmax = bd.nrow * bd.ncol;
-    bd.d = bd.nrow;
-    bd.x = pb.data();
-    bd.xtype = CHOLMOD_REAL;
-    bd.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* xd = nullptr;
-    {
-      const BlasSection blas;
-      xd = cholmod_solve(CHOLMOD_A, factor_, &bd, &c_);
-    }
+    cholmod_dense* xd = solve_dense(pb.data(), n, b.cols());
     if (xd == nullptr) return false;
     const Eigen::Map<const Eigen::MatrixXd> px(static_cast<const double*>(xd->x), n, b.cols());
     x.resize(n, b.cols());
@@ -514,21 +502,24 @@ class CholmodPermutedBackend final : public Backend {
   }
 
  private:
-  // x = B^-1 b (kNatural, lower triangle given: B is A).
-  bool solve_b(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
+  // The factor's solve of the column-major rows x cols block at b (read only: cholmod_solve
+  // copies it); the caller frees the result. nullptr when CHOLMOD fails.
+  cholmod_dense* solve_dense(const double* b, Eigen::Index rows, Eigen::Index cols) const {
     cholmod_dense bd{};
-    bd.nrow = static_cast<std::size_t>(b.rows());
-    bd.ncol = static_cast<std::size_t>(b.cols());
+    bd.nrow = static_cast<std::size_t>(rows);
+    bd.ncol = static_cast<std::size_t>(cols);
     bd.nzmax = bd.nrow * bd.ncol;
     bd.d = bd.nrow;
-    bd.x = const_cast<double*>(b.data());  // read only (cholmod_solve copies it)
+    bd.x = const_cast<double*>(b);
     bd.xtype = CHOLMOD_REAL;
     bd.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* xd = nullptr;
-    {
-      const BlasSection blas;
-      xd = cholmod_solve(CHOLMOD_A, factor_, &bd, &c_);
-    }
+    const BlasSection blas;
+    return cholmod_solve(CHOLMOD_A, factor_, &bd, &c_);
+  }
+
+  // x = B^-1 b (kNatural, lower triangle given: B is A).
+  bool solve_b(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
+    cholmod_dense* xd = solve_dense(b.data(), b.rows(), b.cols());
     if (xd == nullptr) return false;
     x = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(xd->x), b.rows(), b.cols());
     cholmod_free_dense(&xd, &c_);

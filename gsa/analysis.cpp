@@ -101,8 +101,7 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       // follows sharp features, and the relaxation test (a 100 x heavier fit missing the
       // data coherently) fires on any curved part (measured: wavy part, 0.03 mm noise,
       // 23 elements relaxed and 1.4 x the error).
-      if (so.local && correlated)
-        out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose);
+      if (so.local) out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose, correlated);
     }
     times.choice += seconds_since(tc);
     refit_deformed(problem, out.fit, out.choice);

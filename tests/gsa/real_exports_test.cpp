@@ -155,15 +155,16 @@ TEST(GsaRealExports, AramisCrackBandIsKeptAndAgreesWithAramis) {
   // peak eps_y 1.98 % against ARAMIS's 3.00 %: the band is two facets (1.4 mm) wide, under
   // the automatic 4.2 mm gauge and the 1.6 x 2.1 mm elements (docs/usage.md, "Real
   // exports"). Since the strain test of the local relaxation (GCV chose its heaviest
-  // weight; the fit's strain misses the residuals' local gradient along the crack, 8
-  // elements relaxed to a 0.78 mm gauge): RMS 1.4e-3, 4.6e-3, bias 2.6e-5, -8.6e-4, peak
-  // 2.52 %. Without the strain test this fails (peak 0.66 of ARAMIS's, RMS yy 6.1e-3).
+  // weight; the fit's strain misses the residuals' local gradient along the crack): 11 of
+  // 18 elements relaxed, GCV then a 0.85 mm gauge, 0.48 mm in the relaxed elements, no
+  // refinement; RMS 8.5e-4, 4.3e-3, bias 8.7e-5, -6.1e-4, peak 2.85 %. Without the strain
+  // test this fails (peak 0.66 of ARAMIS's, RMS yy 6.1e-3, nothing relaxed).
   EXPECT_GT(r.relaxed_elements, 0);
   EXPECT_LT(r.local_gauge_length, r.gauge_length);
   EXPECT_LT(a.rms_xx, 2.5e-3);
-  EXPECT_LT(a.rms_yy, 5.5e-3);
+  EXPECT_LT(a.rms_yy, 5e-3);
   EXPECT_LT(std::abs(a.bias_yy), 2e-3);
-  EXPECT_GT(a.peak_yy_gsa, 0.75 * a.peak_yy_system);
+  EXPECT_GT(a.peak_yy_gsa, 0.85 * a.peak_yy_system);
   EXPECT_LT(a.peak_yy_gsa, 1.3 * a.peak_yy_system);
 }
 

@@ -5,7 +5,8 @@
 // the deformation gradient (gsa/local_fit.hpp), as RMS errors of the Green
 // strains at points at least two spacings from the outline, plus the error near
 // the outline, the neck peak and the points flagged or left without a strain.
-// neckn*: necks narrower than an element (refined there, docs/theory/strain.md).
+// neckn*: necks narrower than an element (refined there, docs/theory/strain.md); band3*:
+// a band narrower than an element along a narrow strip, as the ARAMIS crack band.
 //   build/bin/gsa_realdata_bench [seeds=2] [filter]
 #include <algorithm>
 #include <cmath>

@@ -23,6 +23,7 @@ constexpr int kStrainWindow = 9;        // marks of each local gradient fit (the
 // relaxed, seeds 1 and 2; 4, with the median scaling: 1 each; 6: none); the ARAMIS crack
 // band's elements reach 5-10.
 constexpr double kStrainMisfit = 6.0;
+constexpr std::size_t kStrainMarks = 20000;  // marks judged at most
 constexpr double kSmoothestChoice = 5.5;  // log10(delta / d^6): the weight at the top of its search
 
 }  // namespace
@@ -52,7 +53,10 @@ std::vector<double> strain_misfit_scores(const MatX& residual, const VecX& weigh
   std::vector<int> count(static_cast<std::size_t>(n_el), 0);
   std::vector<std::array<double, 4>> marks_z2;
   std::vector<Index> marks_element;
-  for (std::size_t i = 0; i < used.size(); ++i) {
+  // At most kStrainMarks marks judged (evenly picked): enough per element, and the cost
+  // stays small on large parts.
+  const std::size_t stride = (used.size() + kStrainMarks - 1) / kStrainMarks;
+  for (std::size_t i = 0; i < used.size(); i += stride) {
     const auto& nb = nbs[i];
     if (static_cast<int>(nb.size()) < kStrainWindow - 1) continue;
     const Index kw = static_cast<Index>(nb.size()) + 1;

@@ -5,7 +5,8 @@
 // the deformation gradient (gsa/local_fit.hpp), as RMS errors of the Green
 // strains at points at least two spacings from the outline, plus the error near
 // the outline, the neck peak and the points flagged or left without a strain.
-// neckn*: necks narrower than an element (refined there, docs/theory/strain.md).
+// neckn*: necks narrower than an element (refined there, docs/theory/strain.md); band3*:
+// a band narrower than an element along a narrow strip, as the ARAMIS crack band.
 //   build/bin/gsa_realdata_bench [seeds=2] [filter]
 #include <algorithm>
 #include <cmath>
@@ -120,6 +121,21 @@ std::vector<Study> studies() {
     add("rubber" + tag, neck_deformation(0.23, 0.23, 1.0), rubber, 0.005, corr);
     add("dimple" + tag, dimple_deformation(1.1, 0.95, 0.05, 1.5, 0.0, 0.0), strip, 0.005, corr);
   }
+  // A band narrower than an element along the long side of a narrow strip, as the ARAMIS
+  // crack band (data/real/aramis_mt_crack): 4.5 x 18 mm, facets 0.75 mm apart, strain
+  // 3 % in a band of width parameter 0.6 mm (two facets at half height) on 0.2 % (two rows of elements, the band on
+  // their border); noise 0.4 % of the spacing in plane, the same or (_z4) 4 x along z.
+  PointLayout band;
+  band.length_x = 4.5;
+  band.length_y = 18.0;
+  band.spacing = 0.75;
+  for (double zf : {1.0, 4.0})
+    for (double corr : {0.0, 1.0, 2.5}) {
+      add("band3" + (corr > 0 ? "_L" + std::to_string(corr).substr(0, 3) : std::string("_white")) +
+              (zf > 1 ? "_z4" : ""),
+          band_deformation(0.002, 0.03, 0.6), band, 0.004, corr);
+      out.back().options.undeformed_noise.normal_factor = out.back().options.deformed_noise.normal_factor = zf;
+    }
   // Noise-free reference positions, as a 2-D DIC export gives them (nominal subset
   // centres): all the noise in the deformed state, none in the blank to estimate from.
   for (double corr : {0.0, 1.0, 2.5}) {

@@ -17,6 +17,14 @@
 //   4. every element relaxed alike is one lighter weight everywhere: the multiplier is
 //      folded into the chosen weights and the elements reported as not relaxed.
 //
+// Steps 1-3 run where the noise is correlated (`residual_test`). Under independent noise
+// a strain test takes step 1's place where cross-validation chose about the heaviest
+// weight it may (log10(delta / d^6) >= 5.5): an element whose marks' residuals have a
+// local gradient (least squares over each mark and its 8 nearest) beyond the noise, by
+// a mean squared standardised in-plane component above 6 (strain_misfit_scores), is
+// where the fit's strain misses the data's own: a band narrower than the elements that
+// the heaviest weight flattens (the ARAMIS crack band, docs/usage.md "Real exports").
+//
 // Each element's multiplier is reported with the local gauge length it gives.
 
 #include <functional>
@@ -43,6 +51,18 @@ struct LocalSmoothing {
 // multipliers.
 LocalSmoothing relax_smoothing(DeformedProblem& problem, SmoothingChoice& choice, const NoiseEstimate& noise,
                                const FrameAndMesh& setup, const UndeformedFit& undeformed, const FitMarks& marks,
-                               const std::function<SmoothingChoice()>& choose);
+                               const std::function<SmoothingChoice()>& choose, bool residual_test);
+
+// Per element of the mesh: how far the fit's strain misses the data's own where the fit
+// leaves `residual` (m x 3). At each mark in use the residuals' gradient is fitted by
+// least squares over the mark and its 8 nearest; each of its four in-plane components is
+// squared over its variance under the noise model (correlation and, where estimated, the
+// in-plane level), then scaled so that its median over the marks is a chi-square(1)'s
+// (0.455; with 20 marks or more): 1 on average under noise alone, whether the model's
+// level is right or not (a feature's own misfit inflates the estimate). The score is the
+// largest component's mean over the element's marks (0 with fewer than 2 judged marks).
+std::vector<double> strain_misfit_scores(const MatX& residual, const VecX& weight, const NoiseEstimate& noise,
+                                         const FrameAndMesh& setup, const UndeformedFit& undeformed,
+                                         const FitMarks& marks);
 
 }  // namespace sf::gsa

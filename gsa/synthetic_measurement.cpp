@@ -46,6 +46,22 @@ Deformation neck_deformation(double base, double peak, double w) {
   return d;
 }
 
+Deformation band_deformation(double base, double peak, double w) {
+  Deformation d = neck_deformation(base, peak, w);
+  d.name = "band";
+  d.description = "band of engineering strain " + std::to_string(peak) + " (width parameter " + std::to_string(w) +
+                  " mm) along Y at X = 0 on " + std::to_string(base) + ", none across it";
+  const auto neck_map = d.map;
+  const auto neck_gradient = d.gradient;
+  d.map = [=](const Vec3& P) { return Vec3(neck_map(P).x(), P.y(), 0.0); };
+  d.gradient = [=](const Vec3& P) {
+    Mat32 g = neck_gradient(P);
+    g(1, 0) = 0.0, g(1, 1) = 1.0;
+    return g;
+  };
+  return d;
+}
+
 Deformation dimple_deformation(double l1, double l2, double amplitude, double radius, double cx, double cy) {
   Deformation d;
   d.name = "dimple";

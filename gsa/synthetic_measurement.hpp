@@ -49,6 +49,9 @@ struct Deformation {
 // width stretch lambda^-1/2 (incompressible, plane stress). w: the neck's half
 // width parameter (mm).
 Deformation neck_deformation(double base_strain, double peak_strain, double width);
+// A band of strain along Y at X = 0, as a crack's opening shows ahead of it: stretch
+// lambda(X) as in neck_deformation along X, none across it (x = X + u(X), y = Y).
+Deformation band_deformation(double base_strain, double peak_strain, double width);
 // Homogeneous stretch (l1 along X, l2 along Y) with a smooth out-of-plane dimple
 // of height `amplitude` (mm) and radius parameter `radius` (mm) at (cx, cy).
 Deformation dimple_deformation(double l1, double l2, double amplitude, double radius, double cx, double cy);

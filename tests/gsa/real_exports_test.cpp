@@ -154,11 +154,17 @@ TEST(GsaRealExports, AramisCrackBandIsKeptAndAgreesWithAramis) {
   // Measured when added: RMS 1.5e-3 (xx), 6.1e-3 (yy), bias 1.6e-4 and -8.3e-4; the band's
   // peak eps_y 1.98 % against ARAMIS's 3.00 %: the band is two facets (1.4 mm) wide, under
   // the automatic 4.2 mm gauge and the 1.6 x 2.1 mm elements (docs/usage.md, "Real
-  // exports"). A change that smoothed the band away or dropped it fails here.
+  // exports"). Since the strain test of the local relaxation (GCV chose its heaviest
+  // weight; the fit's strain misses the residuals' local gradient along the crack): 11 of
+  // 18 elements relaxed, GCV then a 0.85 mm gauge, 0.48 mm in the relaxed elements, no
+  // refinement; RMS 8.5e-4, 4.3e-3, bias 8.7e-5, -6.1e-4, peak 2.85 %. Without the strain
+  // test this fails (peak 0.66 of ARAMIS's, RMS yy 6.1e-3, nothing relaxed).
+  EXPECT_GT(r.relaxed_elements, 0);
+  EXPECT_LT(r.local_gauge_length, r.gauge_length);
   EXPECT_LT(a.rms_xx, 2.5e-3);
-  EXPECT_LT(a.rms_yy, 8e-3);
+  EXPECT_LT(a.rms_yy, 5e-3);
   EXPECT_LT(std::abs(a.bias_yy), 2e-3);
-  EXPECT_GT(a.peak_yy_gsa, 0.6 * a.peak_yy_system);
+  EXPECT_GT(a.peak_yy_gsa, 0.85 * a.peak_yy_system);
   EXPECT_LT(a.peak_yy_gsa, 1.3 * a.peak_yy_system);
 }
 

@@ -400,13 +400,22 @@ UndeformedStages undeformed_stages(const GridData& grid, const AnalyseOptions& o
   UndeformedStages u;
   tell(progress, AnalysisStage::kFrameAndMesh, nullptr);
   u.marks = fit_marks(grid);
+  // The blunder check's neighbour search needs the marks only: on a second thread beside
+  // the frame and mesh (the same search, so the same neighbours; its error, if any, is
+  // rethrown by get() after the frame and mesh, as in turn).
+  std::future<std::shared_ptr<const BlunderNeighbours>> neighbours;
+  if (default_threads() > 1)
+    neighbours = std::async(std::launch::async, [&u, &options] {
+      return undeformed_outlier_neighbours(u.marks, options.outliers);
+    });
   const auto t0 = Clock::now();
   u.setup = build_frame_and_mesh(grid, u.marks, options.mesh);
   u.mesh_seconds = seconds_since(t0);
 
   tell(progress, AnalysisStage::kOutliers, &u.setup);
   const auto to = Clock::now();
-  u.outliers = find_undeformed_outliers(u.marks, u.setup.mark_spacing, options.outliers);
+  u.outliers = find_undeformed_outliers(u.marks, u.setup.mark_spacing, options.outliers,
+                                        neighbours.valid() ? neighbours.get() : nullptr);
   u.outliers_seconds = seconds_since(to);
 
   tell(progress, AnalysisStage::kUndeformedFit, &u.setup);

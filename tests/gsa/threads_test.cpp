@@ -34,6 +34,12 @@ struct ThreadSetting {
   ~ThreadSetting() { set_default_threads(0); }
 };
 
+// The default analysis of `grid` on `threads` threads.
+AnalysisResult analysed_on(int threads, const GridData& grid) {
+  const ThreadSetting t(threads);
+  return analyse(grid, AnalyseOptions{});
+}
+
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Every number of the two results that the analysis computed, compared bit for bit;
@@ -84,15 +90,7 @@ TEST(GsaThreads, NeckUnderCorrelatedNoiseGivesTheSameBitsOnOneAndThreeThreads) {
   o.blunders = 2;
   o.seed = 3;
   const SyntheticMeasurement m = make_measurement(neck_deformation(0.2, 0.6, 1.0), o);
-  AnalysisResult one, three;
-  {
-    const ThreadSetting t(1);
-    one = analyse(m.grid, AnalyseOptions{});
-  }
-  {
-    const ThreadSetting t(3);
-    three = analyse(m.grid, AnalyseOptions{});
-  }
+  const AnalysisResult one = analysed_on(1, m.grid), three = analysed_on(3, m.grid);
   ASSERT_GT(one.points.size(), 2500u);
   EXPECT_EQ(first_difference(one, three), "");
   // The case does what it is meant to exercise.
@@ -117,15 +115,7 @@ TEST(GsaThreads, ExactBlankGivesTheSameBitsOnOneAndThreeThreads) {
   o.undeformed_noise = NoiseModel{0.0, 0.0, 0.0};
   o.seed = 2;
   const SyntheticMeasurement m = make_measurement(neck_deformation(0.23, 0.23, 1.0), o);
-  AnalysisResult one, three;
-  {
-    const ThreadSetting t(1);
-    one = analyse(m.grid, AnalyseOptions{});
-  }
-  {
-    const ThreadSetting t(3);
-    three = analyse(m.grid, AnalyseOptions{});
-  }
+  const AnalysisResult one = analysed_on(1, m.grid), three = analysed_on(3, m.grid);
   EXPECT_EQ(first_difference(one, three), "");
   const NoiseEstimate &a = one.noise_displacement, &b = three.noise_displacement;
   EXPECT_TRUE(same_bits(a.sigma_correlated, b.sigma_correlated) && same_bits(a.sigma_white, b.sigma_white) &&

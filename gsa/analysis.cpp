@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <future>
 #include <limits>
 
+#include "common/core/parallel.hpp"
 #include "gsa/deformed_fit.hpp"
 #include "gsa/local_smoothing.hpp"
 #include "gsa/noise_estimate.hpp"
@@ -35,8 +38,11 @@ struct DeformedStages {
   NoiseEstimate noise_displacement;  // exact blank: from the displacement (noise-model rule)
   LocalSmoothing local;  // element multipliers (noise-model rule with local smoothing)
 };
+// `undeformed_noise_of()` gives the blank's noise estimate, waiting for it when it is still
+// being made on another thread (analyse_once): only the smoothing choice needs it.
 DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh& setup, const FitMarks& marks,
-                                   const UndeformedFit& und, const NoiseEstimate& undeformed_noise,
+                                   const UndeformedFit& und,
+                                   const std::function<const NoiseEstimate&()>& undeformed_noise_of,
                                    std::vector<OutlierFlag> flags, const AnalyseOptions& options,
                                    const ProgressCallback& progress, StageTimes& times) {
   const double d = setup.mark_spacing;
@@ -59,11 +65,13 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
   out.choice = {out.fit.penalty, out.fit.passes};
   out.local.multiplier.assign(static_cast<std::size_t>(setup.mesh.n_elements()), 1.0);
   if (so.chooses_by_gcv()) {
+    if (so.rule == SmoothingRule::kNoiseModel) undeformed_noise_of();  // waited for outside the choice's time
     tell(progress, AnalysisStage::kSmoothingChoice, &setup);
     const auto tc = Clock::now();
     if (so.rule == SmoothingRule::kGcv) {
       out.choice = choose_smoothing_gcv(problem, so, d);
     } else {
+      const NoiseEstimate& undeformed_noise = undeformed_noise_of();
       const auto tn = Clock::now();
       // Reference positions without noise (nominal subset centres of a 2-D DIC export, a
       // grid placed by --pitch): the blank gives no correlation length; the displacement's
@@ -286,10 +294,41 @@ bool refined_breaks(const FrameAndMesh& setup, const FitMarks& marks, const Anal
   return s1 || s2;
 }
 
+UndeformedStages undeformed_stages(const GridData& grid, const AnalyseOptions& options, const ProgressCallback& progress);
+bool needs_undeformed_noise(const AnalyseOptions& options);
+void estimate_undeformed_noise(UndeformedStages& u);
+AnalysisResult deformed_stages(const UndeformedStages& u, const GridData& grid, const AnalyseOptions& options,
+                               const ProgressCallback& progress, const std::function<void()>& await_noise);
+
+// analyse_undeformed() then analyse_deformed(), with the blank's noise estimate (the
+// undeformed pilot fits) on a second thread while the deformed blunder check and the
+// first deformed fit run: they do not need it, and only the smoothing choice waits for
+// it. Each part computes what it computed in turn (the same bits, whatever the threads:
+// gsa_threads tests); the stage times then overlap.
 AnalysisResult analyse_once(const GridData& grid, const AnalyseOptions& options, const ProgressCallback& progress,
                             UndeformedStages* kept = nullptr) {
-  UndeformedStages u = analyse_undeformed(grid, options, progress);
-  AnalysisResult res = analyse_deformed(u, grid, options, progress);
+  UndeformedStages u = undeformed_stages(grid, options, progress);
+  AnalysisResult res;
+  {
+    std::future<void> noise;  // destroyed (waited for) before `u`, whose parts it reads and writes
+    if (needs_undeformed_noise(options)) {
+      if (default_threads() > 1)
+        noise = std::async(std::launch::async, [&u] { estimate_undeformed_noise(u); });
+      else
+        estimate_undeformed_noise(u);
+    }
+    // get() rethrows the estimate's exception; the deformed stages read u.noise only after it.
+    auto await_noise = [&noise] {
+      if (noise.valid()) noise.get();
+    };
+    try {
+      res = deformed_stages(u, grid, options, progress, await_noise);
+    } catch (...) {
+      await_noise();  // an error of the estimate came first (it ran first in turn)
+      throw;
+    }
+    await_noise();
+  }
   res.times.mesh = u.mesh_seconds;
   res.times.fit += u.fit.fit_seconds;
   res.times.project = u.fit.project_seconds;
@@ -342,19 +381,41 @@ AnalysisResult analyse_surface(const GridData& grid, const AnalyseOptions& optio
 
 }  // namespace
 
-UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& options,
-                                    const ProgressCallback& progress) {
+namespace {
+
+bool needs_undeformed_noise(const AnalyseOptions& options) {
+  return options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel;
+}
+
+void estimate_undeformed_noise(UndeformedStages& u) {
+  const auto tn = Clock::now();
+  u.noise = gsa::undeformed_noise(u.setup, u.marks, u.fit);
+  u.noise_seconds = seconds_since(tn);
+}
+
+// analyse_undeformed() without the noise estimate.
+UndeformedStages undeformed_stages(const GridData& grid, const AnalyseOptions& options,
+                                   const ProgressCallback& progress) {
   options.validate();
   UndeformedStages u;
   tell(progress, AnalysisStage::kFrameAndMesh, nullptr);
   u.marks = fit_marks(grid);
+  // The blunder check's neighbour search needs the marks only: on a second thread beside
+  // the frame and mesh (the same search, so the same neighbours; its error, if any, is
+  // rethrown by get() after the frame and mesh, as in turn).
+  std::future<std::shared_ptr<const BlunderNeighbours>> neighbours;
+  if (default_threads() > 1)
+    neighbours = std::async(std::launch::async, [&u, &options] {
+      return undeformed_outlier_neighbours(u.marks, options.outliers);
+    });
   const auto t0 = Clock::now();
   u.setup = build_frame_and_mesh(grid, u.marks, options.mesh);
   u.mesh_seconds = seconds_since(t0);
 
   tell(progress, AnalysisStage::kOutliers, &u.setup);
   const auto to = Clock::now();
-  u.outliers = find_undeformed_outliers(u.marks, u.setup.mark_spacing, options.outliers);
+  u.outliers = find_undeformed_outliers(u.marks, u.setup.mark_spacing, options.outliers,
+                                        neighbours.valid() ? neighbours.get() : nullptr);
   u.outliers_seconds = seconds_since(to);
 
   tell(progress, AnalysisStage::kUndeformedFit, &u.setup);
@@ -362,16 +423,13 @@ UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& 
   u.fit =
       fit_undeformed(u.setup, u.marks,
                      {options.smoothing, u.outliers.undeformed, options.max_projection_iterations, u.weights.weight});
-  if (options.smoothing.chooses_by_gcv() && options.smoothing.rule == SmoothingRule::kNoiseModel) {
-    const auto tn = Clock::now();
-    u.noise = gsa::undeformed_noise(u.setup, u.marks, u.fit);
-    u.noise_seconds = seconds_since(tn);
-  }
   return u;
 }
 
-AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid, const AnalyseOptions& options,
-                                const ProgressCallback& progress) {
+// analyse_deformed(); `await_noise()` returns once u.noise and u.noise_seconds are made
+// (analyse_once), and is called before they are read.
+AnalysisResult deformed_stages(const UndeformedStages& u, const GridData& grid, const AnalyseOptions& options,
+                               const ProgressCallback& progress, const std::function<void()>& await_noise) {
   const FitMarks& marks = u.marks;
   const FrameAndMesh& setup = u.setup;
   const UndeformedFit& und = u.fit;
@@ -391,14 +449,22 @@ AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid,
 
   tell(progress, AnalysisStage::kDeformedFit, &setup);
   const auto tf = Clock::now();
-  res.times.noise = u.noise_seconds;
   DeformedProblem problem(setup, marks, und, deformed);
   // Deformed flags of marks the undeformed fit readmitted or that lack a deformed position stay as found.
-  DeformedStages def = run_deformed_stages(problem, setup, marks, und, u.noise, std::move(outliers.deformed), options,
-                                           progress, res.times);
-  // The deformed stages less the noise estimate and the smoothing choice timed in them
-  // (analyse_surface adds the undeformed fit's time).
-  res.times.fit = seconds_since(tf) - (res.times.noise - u.noise_seconds) - res.times.choice;
+  double waited = 0.0;  // for the blank's noise estimate
+  auto undeformed_noise = [&]() -> const NoiseEstimate& {
+    const auto tw = Clock::now();
+    await_noise();
+    waited += seconds_since(tw);
+    return u.noise;
+  };
+  DeformedStages def = run_deformed_stages(problem, setup, marks, und, undeformed_noise, std::move(outliers.deformed),
+                                           options, progress, res.times);
+  await_noise();
+  // The deformed stages less the noise estimate, the smoothing choice timed in them and
+  // the wait for the blank's estimate (analyse_surface adds the undeformed fit's time).
+  res.times.fit = seconds_since(tf) - res.times.noise - res.times.choice - waited;
+  res.times.noise += u.noise_seconds;
   const DeformedResiduals residuals = deformed_residuals(problem, def.fit);
 
   tell(progress, AnalysisStage::kStrains, &setup);
@@ -423,6 +489,20 @@ AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid,
   res.noise_outliers_deformed_across = outliers.noise_deformed_across;
   record_parameters(res, setup, und, problem, def, residuals, options);
   return res;
+}
+
+}  // namespace
+
+UndeformedStages analyse_undeformed(const GridData& grid, const AnalyseOptions& options,
+                                    const ProgressCallback& progress) {
+  UndeformedStages u = undeformed_stages(grid, options, progress);
+  if (needs_undeformed_noise(options)) estimate_undeformed_noise(u);
+  return u;
+}
+
+AnalysisResult analyse_deformed(const UndeformedStages& u, const GridData& grid, const AnalyseOptions& options,
+                                const ProgressCallback& progress) {
+  return deformed_stages(u, grid, options, progress, [] {});
 }
 
 void AnalyseOptions::validate() const {

@@ -170,6 +170,43 @@ double BlunderCheck::threshold_of(Index p, const BlunderOptions& o) const {
 
 Index BlunderCheck::n_flagged() const { return static_cast<Index>(std::count(flagged.begin(), flagged.end(), true)); }
 
+namespace {
+
+// The points a check takes part among: usable, with finite values.
+std::vector<bool> checked_points(const Points3& values, const std::vector<bool>& usable) {
+  std::vector<bool> among(static_cast<std::size_t>(values.rows()));
+  for (Index p = 0; p < values.rows(); ++p)
+    among[static_cast<std::size_t>(p)] = usable[static_cast<std::size_t>(p)] && values.row(p).allFinite();
+  return among;
+}
+
+// The positions of the points `among`, NaN elsewhere.
+Points3 masked(const Points3& positions, const std::vector<bool>& among) {
+  Points3 X = positions;
+  for (Index p = 0; p < X.rows(); ++p)
+    if (!among[static_cast<std::size_t>(p)]) X.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
+  return X;
+}
+
+// Candidate neighbours per point among `among`: o.neighbours + 16 of them, nearest first.
+std::shared_ptr<const BlunderNeighbours> search_neighbours(const Points3& positions, std::vector<bool> among,
+                                                           const BlunderOptions& o) {
+  const Points3 X = masked(positions, among);
+  auto searched = std::make_shared<BlunderNeighbours>();
+  searched->among = std::move(among);
+  searched->count = o.neighbours + 16;
+  searched->candidates = mesh::nearest_neighbours(X, searched->count);
+  return searched;
+}
+
+}  // namespace
+
+std::shared_ptr<const BlunderNeighbours> blunder_neighbours(const Points3& positions, const Points3& values,
+                                                            const std::vector<bool>& usable, const BlunderOptions& o) {
+  o.validate();
+  return search_neighbours(positions, checked_points(values, usable), o);
+}
+
 BlunderCheck find_blunders(const Points3& positions, const Points3& values, const std::vector<bool>& usable,
                            bool normal_only, const BlunderOptions& o, std::shared_ptr<const BlunderNeighbours> reuse) {
   o.validate();
@@ -177,24 +214,15 @@ BlunderCheck find_blunders(const Points3& positions, const Points3& values, cons
   BlunderCheck out;
   out.deviation.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
   out.flagged.assign(static_cast<std::size_t>(n), false);
-  Points3 X = positions;
-  std::vector<bool> among(static_cast<std::size_t>(n));
-  for (Index p = 0; p < n; ++p) {
-    among[static_cast<std::size_t>(p)] = usable[static_cast<std::size_t>(p)] && values.row(p).allFinite();
-    if (!among[static_cast<std::size_t>(p)]) X.row(p).setConstant(std::numeric_limits<double>::quiet_NaN());
-  }
+  std::vector<bool> among = checked_points(values, usable);
   // Candidates once (or those of an earlier check among the same points); each pass
   // takes the nearest ones not flagged.
   const int count = o.neighbours + 16;
-  if (reuse && reuse->count == count && reuse->among == among && reuse->candidates.size() == among.size()) {
+  if (reuse && reuse->count == count && reuse->among == among && reuse->candidates.size() == among.size())
     out.neighbours = std::move(reuse);
-  } else {
-    auto searched = std::make_shared<BlunderNeighbours>();
-    searched->among = std::move(among);
-    searched->count = count;
-    searched->candidates = mesh::nearest_neighbours(X, count);
-    out.neighbours = std::move(searched);
-  }
+  else
+    out.neighbours = search_neighbours(positions, std::move(among), o);
+  const Points3 X = masked(positions, out.neighbours->among);
   const std::vector<std::vector<Index>>& candidates = out.neighbours->candidates;
   const int comps = normal_only ? 1 : 3;
   out.score.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());

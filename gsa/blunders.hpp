@@ -94,5 +94,10 @@ struct BlunderCheck {
 BlunderCheck find_blunders(const Points3& positions, const Points3& values, const std::vector<bool>& usable,
                            bool normal_only, const BlunderOptions& options = {},
                            std::shared_ptr<const BlunderNeighbours> reuse = nullptr);
+// The neighbour search of find_blunders with the same arguments, on its own: started
+// ahead (on another thread beside other work) and passed as find_blunders' `reuse`.
+std::shared_ptr<const BlunderNeighbours> blunder_neighbours(const Points3& positions, const Points3& values,
+                                                            const std::vector<bool>& usable,
+                                                            const BlunderOptions& options = {});
 
 }  // namespace sf::gsa

@@ -499,48 +499,81 @@ NoiseEstimate displacement_noise(const Points3& undeformed, const Points3& defor
   std::array<Table, 2> sq;
   for (Table& t : sq)
     t.assign(static_cast<std::size_t>(nr), std::vector<std::vector<double>>(static_cast<std::size_t>(triples)));
-  for (std::size_t i = 0; i < query.size(); ++i) {
-    const Vec3 c = undeformed.row(query[i]).transpose();
-    const std::vector<Index>& around = nb[i];
-    if (static_cast<int>(around.size()) + 1 < kLocalFewest[0]) continue;
-    // Local tangent plane: the principal directions of the neighbourhood.
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (Index q : around) {
-      const Vec3 r = undeformed.row(q).transpose() - c;
-      cov += r * r.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
-    for (int k = 0; k < nr; ++k) {
-      const double rho = kLocalRadii[k] * d;
-      std::vector<Index> in{query[i]};
-      for (Index q : around)
-        if ((undeformed.row(q).transpose() - c).norm() <= rho * (1.0 + 1e-9)) in.push_back(q);
-      for (int g = 0; g < 2; ++g) {
-        const int np = kLocalTerms[g];
-        if (static_cast<int>(in.size()) < kLocalFewest[g]) continue;
-        MatX A(static_cast<Index>(in.size()), np);
-        for (std::size_t j = 0; j < in.size(); ++j) {
-          const Vec3 r = (undeformed.row(in[j]).transpose() - c) / rho;
-          const double u = r.dot(e1), v = r.dot(e2);
-          int col = 0;
-          for (int deg = 0; deg <= kLocalDegree[g]; ++deg)
-            for (int a = deg; a >= 0; --a) A(static_cast<Index>(j), col++) = std::pow(u, a) * std::pow(v, deg - a);
+  // The query points' local fits on all cores: each writes its own slice of `local`
+  // and `made`, gathered into `sq` in query order below, so the
+  // tables hold the same numbers in the same order whatever the threads.
+  const std::size_t per_query = static_cast<std::size_t>(2 * nr * triples);
+  std::vector<double> local(query.size() * per_query, 0.0);
+  std::vector<char> made(query.size() * 2 * static_cast<std::size_t>(nr), 0);  // per query, degree, radius
+  parallel_for(
+      static_cast<Index>(query.size()),
+      [&](Index qi) {
+        const auto i = static_cast<std::size_t>(qi);
+        double* const out_i = local.data() + i * per_query;
+        const Vec3 c = undeformed.row(query[i]).transpose();
+        const std::vector<Index>& around = nb[i];
+        if (static_cast<int>(around.size()) + 1 < kLocalFewest[0]) return;
+        // Local tangent plane: the principal directions of the neighbourhood.
+        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+        for (Index q : around) {
+          const Vec3 r = undeformed.row(q).transpose() - c;
+          cov += r * r.transpose();
         }
-        const Eigen::ColPivHouseholderQR<MatX> qr(A);
-        if (qr.rank() < np) continue;
-        // The fit's value at the point (u = v = 0) is h^T y, h = A (A^T A)^-1 e_1.
-        const MatX ata = A.transpose() * A;
-        const VecX h = A * ata.ldlt().solve(VecX::Unit(np, 0));
-        Eigen::RowVectorXd res = all.row(slot[static_cast<std::size_t>(query[i])]);
-        for (std::size_t j = 0; j < in.size(); ++j)
-          res -= h[static_cast<Index>(j)] * all.row(slot[static_cast<std::size_t>(in[j])]);
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+        const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
+        std::vector<Index> in;
+        std::vector<std::array<double, 2 * (kLocalDegree[1] + 1)>> powers;  // u^a, v^a per point, a = 0..4
+        for (int k = 0; k < nr; ++k) {
+          const double rho = kLocalRadii[k] * d;
+          in.assign(1, query[i]);
+          for (Index q : around)
+            if ((undeformed.row(q).transpose() - c).norm() <= rho * (1.0 + 1e-9)) in.push_back(q);
+          // std::pow of each power once per point (the same calls, so the same bits, as
+          // one per term).
+          powers.resize(in.size());
+          for (std::size_t j = 0; j < in.size(); ++j) {
+            const Vec3 r = (undeformed.row(in[j]).transpose() - c) / rho;
+            const double u = r.dot(e1), v = r.dot(e2);
+            for (int a = 0; a <= kLocalDegree[1]; ++a) {
+              powers[j][static_cast<std::size_t>(a)] = std::pow(u, a);
+              powers[j][static_cast<std::size_t>(kLocalDegree[1] + 1 + a)] = std::pow(v, a);
+            }
+          }
+          for (int g = 0; g < 2; ++g) {
+            const int np = kLocalTerms[g];
+            if (static_cast<int>(in.size()) < kLocalFewest[g]) continue;
+            MatX A(static_cast<Index>(in.size()), np);
+            for (std::size_t j = 0; j < in.size(); ++j) {
+              const auto& pw = powers[j];
+              int col = 0;
+              for (int deg = 0; deg <= kLocalDegree[g]; ++deg)
+                for (int a = deg; a >= 0; --a)
+                  A(static_cast<Index>(j), col++) =
+                      pw[static_cast<std::size_t>(a)] * pw[static_cast<std::size_t>(kLocalDegree[1] + 1 + deg - a)];
+            }
+            const Eigen::ColPivHouseholderQR<MatX> qr(A);
+            if (qr.rank() < np) continue;
+            // The fit's value at the point (u = v = 0) is h^T y, h = A (A^T A)^-1 e_1.
+            const MatX ata = A.transpose() * A;
+            const VecX h = A * ata.ldlt().solve(VecX::Unit(np, 0));
+            Eigen::RowVectorXd res = all.row(slot[static_cast<std::size_t>(query[i])]);
+            for (std::size_t j = 0; j < in.size(); ++j)
+              res -= h[static_cast<Index>(j)] * all.row(slot[static_cast<std::size_t>(in[j])]);
+            for (int tr = 0; tr < triples; ++tr)
+              out_i[(static_cast<std::size_t>(g) * nr + k) * triples + tr] = res.segment(3 * tr, 3).squaredNorm();
+            made[(i * 2 + static_cast<std::size_t>(g)) * nr + static_cast<std::size_t>(k)] = 1;
+          }
+        }
+      },
+      8);
+  for (std::size_t i = 0; i < query.size(); ++i)
+    for (int g = 0; g < 2; ++g)
+      for (int k = 0; k < nr; ++k) {
+        if (!made[(i * 2 + static_cast<std::size_t>(g)) * nr + static_cast<std::size_t>(k)]) continue;
+        const double* v = local.data() + i * per_query + (static_cast<std::size_t>(g) * nr + k) * triples;
         for (int tr = 0; tr < triples; ++tr)
-          sq[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)][static_cast<std::size_t>(tr)].push_back(
-              res.segment(3 * tr, 3).squaredNorm());
+          sq[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)][static_cast<std::size_t>(tr)].push_back(v[tr]);
       }
-    }
-  }
   // The model fitted to one degree's statistics.
   auto fit_degree = [&](int g) {
     NoiseEstimate e;

@@ -42,12 +42,19 @@ BlunderOptions blunder_options(double mark_spacing, const OutlierOptions& option
 }
 }  // namespace
 
-MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options) {
+std::shared_ptr<const BlunderNeighbours> undeformed_outlier_neighbours(const FitMarks& marks,
+                                                                       const OutlierOptions& options) {
+  const std::vector<bool> all(static_cast<std::size_t>(marks.size()), true);
+  return blunder_neighbours(marks.undeformed, marks.undeformed, all, blunder_options(0.0, options));
+}
+
+MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options,
+                                      std::shared_ptr<const BlunderNeighbours> neighbours) {
   const Index m = marks.size();
   MarkOutliers out;
   const std::vector<bool> all(static_cast<std::size_t>(m), true);
   const BlunderOptions bo = blunder_options(mark_spacing, options);
-  const BlunderCheck u = find_blunders(marks.undeformed, marks.undeformed, all, true, bo);
+  const BlunderCheck u = find_blunders(marks.undeformed, marks.undeformed, all, true, bo, std::move(neighbours));
   out.noise_undeformed = u.noise;
   out.neighbours = u.neighbours;
   for (Index k = 0; k < m; ++k) {

@@ -70,7 +70,12 @@ MarkOutliers find_outliers(const FitMarks& marks, const Points3& deformed, doubl
 // The two halves of find_outliers, for a stage series (one undeformed state, many deformed
 // ones): the undeformed flags (deformed left empty), then a deformed state's flags against
 // them (`out.undeformed` kept; `out.deformed` and `out.noise_deformed` replaced).
-MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options);
+// `neighbours`: undeformed_outlier_neighbours(marks, options), searched ahead (e.g. beside
+// the frame and mesh); null: searched here.
+MarkOutliers find_undeformed_outliers(const FitMarks& marks, double mark_spacing, const OutlierOptions& options,
+                                      std::shared_ptr<const BlunderNeighbours> neighbours = nullptr);
+std::shared_ptr<const BlunderNeighbours> undeformed_outlier_neighbours(const FitMarks& marks,
+                                                                       const OutlierOptions& options);
 void find_deformed_outliers(const FitMarks& marks, const Points3& deformed, double mark_spacing,
                             const OutlierOptions& options, MarkOutliers& out);
 

@@ -34,6 +34,12 @@ struct ThreadSetting {
   ~ThreadSetting() { set_default_threads(0); }
 };
 
+// The default analysis of `grid` on `threads` threads.
+AnalysisResult analysed_on(int threads, const GridData& grid) {
+  const ThreadSetting t(threads);
+  return analyse(grid, AnalyseOptions{});
+}
+
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Every number of the two results that the analysis computed, compared bit for bit;
@@ -84,21 +90,44 @@ TEST(GsaThreads, NeckUnderCorrelatedNoiseGivesTheSameBitsOnOneAndThreeThreads) {
   o.blunders = 2;
   o.seed = 3;
   const SyntheticMeasurement m = make_measurement(neck_deformation(0.2, 0.6, 1.0), o);
-  AnalysisResult one, three;
-  {
-    const ThreadSetting t(1);
-    one = analyse(m.grid, AnalyseOptions{});
-  }
-  {
-    const ThreadSetting t(3);
-    three = analyse(m.grid, AnalyseOptions{});
-  }
+  const AnalysisResult one = analysed_on(1, m.grid), three = analysed_on(3, m.grid);
   ASSERT_GT(one.points.size(), 2500u);
   EXPECT_EQ(first_difference(one, three), "");
   // The case does what it is meant to exercise.
   EXPECT_EQ(one.smoothing_criterion, "Cp");
   EXPECT_GT(
       std::count_if(one.points.begin(), one.points.end(), [](const PointResult& p) { return p.flag.has_value(); }), 0);
+}
+
+// An exact blank (nominal reference positions) with noise correlated over a spacing in
+// the deformed state: the displacement's local fits (displacement_noise, its query points
+// on all threads) and, with more than one thread, the blank's noise estimate beside the
+// deformed blunder check and first fit (analyse_once). Bits and the displacement's noise
+// model the same on one and three threads.
+TEST(GsaThreads, ExactBlankGivesTheSameBitsOnOneAndThreeThreads) {
+  SyntheticMeasurementOptions o;
+  o.layout.kind = PointLayout::Kind::kJittered;
+  o.layout.length_x = 20.0;
+  o.layout.length_y = 10.0;
+  o.layout.spacing = 0.5;
+  const double sigma = 0.005 * o.layout.spacing;
+  o.deformed_noise = NoiseModel{sigma, o.layout.spacing, 0.3 * sigma};
+  o.undeformed_noise = NoiseModel{0.0, 0.0, 0.0};
+  o.seed = 2;
+  const SyntheticMeasurement m = make_measurement(neck_deformation(0.23, 0.23, 1.0), o);
+  const AnalysisResult one = analysed_on(1, m.grid), three = analysed_on(3, m.grid);
+  EXPECT_EQ(first_difference(one, three), "");
+  const NoiseEstimate &a = one.noise_displacement, &b = three.noise_displacement;
+  EXPECT_TRUE(same_bits(a.sigma_correlated, b.sigma_correlated) && same_bits(a.sigma_white, b.sigma_white) &&
+              same_bits(a.correlation_length, b.correlation_length) && same_bits(a.bias_slope, b.bias_slope));
+  ASSERT_EQ(a.gamma.size(), b.gamma.size());
+  for (std::size_t k = 0; k < a.gamma.size(); ++k) EXPECT_TRUE(same_bits(a.gamma[k], b.gamma[k])) << "radius " << k;
+  EXPECT_EQ(a.count, b.count);
+  // The case does what it is meant to exercise: the displacement's estimate found the
+  // correlation and chose the smoothing by Cp.
+  EXPECT_EQ(one.noise_undeformed.sigma_total(), 0.0);
+  EXPECT_GT(a.correlation_length, 0.0);
+  EXPECT_EQ(one.smoothing_criterion, "Cp");
 }
 
 std::string file_text(const fs::path& path) {

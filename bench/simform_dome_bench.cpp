@@ -131,9 +131,12 @@ static void print_forming_results(const std::filesystem::path& summary) {
   try {
     const nlohmann::json j = io::read_json(summary.string());
     if (!j.contains("forming") || !j["forming"].contains("plies")) return;
+    // Angles to 1e-3 degrees, the stretch to 1e-5 (near-inextensible fibres: 0.999 .. 1.001).
     const auto range = [](const nlohmann::json& ply, const char* key, char* out, std::size_t size) {
+      const bool stretch = std::string(key) == "fibre_stretch";
       if (ply.contains(key) && ply[key].contains("min") && ply[key]["min"].is_number())
-        std::snprintf(out, size, "%8.3f .. %-8.3f", ply[key]["min"].get<double>(), ply[key]["max"].get<double>());
+        std::snprintf(out, size, stretch ? "%8.5f .. %-8.5f" : "%8.3f .. %-8.3f", ply[key]["min"].get<double>(),
+                      ply[key]["max"].get<double>());
       else
         std::snprintf(out, size, "%20s", "-");
     };

@@ -12,13 +12,18 @@
 //     other      the rest (line search bookkeeping, outputs, set-up)
 //   peak resident memory (getrusage high-water mark), the threads (element loop, BLAS),
 //   pattern growths (each a new symbolic analysis) and, for the iterative solver, the
-//   GMRES iterations and residuals.
+//   GMRES iterations and residuals; and, per ply, the forming results at the last
+//   converged step (summary.json: trellis shear angle to the partner ply, in-ply shear,
+//   fibre stretch: min .. max).
 // A program that prints figures, not a timed test.
 //   build/bin/simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE]
 //                                [--ordering amd|metis|nesdis|default] [--factor-only] [--time-limit S]
 //   --quick       4 x 4 bricks a ply, 2 of the 36 steps (a smoke test)
 //   --elements N  N x N bricks a ply (the mid size: 10)
 //   --max-steps N stop cleanly after N steps (the full run can take long)
+//   --keep DIR    write the run's results into DIR and keep them (frames, history.csv,
+//                 summary.json: `simform plot DIR` draws the pictures); default: a
+//                 temporary folder, removed at the end
 //   --case FILE   another case (default: the [0,90]s dome)
 //   --stabilise F solver: {stabilise: {fraction: F}} (viscous stabilisation, calibrated from step 1)
 //   --damping C   solver: {stabilise: {damping: C}} (the damping factor given, N s/mm^4, from
@@ -61,6 +66,7 @@
 #include "common/core/parallel.hpp"
 #include "common/io/csv.hpp"
 #include "common/core/memory.hpp"
+#include "common/io/json.hpp"
 #include "common/linalg/krylov.hpp"
 #include "common/linalg/solver.hpp"
 #include "forming/case/build.hpp"
@@ -115,6 +121,41 @@ static void print_split(const SolveProfile& p, double total, double cpu, long it
   std::printf("pattern: %ld growths (each a new symbolic analysis), %.3f s laying out the search band (%s)\n",
               p.pattern_growths, p.band_layout_s, Model::band_pattern() ? "band pattern on" : "--no-band-pattern");
   std::printf("peak memory %.0f MB\n", peak_mb());
+}
+
+// Per ply, the forming results of the last converged step from summary.json (docs/forming.md
+// "Forming results"): trellis shear angle against the partner ply, in-ply shear angle and
+// fibre stretch, each min .. max. Nothing when the run wrote no summary.
+static void print_forming_results(const std::filesystem::path& summary) {
+  if (!std::filesystem::exists(summary)) return;
+  try {
+    const nlohmann::json j = io::read_json(summary.string());
+    if (!j.contains("forming") || !j["forming"].contains("plies")) return;
+    // Angles to 1e-3 degrees, the stretch to 1e-5 (near-inextensible fibres: 0.999 .. 1.001).
+    const auto range = [](const nlohmann::json& ply, const char* key, char* out, std::size_t size) {
+      const bool stretch = std::string(key) == "fibre_stretch";
+      if (ply.contains(key) && ply[key].contains("min") && ply[key]["min"].is_number())
+        std::snprintf(out, size, stretch ? "%8.5f .. %-8.5f" : "%8.3f .. %-8.3f", ply[key]["min"].get<double>(),
+                      ply[key]["max"].get<double>());
+      else
+        std::snprintf(out, size, "%20s", "-");
+    };
+    std::printf("forming results at the last converged step (min .. max):\n%-8s %-8s %-20s %-20s %-20s\n", "ply",
+                "partner", "trellis_shear_deg", "ply_shear_deg", "fibre_stretch");
+    for (const nlohmann::json& ply : j["forming"]["plies"]) {
+      char trellis[64], shear[64], stretch[64];
+      range(ply, "trellis_shear_angle_deg", trellis, sizeof trellis);
+      range(ply, "ply_shear_angle_deg", shear, sizeof shear);
+      range(ply, "fibre_stretch", stretch, sizeof stretch);
+      const std::string partner =
+          ply.contains("trellis_partner") && ply["trellis_partner"].is_string() ? ply["trellis_partner"].get<std::string>()
+                                                                                 : "-";
+      std::printf("%-8s %-8s %s %s %s\n", ply.value("ply", std::string("?")).c_str(), partner.c_str(), trellis, shear,
+                  stretch);
+    }
+  } catch (const std::exception& e) {
+    std::printf("forming results: %s unreadable (%s)\n", summary.string().c_str(), e.what());
+  }
 }
 
 // Random numbers in [-1, 1], the same on every run.
@@ -302,6 +343,7 @@ int main(int argc, char** argv) {
   bool iterative = false;
   std::string linear;
   std::string solvers;  // --solvers: ",kind,kind," (empty: all)
+  std::string keep;     // --keep DIR: the results folder, kept
   double time_limit = 0.0;
   double stabilise = 0.0;
   double damping = 0.0;
@@ -343,6 +385,8 @@ int main(int argc, char** argv) {
       linear = argv[++i];
     } else if (a == "--case" && i + 1 < argc) {
       file = argv[++i];
+    } else if (a == "--keep" && i + 1 < argc) {
+      keep = argv[++i];
     } else if (a == "--stabilise" && i + 1 < argc) {
       stabilise = std::atof(argv[++i]);
       if (!(stabilise > 0.0 && stabilise < 1.0)) {
@@ -360,7 +404,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: simform_dome_bench [--quick] [--elements N] [--max-steps N] [--case FILE] [--ordering O] "
                    "[--factor-only [--solvers K,K] | --iterative] [--linear direct|iterative|iterative-ply|auto] "
-                   "[--no-band-pattern] [--time-limit S] [--stabilise FRACTION | --damping C]\n");
+                   "[--no-band-pattern] [--time-limit S] [--stabilise FRACTION | --damping C] [--keep DIR]\n");
       return 2;
     }
   }
@@ -400,8 +444,9 @@ int main(int argc, char** argv) {
     if (only_factor) return factor_only(spec, iterative, solvers);
     // One folder per process: runs side by side (sizes, orderings) do not collide.
     const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / ("sf_simform_dome_bench_" + std::to_string(getpid()));
-    std::filesystem::remove_all(dir);
+        keep.empty() ? std::filesystem::temp_directory_path() / ("sf_simform_dome_bench_" + std::to_string(getpid()))
+                     : std::filesystem::path(keep);
+    if (keep.empty()) std::filesystem::remove_all(dir);
     RunOptions o;
     o.out_dir = dir.string();
     o.quiet = false;  // simform's step lines on stderr: progress on a long run
@@ -452,7 +497,12 @@ int main(int argc, char** argv) {
     std::printf("largest displacement (x, y, z) %.12g %.12g %.12g mm\n", r.max_displacement.x(), r.max_displacement.y(),
                 r.max_displacement.z());
     print_split(p, total, cpu, r.total_iterations);
-    std::filesystem::remove_all(dir);
+    print_forming_results(dir / "summary.json");
+    if (keep.empty())
+      std::filesystem::remove_all(dir);
+    else
+      std::printf("results kept in %s (simform plot %s draws the pictures)\n", dir.string().c_str(),
+                  dir.string().c_str());
     return r.ok() ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "simform_dome_bench: %s\n", e.what());

@@ -139,6 +139,7 @@ class LoadStepper final : public Stepper {
       // retry started from the same state (up to kMaxEscalation); the last retry cuts
       // back to min_increment.
       double last_reached = -1.0, scale = 1.0;
+      double boosted_from = 0.0;  // the damping before the last retry raised it (0: not raised)
       for (int retry = 0; !r.report.ok() && bs.active() && !needs_calibration() && retry < bs.retries; ++retry) {
         const double reached = from_lambda + r.report.load_factor * (lambda - from_lambda);
         scale = std::abs(reached - last_reached) <= 1e-12 * std::max(1.0, std::abs(reached))
@@ -155,7 +156,16 @@ class LoadStepper final : public Stepper {
         from_lambda = reached;
         StaticOptions again = statics;
         again.clock = {reached * T, lambda * T, nullptr, 0.0};
-        if (retry + 1 == bs.retries) again.give_up_after = 0;
+        if (retry + 1 == bs.retries) {
+          again.give_up_after = 0;
+          // The last retry, stabilised: ten times the damping for the rest of this step
+          // (a snap of a ply that no switch passes is damped through, as a dynamic step
+          // would); its energy counted with that c, the step's earlier sub-steps too.
+          if (stabilisation_ && stabilisation_->damping() > 0.0 && boosted_from == 0.0) {
+            boosted_from = stabilisation_->damping();
+            stabilisation_->set_damping(kLastRetryDamping * boosted_from);
+          }
+        }
         again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
         const std::string before = r.report.message;
         const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
@@ -171,6 +181,7 @@ class LoadStepper final : public Stepper {
                              r.report.message;
       }
       if (!r.report.ok()) {
+        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
         if (needs_calibration() && r.report.load_factor <= 0.0)
           r.report.message += "; stabilise fraction: no part of the step converged to calibrate the damping from: "
                               "give solver stabilise damping (N s/mm^4) instead";
@@ -207,6 +218,7 @@ class LoadStepper final : public Stepper {
         if (!substeps.empty()) substeps.back().to = r.positions;
         for (const SubStep& s : substeps) dissipated_ += stabilisation_->dissipation(s.from, s.to, s.dt);
         if (needs_calibration()) calibrate(state.x, r.positions, (lambda - lambda_prev) * T);
+        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
       }
       commit_interactions(problem_.model, r.positions, at_end);
       const VecX step_start = state.x;
@@ -297,6 +309,7 @@ class LoadStepper final : public Stepper {
   double dissipated_ = 0.0;                        // N mm, from the run's start
   TangentWorkspace mode_workspace_;                // branch switching's tangents (apart from Newton's)
   static constexpr double kMaxEscalation = 8.0;
+  static constexpr double kLastRetryDamping = 10.0;  // the last retry's damping / the run's
   double escalation_ = 1.0;     // the next switch's amplitude / the given one
   bool switched_last_ = false;  // the last step's end was switched
 };

@@ -192,6 +192,8 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.stabilise.warn_ratio = s.stabilise_warn_ratio;
   out.stabilise.validate();
   out.branch_switch.amplitude = s.branch_switch_amplitude;
+  out.branch_switch.give_up_after = s.branch_switch_give_up_after;
+  out.branch_switch.retries = s.branch_switch_retries;
   out.branch_switch.validate();
 
   if (s.dynamic) {

@@ -605,13 +605,21 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   }
   if (const YAML::Node bs = n["branch_switch"]; bs.IsDefined()) {
     s.branch_switch_place = place_of(bs);
-    if (r.mapping(bs, "solver branch_switch", {"amplitude"})) {
+    if (r.mapping(bs, "solver branch_switch", {"amplitude", "give_up_after", "retries"})) {
       if (!bs["amplitude"].IsDefined())
         r.problem(ProblemKind::kMissing, bs,
                   "solver branch_switch: give amplitude (mm, the largest nodal displacement of the imperfection "
                   "along the critical mode, e.g. a tenth of a ply thickness)");
       else if (const auto v = r.positive(bs["amplitude"], "solver branch_switch amplitude", "mm"))
         s.branch_switch_amplitude = *v;
+      if (bs["give_up_after"].IsDefined())
+        if (const auto v = r.integer(bs["give_up_after"], "solver branch_switch give_up_after (failed sub-steps "
+                                     "of a step before a switch; 0: cut back to min_increment first)", 0, 1000))
+          s.branch_switch_give_up_after = *v;
+      if (bs["retries"].IsDefined())
+        if (const auto v = r.integer(bs["retries"], "solver branch_switch retries (switched retries of a failed step)",
+                                     0, 100))
+          s.branch_switch_retries = *v;
     }
   }
   if (n["line_search"].IsDefined())

@@ -184,6 +184,10 @@ struct CaseSolver {
   // failed step's last converged sub-step) by A mm along its tangent's nearest-zero mode
   // (forming/solve/branch_switch.hpp). 0: off (the default). May change for a restart.
   double branch_switch_amplitude = 0.0;  // mm
+  // {give_up_after: N, retries: R}: a failed step gives up after N failed sub-steps and
+  // is retried from a switched state at most R times (BranchSwitchOptions).
+  int branch_switch_give_up_after = 4;
+  int branch_switch_retries = 4;
   SourcePlace branch_switch_place;       // of the "branch_switch" key's value; 0: not given
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given

@@ -100,7 +100,9 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
                                 {"damping", spec.solver.stabilise_damping},
                                 {"warn_ratio", spec.solver.stabilise_warn_ratio}};
   if (spec.solver.branch_switch_amplitude > 0.0)
-    j["solver"]["branch_switch"] = {{"amplitude", spec.solver.branch_switch_amplitude}};
+    j["solver"]["branch_switch"] = {{"amplitude", spec.solver.branch_switch_amplitude},
+                                    {"give_up_after", spec.solver.branch_switch_give_up_after},
+                                    {"retries", spec.solver.branch_switch_retries}};
   j["output"] = {{"every", spec.output.every},
                  {"samples", {spec.output.samples_inplane, spec.output.samples_thickness}}};
   j["model"] = {{"dofs", model.n_dofs()},

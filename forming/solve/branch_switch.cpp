@@ -31,6 +31,11 @@ void BranchSwitchOptions::validate() const {
   if (!(amplitude >= 0.0) || !std::isfinite(amplitude))
     throw InputError("solver branch_switch amplitude: expected a displacement >= 0 (mm), found " +
                      std::to_string(amplitude));
+  if (give_up_after < 0)
+    throw InputError("solver branch_switch give_up_after: expected at least 0 (0: off), found " +
+                     std::to_string(give_up_after));
+  if (retries < 0)
+    throw InputError("solver branch_switch retries: expected at least 0, found " + std::to_string(retries));
   if (inverse_steps < 1)
     throw InputError("solver branch_switch inverse_steps: expected at least 1, found " +
                      std::to_string(inverse_steps));

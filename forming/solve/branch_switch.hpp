@@ -39,6 +39,13 @@ class TangentWorkspace;
 struct BranchSwitchOptions {
   double amplitude = 0.0;  // mm: largest nodal displacement of the imperfection; 0: off
   int inverse_steps = 30;  // inverse-iteration solves for the mode
+  // A failed step: its solve gives up after this many failed sub-steps
+  // (StaticOptions::give_up_after) and is tried again from its last converged sub-step
+  // moved along the mode, at most `retries` times; the last try cuts back to
+  // min_increment. A retry that starts where the last one did (no progress) doubles
+  // the amplitude, up to 8 A. give_up_after 0: every try cuts back to min_increment.
+  int give_up_after = 4;
+  int retries = 4;
   bool active() const { return amplitude > 0.0; }
   // Throws sf::InputError naming "solver branch_switch <field>".
   void validate() const;

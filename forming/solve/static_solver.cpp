@@ -64,6 +64,7 @@ void StaticOptions::validate() const {
   if (regrow_after < 0) bad_option("regrow_after", "at least 0", regrow_after);
   if (max_iterations < 1) bad_option("max_iterations", "at least 1", max_iterations);
   if (max_steps < 1) bad_option("max_steps", "at least 1", max_steps);
+  if (give_up_after < 0) bad_option("give_up_after", "at least 0 (0: off)", give_up_after);
   if (!(residual_tol_rel >= 0.0)) bad_option("residual_tol_rel", "a value >= 0", residual_tol_rel);
   if (!(residual_tol_abs >= 0.0)) bad_option("residual_tol_abs", "a value >= 0 (N)", residual_tol_abs);
   if (!(divergence_factor > 1.0)) bad_option("divergence_factor", "a factor > 1", divergence_factor);
@@ -532,6 +533,7 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     increment = std::clamp(options.workspace->next_increment, options.min_increment, increment);
   int attempts = 0;
   int in_a_row = 0;  // steps converged since the last cut-back or growth (regrow_after)
+  int failures = 0;  // sub-steps failed in this solve (give_up_after)
   // StaticOptions::extrapolate: the first predictor starts from the previous increment.
   const double span = options.clock.end - options.clock.start;
   VecX extrapolated;
@@ -579,6 +581,14 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
     why = rec.failure;
     report.add(std::move(rec));
     in_a_row = 0;
+    ++failures;
+    if (options.give_up_after > 0 && failures >= options.give_up_after) {
+      report.status = SolveStatus::kStepFailed;
+      report.message = "load step from lambda " + detail::short_number(lambda) + " failed (" + why + "); " +
+                       std::to_string(failures) + " sub-steps failed, the last of increment " +
+                       detail::short_number(increment) + " (give_up_after)";
+      break;
+    }
     increment *= 0.5;
     if (increment < options.min_increment) {
       report.status = SolveStatus::kStepFailed;

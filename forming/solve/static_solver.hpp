@@ -25,7 +25,8 @@
 // last five corrections were all damped below 1/2 without halving |r_f| is cut back at
 // once (after at least eight iterations). A step
 // that fails (too many iterations, divergence, an inverted Gauss point, a singular
-// tangent) is retried from the last converged state with half the load increment;
+// tangent) is retried from the last converged state with half the load increment
+// (with options.give_up_after, only so many times in the solve);
 // after a step that converges in <= options.easy_iterations, or after
 // options.regrow_after steps in a row converged since the last cut-back or growth, the
 // increment grows by options.growth (capped at max_increment); with a shared options.workspace (a run's
@@ -84,6 +85,13 @@ struct StaticOptions {
   // the whole stroke as penetration. Off: the predictor starts at the start state.
   bool extrapolate = false;
   int max_steps = 1000;             // attempted steps in total (converged + cut back)
+  // Give up early: a solve in which this many sub-steps have failed (the increment
+  // halved each time) ends at once as failed (kStepFailed, at its last converged
+  // sub-step) instead of cutting back on to min_increment; 0: off. Branch switching sets
+  // it (forming/solve/stepper.hpp): a stall beside a bifurcation is not passed by ever
+  // smaller increments (Newton creeps towards it in sub-steps of 1e-3 of a step, each
+  // failure up to max_iterations), and a switch from the last converged state costs less.
+  int give_up_after = 0;
   double residual_tol_rel = 1e-10;  // relative to force_scale
   double residual_tol_abs = 0.0;    // N
   double divergence_factor = 1e8;   // |r| growing past this times the step's first |r| fails

@@ -1,5 +1,7 @@
 #include "forming/solve/stepper.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -100,6 +102,11 @@ class LoadStepper final : public Stepper {
       // Process time over the step: tools move with it, rates are taken over it.
       StaticOptions statics = settings_.statics;
       statics.clock = {lambda_prev * T, lambda * T, nullptr, 0.0};
+      // Branch switching: a stall is left for a switch after a few failed sub-steps, not
+      // cut back to min_increment first (not while the damping is to be calibrated: that
+      // takes the part of the first step that converged).
+      const BranchSwitchOptions& bs = settings_.branch_switch;
+      if (bs.active() && bs.retries > 0 && !needs_calibration()) statics.give_up_after = bs.give_up_after;
       std::vector<BranchSwitch> switches = std::move(pending);
       pending.clear();
       const std::vector<PrescribedDof> targets = problem_.prescriptions.at(lambda);
@@ -128,21 +135,37 @@ class LoadStepper final : public Stepper {
         }
       }
       // Branch switching: the failed step once more from its last converged sub-step,
-      // moved along that state's nearest-zero mode.
-      for (int retry = 0; !r.report.ok() && settings_.branch_switch.active() && !needs_calibration() &&
-                          retry < settings_.branch_switch_retries;
-           ++retry) {
+      // moved along that state's nearest-zero mode; twice the amplitude when the last
+      // retry started from the same state (up to kMaxEscalation); the last retry cuts
+      // back to min_increment.
+      double last_reached = -1.0, scale = 1.0;
+      double boosted_from = 0.0;  // the damping before the last retry raised it (0: not raised)
+      for (int retry = 0; !r.report.ok() && bs.active() && !needs_calibration() && retry < bs.retries; ++retry) {
         const double reached = from_lambda + r.report.load_factor * (lambda - from_lambda);
+        scale = std::abs(reached - last_reached) <= 1e-12 * std::max(1.0, std::abs(reached))
+                    ? std::min(2.0 * scale, kMaxEscalation)
+                    : 1.0;
+        last_reached = reached;
         const double t_reached = reached * T;
         const InteractionContext at_reached =
             t_reached > lambda_prev * T ? InteractionContext{t_reached, nullptr, &state.x, lambda_prev * T}
                                         : InteractionContext{t_reached, nullptr, &r.positions, t_reached - T / n};
         const VecX x_reached = r.positions;
-        VecX moved = switch_branch(x_reached, reached, k, true, at_reached, switches);
+        VecX moved = switch_branch(x_reached, reached, k, true, at_reached, switches, scale);
         if (moved.size() == 0) break;
         from_lambda = reached;
         StaticOptions again = statics;
         again.clock = {reached * T, lambda * T, nullptr, 0.0};
+        if (retry + 1 == bs.retries) {
+          again.give_up_after = 0;
+          // The last retry, stabilised: ten times the damping for the rest of this step
+          // (a snap of a ply that no switch passes is damped through, as a dynamic step
+          // would); its energy counted with that c, the step's earlier sub-steps too.
+          if (stabilisation_ && stabilisation_->damping() > 0.0 && boosted_from == 0.0) {
+            boosted_from = stabilisation_->damping();
+            stabilisation_->set_damping(kLastRetryDamping * boosted_from);
+          }
+        }
         again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
         const std::string before = r.report.message;
         const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
@@ -158,6 +181,7 @@ class LoadStepper final : public Stepper {
                              r.report.message;
       }
       if (!r.report.ok()) {
+        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
         if (needs_calibration() && r.report.load_factor <= 0.0)
           r.report.message += "; stabilise fraction: no part of the step converged to calibrate the damping from: "
                               "give solver stabilise damping (N s/mm^4) instead";
@@ -194,6 +218,7 @@ class LoadStepper final : public Stepper {
         if (!substeps.empty()) substeps.back().to = r.positions;
         for (const SubStep& s : substeps) dissipated_ += stabilisation_->dissipation(s.from, s.to, s.dt);
         if (needs_calibration()) calibrate(state.x, r.positions, (lambda - lambda_prev) * T);
+        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
       }
       commit_interactions(problem_.model, r.positions, at_end);
       const VecX step_start = state.x;
@@ -229,7 +254,7 @@ class LoadStepper final : public Stepper {
   // negative pivots), or always after a failure, x moved along the nearest-zero mode,
   // recorded in `log`; empty when x stays.
   VecX switch_branch(const VecX& x, double lambda, int k, bool after_failure, const InteractionContext& context,
-                     std::vector<BranchSwitch>& log) {
+                     std::vector<BranchSwitch>& log, double failure_scale = 1.0) {
     const std::vector<PrescribedDof> fixed = problem_.prescriptions.at(lambda);
     const ExternalLoad load = problem_.loads.at(problem_.model, lambda, x, problem_.loads.follower);
     const TangentMode tm = tangent_mode(problem_.model, x, fixed, context, &load.tangent, mode_workspace_,
@@ -244,7 +269,7 @@ class LoadStepper final : public Stepper {
       switched_last_ = unstable;
     }
     if (!(unstable || after_failure)) return VecX();
-    const double amplitude = escalation_ * settings_.branch_switch.amplitude;
+    const double amplitude = (after_failure ? failure_scale : escalation_) * settings_.branch_switch.amplitude;
     int sign = 0;
     VecX moved = perturbed(problem_.model, x, tm.mode, amplitude, context, sign);
     if (moved.size() == 0) return moved;
@@ -284,6 +309,7 @@ class LoadStepper final : public Stepper {
   double dissipated_ = 0.0;                        // N mm, from the run's start
   TangentWorkspace mode_workspace_;                // branch switching's tangents (apart from Newton's)
   static constexpr double kMaxEscalation = 8.0;
+  static constexpr double kLastRetryDamping = 10.0;  // the last retry's damping / the run's
   double escalation_ = 1.0;     // the next switch's amplitude / the given one
   bool switched_last_ = false;  // the last step's end was switched
 };

@@ -14,9 +14,10 @@
 //                     its constraint met (at most max_multiplier_updates times);
 //                     with branch switching (forming/solve/branch_switch.hpp) a step
 //                     whose converged tangent is unstable hands the next step its state
-//                     moved along the nearest-zero mode, and a failed step is tried again
-//                     from its last converged sub-step so moved (at most
-//                     branch_switch_retries times);
+//                     moved along the nearest-zero mode, and a failed step gives up after
+//                     a few failed sub-steps in a row and is tried again from its last
+//                     converged sub-step so moved (BranchSwitchOptions: give_up_after,
+//                     retries);
 //   DynamicStepper    implicit dynamics: step k integrates the output interval
 //                     [(k - 1) T / n, k T / n] with solve_dynamic (time steps cut back
 //                     and regrown inside); load factor t / T, starting at rest;
@@ -63,9 +64,8 @@ struct StepperSettings {
   StabiliseOptions stabilise;
   // kLoad: branch switching at a bifurcation (forming/solve/branch_switch.hpp): after a
   // converged step whose tangent is unstable, and once more for a failed step (at most
-  // `retries` times a step), the state moves along the nearest-zero eigenmode.
+  // branch_switch.retries times a step), the state moves along the nearest-zero eigenmode.
   BranchSwitchOptions branch_switch;
-  int branch_switch_retries = 2;
   DynamicOptions dynamics;          // kDynamic: per output interval (its times are set per step)
   double end_time = 1.0;            // kDynamic, s
   ArcLengthOptions arc;             // kArcLength

@@ -6,6 +6,9 @@
 // branch switching the run moves onto the buckled branch: the strip deflects, its end
 // state is stable (no negative pivot) and stores less energy than the straight one at the
 // same end shortening.
+// And the stall of the 70 mm/s matched-die bend at 3.1 mm (step 7), restarted from its
+// step 6: a failed step gives up after a few failed sub-steps and switches, instead of
+// creeping to min_increment first.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,11 +16,16 @@
 #include <string>
 #include <vector>
 
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
 #include "forming/case/build.hpp"
 #include "forming/case/reader.hpp"
+#include "forming/run/run.hpp"
 #include "forming/solve/branch_switch.hpp"
 #include "forming/solve/stepper.hpp"
 #include "forming/solve/tangent_solver.hpp"
+#include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
 namespace {
@@ -118,6 +126,49 @@ TEST(BranchSwitch, StraightStripPastBucklingLoadFindsTheBuckledBranch) {
   EXPECT_LT(buckled.energy, 0.9 * straight.energy);
 }
 
+// Newton iterations of the 70 mm/s bend's step 7 from its step 6 (deterministic): 543 (19
+// cut-backs) when the failing attempt first crept to min_increment (it creeps towards
+// 3.14 mm in sub-steps down to 1e-3 of the step, most of them failing after 17-30
+// iterations) and the retry switched there; 129 (5 cut-backs) giving up after 4 failed
+// sub-steps (give_up_after, the default), switching at 3.06 mm.
+constexpr int kBendStep7Iterations = 250;
+
+TEST(BranchSwitch, BendStallIsLeftAfterAFewFailedSubSteps) {
+  namespace fs = std::filesystem;
+  const fs::path source = fs::path(SF_SOURCE_DIR);
+  const CaseCheck c = check_case_file((source / "data/forming/processes/matched_die_bend_70mms.yaml").string());
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  const fs::path dir = fs::temp_directory_path() / "sf_branch_switch_bend_step7";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(source / "tests/forming/cases/bend70_step6_restart.json", dir / "restart.json");
+  RunOptions o;
+  o.out_dir = dir.string();
+  o.quiet = true;
+  o.restart = true;
+  o.stop_after = 1;
+  const RunReport report = run_case(c.spec, o);
+  ASSERT_EQ(report.status, RunReport::Status::kStopped) << report.message;
+  const nlohmann::json summary = nlohmann::json::parse(fixtures::read_text(dir / "summary.json"));
+  ASSERT_TRUE(summary.contains("branch_switches"));
+  int after_failure = 0;
+  for (const nlohmann::json& b : summary["branch_switches"]) {
+    std::printf("[ measured ] switch in step %d at load factor %.4g (after a failure: %d), eigenvalue %.3e, ply %d "
+                "x %.2f z %.2f, %.3g mm\n",
+                b["step"].get<int>(), b["load_factor"].get<double>(), int(b["after_failure"].get<bool>()),
+                b["eigenvalue"].get<double>(), b["ply"].get<int>(), b["x"].get<double>(), b["z"].get<double>(),
+                b["amplitude"].get<double>());
+    EXPECT_EQ(b["step"].get<int>(), 7);
+    if (b["after_failure"].get<bool>()) ++after_failure;
+  }
+  std::printf("[ measured ] step 7: %d Newton iterations (543 creeping to min_increment first)\n",
+              report.total_iterations);
+  EXPECT_GE(after_failure, 1);  // the stall is there: the step failed and was switched out of
+  EXPECT_LE(report.total_iterations, kBendStep7Iterations);
+  EXPECT_NEAR(report.load_factor, 7.0 / 30.0, 1e-9);
+  fs::remove_all(dir);
+}
+
 TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
   std::string text = strip_case(0.05);
   text.replace(text.find("amplitude: 0.05"), 19, "amplitude: -1");
@@ -129,6 +180,21 @@ TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
   ASSERT_TRUE(off.ok() && on.ok());
   EXPECT_EQ(off.spec.fingerprint, on.spec.fingerprint);
   EXPECT_DOUBLE_EQ(on.spec.solver.branch_switch_amplitude, 0.05);
+  EXPECT_EQ(on.spec.solver.branch_switch_give_up_after, 4);  // the defaults
+  EXPECT_EQ(on.spec.solver.branch_switch_retries, 4);
+  std::string tuned = strip_case(0.05);
+  tuned.replace(tuned.find("amplitude: 0.05"), 19, "amplitude: 0.05, give_up_after: 0, retries: 2");
+  const CaseCheck t = check_case_text(tuned, "t.yaml");
+  ASSERT_TRUE(t.ok()) << t.located(0);
+  EXPECT_EQ(t.spec.solver.branch_switch_give_up_after, 0);
+  EXPECT_EQ(t.spec.solver.branch_switch_retries, 2);
+  EXPECT_EQ(t.spec.fingerprint, on.spec.fingerprint);
+  std::string wrong = strip_case(0.05);
+  wrong.replace(wrong.find("amplitude: 0.05"), 19, "amplitude: 0.05, give_up_after: -3");
+  const CaseCheck w = check_case_text(wrong, "w.yaml");
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.located(0).find("give_up_after"), std::string::npos) << w.located(0);
+  EXPECT_NE(w.located(0).find("w.yaml:9:"), std::string::npos) << w.located(0);
 }
 
 }  // namespace

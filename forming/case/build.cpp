@@ -194,6 +194,7 @@ StepperSettings stepper_settings(const FormingCase& spec) {
   out.branch_switch.amplitude = s.branch_switch_amplitude;
   out.branch_switch.give_up_after = s.branch_switch_give_up_after;
   out.branch_switch.retries = s.branch_switch_retries;
+  out.branch_switch.last_retry_damping = s.branch_switch_last_retry_damping;
   out.branch_switch.validate();
 
   if (s.dynamic) {

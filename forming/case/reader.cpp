@@ -605,7 +605,7 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
   }
   if (const YAML::Node bs = n["branch_switch"]; bs.IsDefined()) {
     s.branch_switch_place = place_of(bs);
-    if (r.mapping(bs, "solver branch_switch", {"amplitude", "give_up_after", "retries"})) {
+    if (r.mapping(bs, "solver branch_switch", {"amplitude", "give_up_after", "retries", "last_retry_damping"})) {
       if (!bs["amplitude"].IsDefined())
         r.problem(ProblemKind::kMissing, bs,
                   "solver branch_switch: give amplitude (mm, the largest nodal displacement of the imperfection "
@@ -620,6 +620,16 @@ void read_solver(Reader& r, const YAML::Node& n, CaseSolver& s) {
         if (const auto v = r.integer(bs["retries"], "solver branch_switch retries (switched retries of a failed step)",
                                      0, 100))
           s.branch_switch_retries = *v;
+      if (bs["last_retry_damping"].IsDefined()) {
+        if (const auto v = r.number(bs["last_retry_damping"], "solver branch_switch last_retry_damping")) {
+          if (*v >= 1.0 && *v <= 1000.0)
+            s.branch_switch_last_retry_damping = *v;
+          else
+            r.problem(ProblemKind::kOutOfRange, bs["last_retry_damping"],
+                      "solver branch_switch last_retry_damping: expected a factor from 1 (the damping not raised) "
+                      "to 1000 on the run's stabilisation damping, got " + std::to_string(*v));
+        }
+      }
     }
   }
   if (n["line_search"].IsDefined())

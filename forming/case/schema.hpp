@@ -188,6 +188,9 @@ struct CaseSolver {
   // is retried from a switched state at most R times (BranchSwitchOptions).
   int branch_switch_give_up_after = 4;
   int branch_switch_retries = 4;
+  // {last_retry_damping: F}: the last retry of a failed step runs with F times the run's
+  // stabilisation damping (1: not raised, the default; needs solver stabilise).
+  double branch_switch_last_retry_damping = 1.0;
   SourcePlace branch_switch_place;       // of the "branch_switch" key's value; 0: not given
   SourcePlace analysis_place;  // of the value of "analysis" (cross-field problems); 0: not given
   SourcePlace control_place;   // of the value of "control"; 0: not given

@@ -102,7 +102,8 @@ nlohmann::json parameters_json(const FormingCase& spec, const Model& model) {
   if (spec.solver.branch_switch_amplitude > 0.0)
     j["solver"]["branch_switch"] = {{"amplitude", spec.solver.branch_switch_amplitude},
                                     {"give_up_after", spec.solver.branch_switch_give_up_after},
-                                    {"retries", spec.solver.branch_switch_retries}};
+                                    {"retries", spec.solver.branch_switch_retries},
+                                    {"last_retry_damping", spec.solver.branch_switch_last_retry_damping}};
   j["output"] = {{"every", spec.output.every},
                  {"samples", {spec.output.samples_inplane, spec.output.samples_thickness}}};
   j["model"] = {{"dofs", model.n_dofs()},

@@ -46,6 +46,9 @@ struct BranchSwitchOptions {
   // the amplitude, up to 8 A. give_up_after 0: every try cuts back to min_increment.
   int give_up_after = 4;
   int retries = 4;
+  // The last retry runs with this many times the stabilisation damping (a snap no switch
+  // passes is then damped through, dissipating more: the run warns); 1: not raised.
+  double last_retry_damping = 1.0;
   bool active() const { return amplitude > 0.0; }
   // Throws sf::InputError naming "solver branch_switch <field>".
   void validate() const;

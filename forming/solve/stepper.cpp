@@ -158,12 +158,13 @@ class LoadStepper final : public Stepper {
         again.clock = {reached * T, lambda * T, nullptr, 0.0};
         if (retry + 1 == bs.retries) {
           again.give_up_after = 0;
-          // The last retry, stabilised: ten times the damping for the rest of this step
-          // (a snap of a ply that no switch passes is damped through, as a dynamic step
-          // would); its energy counted with that c, the step's earlier sub-steps too.
-          if (stabilisation_ && stabilisation_->damping() > 0.0 && boosted_from == 0.0) {
+          // The last retry, if asked, with raised damping for the rest of this step (a snap
+          // of a ply that no switch passes is damped through, as a dynamic step would); its
+          // energy counted with that c, the step's earlier sub-steps too.
+          if (bs.last_retry_damping > 1.0 && stabilisation_ && stabilisation_->damping() > 0.0 &&
+              boosted_from == 0.0) {
             boosted_from = stabilisation_->damping();
-            stabilisation_->set_damping(kLastRetryDamping * boosted_from);
+            stabilisation_->set_damping(bs.last_retry_damping * boosted_from);
           }
         }
         again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
@@ -309,7 +310,6 @@ class LoadStepper final : public Stepper {
   double dissipated_ = 0.0;                        // N mm, from the run's start
   TangentWorkspace mode_workspace_;                // branch switching's tangents (apart from Newton's)
   static constexpr double kMaxEscalation = 8.0;
-  static constexpr double kLastRetryDamping = 10.0;  // the last retry's damping / the run's
   double escalation_ = 1.0;     // the next switch's amplitude / the given one
   bool switched_last_ = false;  // the last step's end was switched
 };

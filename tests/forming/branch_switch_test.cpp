@@ -182,12 +182,14 @@ TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
   EXPECT_DOUBLE_EQ(on.spec.solver.branch_switch_amplitude, 0.05);
   EXPECT_EQ(on.spec.solver.branch_switch_give_up_after, 4);  // the defaults
   EXPECT_EQ(on.spec.solver.branch_switch_retries, 4);
+  EXPECT_DOUBLE_EQ(on.spec.solver.branch_switch_last_retry_damping, 1.0);  // not raised unless asked
   std::string tuned = strip_case(0.05);
-  tuned.replace(tuned.find("amplitude: 0.05"), 19, "amplitude: 0.05, give_up_after: 0, retries: 2");
+  tuned.replace(tuned.find("amplitude: 0.05"), 19, "amplitude: 0.05, give_up_after: 0, retries: 2, last_retry_damping: 10");
   const CaseCheck t = check_case_text(tuned, "t.yaml");
   ASSERT_TRUE(t.ok()) << t.located(0);
   EXPECT_EQ(t.spec.solver.branch_switch_give_up_after, 0);
   EXPECT_EQ(t.spec.solver.branch_switch_retries, 2);
+  EXPECT_DOUBLE_EQ(t.spec.solver.branch_switch_last_retry_damping, 10.0);
   EXPECT_EQ(t.spec.fingerprint, on.spec.fingerprint);
   std::string wrong = strip_case(0.05);
   wrong.replace(wrong.find("amplitude: 0.05"), 19, "amplitude: 0.05, give_up_after: -3");
@@ -195,6 +197,12 @@ TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
   ASSERT_FALSE(w.ok());
   EXPECT_NE(w.located(0).find("give_up_after"), std::string::npos) << w.located(0);
   EXPECT_NE(w.located(0).find("w.yaml:9:"), std::string::npos) << w.located(0);
+  std::string lower = strip_case(0.05);
+  lower.replace(lower.find("amplitude: 0.05"), 19, "amplitude: 0.05, last_retry_damping: 0.5");
+  const CaseCheck l = check_case_text(lower, "l.yaml");
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.located(0).find("last_retry_damping"), std::string::npos) << l.located(0);
+  EXPECT_NE(l.located(0).find("l.yaml:9:"), std::string::npos) << l.located(0);
 }
 
 }  // namespace

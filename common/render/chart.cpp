@@ -9,29 +9,6 @@ namespace {
 
 const Colour kInk{0.15, 0.15, 0.15};
 
-// Liang-Barsky: clips segment p-q to the rectangle; false when nothing is left.
-bool clip(Vec2& p, Vec2& q, const std::array<double, 4>& r) {
-  double t0 = 0, t1 = 1;
-  const Vec2 d = q - p;
-  const double pk[4] = {-d.x(), d.x(), -d.y(), d.y()};
-  const double qk[4] = {p.x() - r[0], r[2] - p.x(), p.y() - r[1], r[3] - p.y()};
-  for (int k = 0; k < 4; ++k) {
-    if (pk[k] == 0) {
-      if (qk[k] < 0) return false;
-      continue;
-    }
-    const double t = qk[k] / pk[k];
-    if (pk[k] < 0)
-      t0 = std::max(t0, t);
-    else
-      t1 = std::min(t1, t);
-    if (t0 > t1) return false;
-  }
-  const Vec2 a = p + t0 * d, b = p + t1 * d;
-  p = a;
-  q = b;
-  return true;
-}
 
 std::vector<double> ticks_with_step(double lo, double hi, double step) {
   std::vector<double> t;
@@ -213,7 +190,7 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
       }
       Vec2 a = px(s.x[i], s.y[i]), b = px(s.x[i + 1], s.y[i + 1]);
       const Vec2 a0 = a;
-      if (!clip(a, b, plot)) {
+      if (!clip_segment(a, b, plot)) {
         flush();
         continue;
       }
@@ -245,6 +222,29 @@ ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const st
                          label_font, kInk, 0, -1, false, 90});  // justified in the text's own frame
   write_png(scene, size, path);
   return cf;
+}
+
+bool clip_segment(Vec2& p, Vec2& q, const std::array<double, 4>& r) {
+  double t0 = 0, t1 = 1;
+  const Vec2 d = q - p;
+  const double pk[4] = {-d.x(), d.x(), -d.y(), d.y()};
+  const double qk[4] = {p.x() - r[0], r[2] - p.x(), p.y() - r[1], r[3] - p.y()};
+  for (int k = 0; k < 4; ++k) {
+    if (pk[k] == 0) {
+      if (qk[k] < 0) return false;
+      continue;
+    }
+    const double t = qk[k] / pk[k];
+    if (pk[k] < 0)
+      t0 = std::max(t0, t);
+    else
+      t1 = std::min(t1, t);
+    if (t0 > t1) return false;
+  }
+  const Vec2 a = p + t0 * d, b = p + t1 * d;
+  p = a;
+  q = b;
+  return true;
 }
 
 }  // namespace sf::render

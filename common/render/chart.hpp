@@ -52,4 +52,8 @@ struct ChartFraming {
 // Renders and writes the chart as PNG (see write_png for errors).
 ChartFraming write_chart_png(const Chart& chart, const ImageSize& size, const std::string& path);
 
+// Clips segment p-q to the rectangle {x_lo, y_lo, x_hi, y_hi} (Liang-Barsky), in place;
+// false when nothing of it is inside.
+bool clip_segment(Vec2& p, Vec2& q, const std::array<double, 4>& rect);
+
 }  // namespace sf::render

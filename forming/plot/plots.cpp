@@ -542,6 +542,7 @@ class Plotter {
         render::Colour::from_rgb8(0x75, 0x70, 0xb3), render::Colour::from_rgb8(0xe7, 0x29, 0x8a),
         render::Colour::from_rgb8(0x66, 0xa6, 0x1e), render::Colour::from_rgb8(0xe6, 0xab, 0x02)};
     const double tol = 1e-6 * std::max(1.0, box_.size().norm());
+    Box plies;
     for (int b = 0; b < n_bodies(); ++b) {
       render::Surface& s = scene.surfaces.emplace_back();
       std::vector<Vec3> pts;
@@ -566,25 +567,36 @@ class Plotter {
       s.shading = false;
       s.outline = true;
       scene.legend.push_back({render::LegendEntry::Kind::kSwatch, s.colour, ply_label(b)});
+      for (const Vec3& p : pts) plies.add(p);
     }
+    // The picture is framed on the plies: the tools are drawn within a margin of a third of
+    // the plies' larger extent around them (a long die wall or a big frame would otherwise
+    // shrink the laminate to a sliver of the picture).
+    const double margin = plies.lo[0] <= plies.hi[0] ? std::max(plies.size()[0], plies.size()[2]) / 3.0 : 0.0;
+    const std::array<double, 4> frame = {plies.lo[0] - margin, plies.lo[2] - margin, plies.hi[0] + margin,
+                                         plies.hi[2] + margin};
     // Tool sections: each triangle cut by the plane y = y0 - tiny (in front of the plies).
     for (const Tool& t : tools_) {
       render::GlyphSet g;
       g.kind = render::GlyphSet::Kind::kSegment;
       g.colour = kToolLine;
-      g.width = 0.004 * box_.size().norm();
+      g.width = (margin > 0.0 ? 0.0025 * std::hypot(frame[2] - frame[0], frame[3] - frame[1])
+                                      : 0.004 * box_.size().norm());
       std::vector<std::size_t> all(t.mesh.n_cells());
       for (std::size_t c = 0; c < all.size(); ++c) all[c] = c;
       for (const auto& [p, q] : plane_cuts(t.mesh, all, Vec3(0.0, y0, 0.0), Vec3::UnitY())) {
-        g.tails.push_back(p);
-        g.heads.push_back(q);
+        Vec2 a(p[0], p[2]), e(q[0], q[2]);
+        if (margin > 0.0 && !render::clip_segment(a, e, frame)) continue;
+        g.tails.push_back(Vec3(a.x(), p[1], a.y()));
+        g.heads.push_back(Vec3(e.x(), q[1], e.y()));
       }
       if (g.tails.empty()) continue;
       scene.glyphs.push_back(std::move(g));
       scene.legend.push_back({render::LegendEntry::Kind::kLine, kToolLine, "tool '" + t.name + "'"});
     }
     write(report, scene, "section.png",
-          "Section of the 2-D (plane strain) part: every ply in its own colour, the tools' surfaces as lines.");
+          "Section of the 2-D (plane strain) part: every ply in its own colour, the tools' surfaces as lines "
+          "(drawn within a third of the plies' extent around them).");
   }
 
   // The part's centre in plan (reference): the centre of the plies' plan box, moved onto

@@ -9,13 +9,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
 #include "common/io/vtk_xml.hpp"
+#include "common/render/scene.hpp"
 #include "forming/case/reader.hpp"
+#include "forming/plot/plots.hpp"
 #include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
@@ -100,6 +104,23 @@ TEST(ProcessCase, QuickMatchedDieBendPressesTheLaminateIntoTheDie) {
         if (std::isfinite(g)) min_gap = std::min(min_gap, g);
   std::printf("[ measured ] largest penetration: %.3e mm\n", -min_gap);
   EXPECT_GT(min_gap, -kPenetrationTol);
+  // The section picture is framed on the plies: the die wall and the holder reach far
+  // beyond the laminate, and framed on them the plies were a sliver of the picture.
+  PlotOptions po;
+  po.frames = 0;
+  po.animation = false;
+  po.quiet = true;
+  po.size = {800, 600};
+  plot_results(dir.string(), po);
+  const render::RgbImage img = render::read_png_rgb((dir / "plots" / "section.png").string());
+  int ply_pixels = 0;  // lam.1 #d95f02 and lam.2 #1b9e77 of plots.cpp's palette, within 24 of 255
+  for (std::size_t p = 0; p + 2 < img.pixels.size(); p += 3)
+    for (const std::array<int, 3> rgb : {std::array<int, 3>{0xd9, 0x5f, 0x02}, std::array<int, 3>{0x1b, 0x9e, 0x77}})
+      if (std::abs(img.pixels[p] - rgb[0]) < 24 && std::abs(img.pixels[p + 1] - rgb[1]) < 24 &&
+          std::abs(img.pixels[p + 2] - rgb[2]) < 24)
+        ++ply_pixels;
+  std::printf("[ measured ] section.png: %d pixels of the plies of %zu\n", ply_pixels, img.pixels.size() / 3);
+  EXPECT_GT(ply_pixels, 5000);  // 7401 framed on the plies, 2547 framed on the tools
   std::filesystem::remove_all(dir);
 }
 

@@ -316,13 +316,7 @@ class CholmodPermutedBackend final : public Backend {
         b_col_.size() == static_cast<std::size_t>(n) + 1 && b_row_.size() == static_cast<std::size_t>(a.nonZeros()) &&
         std::equal(b_col_.begin(), b_col_.end(), a.outerIndexPtr()) &&
         std::equal(b_row_.begin(), b_row_.end(), a.innerIndexPtr())) {
-      release(inverse_);
-      release(b_col_);
-      release(b_row_);
-      release(map_);
-      release(b_val_);
-      direct_ = true;
-      ordering_ = "natural";
+      go_direct();
       return {};
     }
     if (factor_ != nullptr) cholmod_free_factor(&factor_, &c_);
@@ -332,13 +326,7 @@ class CholmodPermutedBackend final : public Backend {
       for (int j = 0; j < n && !upper; ++j)
         upper = a.outerIndexPtr()[j + 1] > a.outerIndexPtr()[j] && a.innerIndexPtr()[a.outerIndexPtr()[j]] < j;
       if (!upper) {
-        release(inverse_);
-        release(b_col_);
-        release(b_row_);
-        release(map_);
-        release(b_val_);
-        direct_ = true;
-        ordering_ = "natural";
+        go_direct();
         return analyze_b(a, const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()), true);
       }
     }
@@ -424,6 +412,17 @@ class CholmodPermutedBackend final : public Backend {
 
   // The supernodal analysis of B (a's size, the given columns and rows) in its own order
   // (no postorder: P already has it, or the caller laid B out in its order).
+  // From here on A is B, read in place: the permutation, the copy and its map are dropped.
+  void go_direct() {
+    release(inverse_);
+    release(b_col_);
+    release(b_row_);
+    release(map_);
+    release(b_val_);
+    direct_ = true;
+    ordering_ = "natural";
+  }
+
   Outcome analyze_b(const SparseMatrix& a, int* col, int* row, bool counts) {
     cholmod_sparse b_view = lower_view(a, col, row, nullptr, CHOLMOD_PATTERN);
     c_.nmethods = 1;

@@ -64,7 +64,12 @@ class Continuation {
         options_(options),
         free_(is_free),
         solver_(options.linear_solver, unsymmetric || !model.symmetric_tangent()),
-        pattern_(model.make_pattern(is_free, solver_.lower())) {}
+        pattern_(model.make_pattern(is_free, solver_.lower())) {
+    // The tangent is assembled in the Cholesky's order and factorised in place (no copy).
+    solver_.lay_out(pattern_);
+  }
+  Continuation(const Continuation&) = delete;  // solver_ holds a pointer to pattern_
+  Continuation& operator=(const Continuation&) = delete;
 
   Index n_free() const { return free_.size(); }
   const FreeDofs& free() const { return free_; }

@@ -27,6 +27,11 @@
 //   iter_s           kernel + scatter + residual + factorisation + solve: one Newton iteration
 //   kern_GF, fact_GF GFLOP/s of the kernel (flops counted from the algorithm,
 //                    BrickKernel::tangent_flops) and of the factorisation (CHOLMOD's count)
+//   kern_%           the kernel's share of a core's double-precision peak: every brick
+//                    once on one thread, on that thread's processor clock, against
+//                    linalg::fma_peak_gflops on the same thread (independent of the load;
+//                    the two cores' share is this when the element loop scales, as
+//                    kernel_s shows)
 //   newton, static_s Newton iterations and wall time of the whole static solve (stretch
 //                    in two load steps sharing one TangentWorkspace, as a run's steps do)
 //   layouts          times the pattern was laid out in that solve (1: kept across steps)
@@ -50,6 +55,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +80,12 @@ using namespace sf;
 using namespace sf::forming;
 
 namespace {
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 double peak_mb() {
   rusage u{};
@@ -271,6 +283,25 @@ int run_case(int n, int plies, int repeats, bool study = false) {
     }
   };
   kernels_only();  // warm-up (thread buffers)
+  // The kernel's share of a core's peak, on the processor clock of one thread (so the
+  // machine's load does not enter): every brick once on this thread, against the same
+  // thread's fused multiply-add rate with the same vector set.
+  double kern_1_s = 0.0;
+  {
+    BrickScratch scratch;
+    ElementResult result;
+    const double t_start = thread_seconds();
+    for (Index g = 0; g < n_el; ++g) {
+      const linalg::ElementEntries& en = entries[static_cast<std::size_t>(g)];
+      BrickParams xe = BrickParams::Zero();
+      for (std::size_t a = 0; a < en.dofs.size(); ++a)
+        xe(en.local[a] / 3, en.local[a] % 3) += en.coefs[a] * x(en.dofs[a]);
+      model.kernel().evaluate(X_e[static_cast<std::size_t>(g)], xe, model.material(bricks[g].first), true, {}, scratch,
+                              result);
+    }
+    kern_1_s = thread_seconds() - t_start;
+  }
+  const double core_peak_gf = linalg::fma_peak_gflops(0.2);
   model.assemble_into(x, InteractionContext{}, &pattern);
   const double kernel_s = median_time(repeats, kernels_only);
   const double asm_s = median_time(repeats, [&] { model.assemble_into(x, InteractionContext{}, &pattern); });
@@ -312,11 +343,12 @@ int run_case(int n, int plies, int repeats, bool study = false) {
   const int newton = res1.report.total_iterations + res.report.total_iterations;
 
   const double kern_gf = n_el * model.kernel().tangent_flops() / kernel_s / 1e9;
+  const double kern_pct = 100.0 * n_el * model.kernel().tangent_flops() / kern_1_s / 1e9 / core_peak_gf;
   std::printf(
-      "%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %7.1f %6d %7d %8.2f %8.1f %8.1f\n", n,
-      n,
-      plies, static_cast<long>(nd), static_cast<long>(n_free), layout_s, kernel_s, asm_s - kernel_s,
-      resid_s, analyse_s, fact_s, solve_s, iter_s, kern_gf, flops / fact_s / 1e9, newton, so.workspace->layouts(),
+      "%3dx%-3d %5d %8ld %8ld %8.3f %8.3f %9.3f %8.3f %8.3f %8.3f %8.4f %8.3f %7.1f %6.0f%% %7.1f %6d %7d %8.2f %8.1f "
+      "%8.1f\n",
+      n, n, plies, static_cast<long>(nd), static_cast<long>(n_free), layout_s, kernel_s, asm_s - kernel_s, resid_s,
+      analyse_s, fact_s, solve_s, iter_s, kern_gf, kern_pct, flops / fact_s / 1e9, newton, so.workspace->layouts(),
       static_s, iter_mb, peak_mb());
   std::fflush(stdout);
   return 0;
@@ -473,12 +505,20 @@ int main(int argc, char** argv) {
         g_lu.empty() ? "CHOLMOD supernodal Cholesky, MUMPS LDL^T when indefinite (UMFPACK LU without MUMPS)"
                      : ("--lu " + g_lu + ": the tangent as an unsymmetric one (both triangles, LU)").c_str(),
         linalg::blas_description().c_str());
+    const int threads = sf::default_threads();
+    double peak_gf = 0.0;
+#pragma omp parallel num_threads(threads) reduction(+ : peak_gf)
+    peak_gf += linalg::fma_peak_gflops(0.3);
+    std::printf(
+        "# double-precision peak measured (%s fused multiply-add chains, processor time): %.1f GFLOP/s on %d "
+        "threads at once, %.1f a core alone\n",
+        linalg::to_string(linalg::kernel_isa()).c_str(), peak_gf, threads, linalg::fma_peak_gflops(0.3));
     std::printf(
         "# per Newton iteration, wall-clock seconds (medians of %d), GFLOP/s, memory MB (peak RSS of the case)\n",
         repeats);
-    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %6s %7s %8s %8s %8s\n", "n x n", "plies",
+    std::printf("%7s %5s %8s %8s %8s %8s %9s %8s %8s %8s %8s %8s %7s %7s %7s %6s %7s %8s %8s %8s\n", "n x n", "plies",
                 "n_dofs", "n_free", "layout_s", "kernel_s", "scatter_s", "resid_s", "analyse", "fact_s", "solve_s",
-                "iter_s", "kern_GF", "fact_GF", "newton", "layouts", "static_s", "iter_MB", "peak_MB");
+                "iter_s", "kern_GF", "kern_%", "fact_GF", "newton", "layouts", "static_s", "iter_MB", "peak_MB");
     std::fflush(stdout);
     const std::string self = argv[0];
     for (int n : {10, 20, 40}) {

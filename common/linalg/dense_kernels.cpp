@@ -1,7 +1,9 @@
 #include "common/linalg/dense_kernels.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <ctime>
 #include <cstring>
 
 #include "common/linalg/simd.hpp"
@@ -96,6 +98,30 @@ void atb_lower_generic(int n, int depth, const double* a, int lda, const double*
   atb_lower<2>(n, depth, a, lda, b, ldb, c, ldc);
 }
 
+// n rounds of kChains independent multiply-add chains of W lanes: kChains covers the
+// FMA latency times the units (4 x 2 on recent x86) with registers to spare.
+template <int W>
+[[gnu::always_inline]] inline double fma_chains(long n) {
+  constexpr int kChains = 12;
+  simd::Vec<W> acc[kChains];
+  for (int i = 0; i < kChains; ++i) acc[i] = simd::Vec<W>{} + (1.0 + 1e-3 * i);
+  const simd::Vec<W> m = simd::Vec<W>{} + 0.999999999, c = simd::Vec<W>{} + 1e-9;
+  for (long k = 0; k < n; ++k)
+    for (int i = 0; i < kChains; ++i) acc[i] = acc[i] * m + c;
+  double s = 0.0;
+  for (int i = 0; i < kChains; ++i) s += simd::sum<W>(acc[i]);
+  return s;
+}
+SF_SIMD_AVX512 double fma_chains_avx512(long n) { return fma_chains<8>(n); }
+SF_SIMD_AVX2 double fma_chains_avx2(long n) { return fma_chains<4>(n); }
+double fma_chains_generic(long n) { return fma_chains<2>(n); }
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 }  // namespace
 
 std::string to_string(KernelIsa isa) {
@@ -146,6 +172,38 @@ void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, 
       break;
   }
   atb_lower_generic(n, depth, a, lda, b, ldb, c, ldc);
+}
+
+double fma_peak_gflops(double seconds) {
+  const KernelIsa isa = kernel_isa();
+  const auto run = [isa](long n) {
+    switch (isa) {
+      case KernelIsa::kAvx512:
+        return fma_chains_avx512(n);
+      case KernelIsa::kAvx2:
+        return fma_chains_avx2(n);
+      case KernelIsa::kGeneric:
+        break;
+    }
+    return fma_chains_generic(n);
+  };
+  // 2 flops a lane a multiply-add, 12 chains (fma_chains); the best of the timed rounds.
+  const double flops_per_round = 2.0 * 12 * vector_width(isa);
+  long n = 1 << 16;
+  volatile double sink = 0.0;
+  double best = 0.0, spent = 0.0;
+  while (spent < seconds || best == 0.0) {
+    const double t0 = thread_seconds();
+    sink = sink + run(n);
+    const double dt = thread_seconds() - t0;
+    spent += dt;
+    if (dt < 0.02) {
+      n *= 4;  // too short to time
+      continue;
+    }
+    best = std::max(best, flops_per_round * static_cast<double>(n) / dt / 1e9);
+  }
+  return best;
 }
 
 }  // namespace sf::linalg

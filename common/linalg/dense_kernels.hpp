@@ -40,4 +40,11 @@ int vector_width(KernelIsa isa);
 void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc);
 inline double add_atb_lower_flops(int n, int depth) { return double(n) * (n + 1) * depth; }
 
+// The calling thread's attainable double-precision rate with the vector set in use,
+// GFLOP/s: independent chains of fused multiply-adds (no memory traffic) for about
+// `seconds`, timed on the thread's processor clock. What one core can do at most with
+// kernel_isa() (both FMA units busy where the processor has two); benchmarks run it on
+// each of their threads at once and compare their kernels' rates with the sum.
+double fma_peak_gflops(double seconds = 0.2);
+
 }  // namespace sf::linalg

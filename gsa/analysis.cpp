@@ -106,10 +106,9 @@ DeformedStages run_deformed_stages(DeformedProblem& problem, const FrameAndMesh&
       };
       out.choice = choose();
       // Local relaxation: its residual test (a 100 x heavier fit missing the data coherently)
-      // only with correlated noise, since with independent noise GCV already follows sharp
-      // features and the test fires on any curved part (measured: wavy part, 0.03 mm noise,
-      // 23 elements relaxed and 1.4 x the error); under independent noise a strain test
-      // where GCV chose its heaviest weight (gsa/local_smoothing.hpp).
+      // with correlated noise; under independent noise a strain test where GCV chose its
+      // heaviest weight, elsewhere the residual test as a trial GCV must accept (it fires on
+      // any curved part: gsa/local_smoothing.hpp).
       if (so.local) out.local = relax_smoothing(problem, out.choice, out.noise, setup, und, marks, choose, correlated);
     }
     times.choice += seconds_since(tc);

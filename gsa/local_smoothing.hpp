@@ -24,6 +24,11 @@
 // a mean squared standardised in-plane component above 6 (strain_misfit_scores), is
 // where the fit's strain misses the data's own: a band narrower than the elements that
 // the heaviest weight flattens (the ARAMIS crack band, docs/usage.md "Real exports").
+// Elsewhere under independent noise steps 1-3 run as a trial: kept only where GCV, the
+// weight chosen again, falls by 6 / N or more (N marks in use), and the relaxed elements
+// are then never smoothed more than the whole part was before. A coherent feature that
+// held the global weight down (a dimple, a neck) is relaxed and the rest smoothed more;
+// on a smooth curved part (a dome) GCV refuses it. Not on noise-free marks.
 //
 // Each element's multiplier is reported with the local gauge length it gives.
 

@@ -43,7 +43,8 @@ int find_material(const FormingCase& spec, const std::string& name) {
 }
 
 const std::vector<std::string> kLawKeys = {"stiffness",  "tolerance", "viscous",  "coulomb", "stick_velocity",
-                                           "engage_gap", "points",    "two_pass", "band"};
+                                           "engage_gap", "points",    "two_pass", "band",    "tail",
+                                           "tail_reach", "stick_slip"};
 
 // The contact law keys of mapping n (those present in kLawKeys); false on a problem.
 bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseContactLaw& law) {
@@ -66,14 +67,33 @@ bool read_law(Reader& r, const YAML::Node& n, const std::string& what, CaseConta
   nonneg("viscous", "c_f, N s/mm^3", law.friction.viscous);
   nonneg("coulomb", "mu", law.friction.coulomb);
   nonneg("engage_gap", "mm", law.friction.engage_gap);
+  nonneg("tail", "S_t, N/mm^3; the normal law's tie about the band's open end", law.normal.tail);
+  nonneg("tail_reach", "mm; 0 = a linear tail", law.normal.tail_reach);
+  if (law.normal.tail > 0.0 && law.normal.augmented) {
+    r.problem(ProblemKind::kUnsupported, n["tail"], what + ": tail cannot be combined with tolerance (the augmented Lagrangian)");
+    ok = false;
+  }
   if (n["stick_velocity"].IsDefined()) {
     if (const auto v = r.positive(n["stick_velocity"], what + " stick_velocity", "mm/s"))
       law.friction.stick_velocity = *v;
     else
       ok = false;
-  } else if (law.friction.coulomb > 0.0) {
+  }
+  if (n["stick_slip"].IsDefined()) {
+    if (const auto v = r.positive(n["stick_slip"], what + " stick_slip", "mm of elastic slip before sliding"))
+      law.friction.stick_slip = *v;
+    else
+      ok = false;
+    if (n["stick_velocity"].IsDefined()) {
+      r.problem(ProblemKind::kConflict, n["stick_slip"],
+                what + ": give stick_slip (slip distance, mm) or stick_velocity (mm/s), not both");
+      ok = false;
+    }
+  }
+  if (law.friction.coulomb > 0.0 && !n["stick_velocity"].IsDefined() && !n["stick_slip"].IsDefined()) {
     r.problem(ProblemKind::kMissing, n["coulomb"],
-              what + ": Coulomb friction needs stick_velocity (mm/s, the slip rate below which it sticks)");
+              what + ": Coulomb friction needs stick_velocity (mm/s, the slip rate below which it sticks) or "
+                     "stick_slip (mm, the elastic slip before it slides)");
     ok = false;
   }
   ok = r.optional_key(n, "points", law.points, [&](const YAML::Node& v) {

@@ -118,12 +118,28 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   const Mat3 P = Mat3::Identity() - n * n.transpose();
   const Vec3 vt = P * rates.relative;
   const double eps = law.stick_velocity;
-  const double s = std::sqrt(vt.squaredNorm() + eps * eps);
-  const double mu_p = law.coulomb * p;
-  const double c = law.viscous + (law.coulomb > 0.0 ? mu_p / s : 0.0);
+  // Coulomb: the bearing pressure (the rounded penalty's, never a tail's tie: contact_law.hpp).
+  const double mu_p = law.coulomb * law.normal.bearing;
+  // The slip-distance form (PointLaw::distance): Coulomb's own relative rate (shifted by the
+  // elastic slip) and the exact return map's s = max(|v_T,c|, eps), sticking below eps.
+  const bool distance = law.distance && law.coulomb > 0.0;
+  SF_ASSERT(!(distance && out.damping.size() > 0), "contact point: the slip-distance Coulomb form is quasi-static");
+  const Vec3 wc = rates.relative + rates.coulomb_shift;
+  const Vec3 vtc = distance ? Vec3(P * wc) : vt;
+  const double s = distance ? std::max(vtc.norm(), eps) : std::sqrt(vt.squaredNorm() + eps * eps);
+  const bool sliding = !distance || vtc.norm() > eps;  // ds/dv_T,c = v_T,c / s, else 0 (stick)
+  const double c_c = law.coulomb > 0.0 ? mu_p / s : 0.0;
+  const double c = law.viscous + c_c;
   state.slip_rate = vt;
-  state.shear = -c * vt;
-  if (c != 0.0) add_jt(k, w * c, vt, out.force);
+  state.coulomb_slip_rate = vtc;
+  if (distance) {
+    state.shear = -law.viscous * vt - c_c * vtc;
+    if (law.viscous != 0.0) add_jt(k, w * law.viscous, vt, out.force);
+    if (c_c != 0.0) add_jt(k, w * c_c, vtc, out.force);
+  } else {
+    state.shear = -c * vt;
+    if (c != 0.0) add_jt(k, w * c, vt, out.force);
+  }
   if (!tangent && out.damping.size() == 0) {
     finish();
     return state;
@@ -171,16 +187,42 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
       dw.middleCols<3>(3 * cc).diagonal().setConstant(k.phi[static_cast<std::size_t>(cc)] * rates.inv_dt);
   if (!k.tool) dw -= rates.master_d1 * dzeta.row(0) + rates.master_d2 * dzeta.row(1);
   const LocalRows<3> dvt = -n.dot(rates.relative) * dn - n * (rates.relative.transpose() * dn) + P * dw;
+  LocalRows<1> dg(1, m);  // dg/du
+  if (law.coulomb > 0.0 || law.viscous_slope != 0.0)
+    for (int cc = 0; cc < k.n; ++cc)
+      dg.segment<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.gap_gradient.transpose();
+  if (distance) {
+    // Viscous on v_T, Coulomb on v_T,c = P (v_rel + shift) (the shift is state: constant):
+    //   Phi [w (c_v dv_T + v_T c_v' dg + c_c dv_T,c + v_T,c dc_c)] - R [w dzeta],
+    //   R = rho_a,l (c_v v_T + c_c v_T,c)_i,
+    //   dc_c = -(mu S_b / s) dg - [sliding] (mu p / s^3) v_T,c^T dv_T,c.
+    const LocalRows<3> dvtc = -n.dot(wc) * dn - n * (wc.transpose() * dn) + P * dw;
+    LocalRows<1> dc = (-law.coulomb * law.normal.bearing_stiffness / s) * dg;
+    if (sliding) dc -= (mu_p / (s * s * s)) * (vtc.transpose() * dvtc);
+    LocalRows<3> phi_part = law.viscous * dvt + c_c * dvtc;
+    phi_part.noalias() += vtc * dc;
+    if (law.viscous_slope != 0.0) phi_part.noalias() += vt * (law.viscous_slope * dg);
+    V.leftCols<3>() += w * phi_part.transpose();
+    if (!k.tool) {
+      const Vec3 r = law.viscous * vt + c_c * vtc;
+      for (int a = 0; a < k.n; ++a) {
+        const auto ia = static_cast<std::size_t>(a);
+        U.block<3, 2>(3 * a, 5) = r * Vec2(k.rho1[ia], k.rho2[ia]).transpose();
+      }
+      V.middleCols<2>(5) -= w * dzeta.transpose();
+    }
+    stiff = true;
+    finish();
+    return state;
+  }
   // Friction stiffness w [ (J^T v_T) dc/du + c J^T dv_T/du + c (dJ^T/du) v_T ]
   //   = Phi [w (v_T dc + c dv_T)] - R [w c dzeta]   (R = rho_a,l (v_T)_i: body only).
   LocalRows<3> phi_part = c * dvt;
   if (law.coulomb > 0.0 || law.viscous_slope != 0.0) {
-    LocalRows<1> dg(1, m);  // dg/du
-    for (int cc = 0; cc < k.n; ++cc)
-      dg.segment<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.gap_gradient.transpose();
     // dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du, dp/du = -S dg/du.
     LocalRows<1> dc = law.viscous_slope * dg;
-    if (law.coulomb > 0.0) dc += (-law.coulomb * S / s) * dg - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
+    if (law.coulomb > 0.0)
+      dc += (-law.coulomb * law.normal.bearing_stiffness / s) * dg - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
     phi_part.noalias() += vt * dc;
   }
   V.leftCols<3>() += w * phi_part.transpose();

@@ -38,6 +38,12 @@
 //     dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du,  dp/du = -S dg/du,
 //       c_v' = d(c_f h)/dg, the engagement taper of the viscous layer (PointLaw);
 //   damping (dynamic runs)  w [ (J^T v_T) dc/dv + c J^T P J ],  dc/dv = -(mu p/s^3) v_T^T J.
+//   Slip-distance Coulomb (quasi-static): Coulomb acts on v_T,c = P (v_rel + e / dt), e the
+//   committed elastic slip, with s = max(|v_T,c|, eps), eps = the slip distance / dt: the
+//   traction -mu p v_T,c / s is -mu p P(e + du) / max(|P(e + du)|, d) (stick: an elastic
+//   spring mu p / d; slip: mu p along the slip), the same terms with v_T,c and
+//   dv_T,c/du = -(n . w_c) dn/du - n (w_c^T dn/du) + P dv_rel/du (w_c = v_rel + e / dt),
+//   and the s^-3 term only while sliding (|v_T,c| > eps); the viscous part keeps v_T.
 // Every term is tested against central finite differences of the force
 // (tests/verification/contact_tangent_test.cpp).
 //
@@ -72,6 +78,9 @@ struct PointRates {
   double inv_dt = 0.0;            // quasi-static: 1 / (t - t_prev); dynamic: 0
   Vec3 master_d1 = Vec3::Zero();  // m_1, m_2: d v_m / d zeta (body master only)
   Vec3 master_d2 = Vec3::Zero();
+  // Slip-distance Coulomb (PointLaw::distance): the committed elastic slip over the step,
+  // e / dt (mm/s), added to v_rel for the Coulomb term only (state: no derivative).
+  Vec3 coulomb_shift = Vec3::Zero();
 };
 
 struct PointLaw {
@@ -79,7 +88,10 @@ struct PointLaw {
   double viscous = 0.0;         // c_f h(g): c_f where engaged, tapering to 0 (surface_contact.hpp)
   double viscous_slope = 0.0;   // d viscous / d g, N s/mm^4 (<= 0 in the taper, else 0)
   double coulomb = 0.0;         // mu
-  double stick_velocity = 0.0;  // eps, mm/s
+  double stick_velocity = 0.0;  // eps, mm/s (slip-distance form: the slip distance / dt)
+  // Coulomb regularised by slip distance (FrictionLaw::stick_slip): the return map's
+  // c = mu p / max(|v_T,c|, eps) on v_T,c = P (v_rel + shift), not mu p / sqrt(|v_T|^2 + eps^2).
+  bool distance = false;
   bool friction() const { return viscous > 0.0 || coulomb > 0.0; }
 };
 
@@ -115,6 +127,7 @@ struct PointState {
   double pressure = 0.0;          // MPa
   Vec3 slip_rate = Vec3::Zero();  // v_T, mm/s
   Vec3 shear = Vec3::Zero();      // friction traction on the slave, -c v_T, MPa
+  Vec3 coulomb_slip_rate = Vec3::Zero();  // v_T,c (slip-distance form; = v_T otherwise), mm/s
 };
 
 PointState add_contact_point(const PointKinematics& k, const PointLaw& law, const PointRates& rates, double weight,

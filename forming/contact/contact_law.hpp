@@ -17,6 +17,19 @@
 //   touch exactly (stacked plies, g = 0) have p = S_n delta / 8 and stiffness S_n / 2,
 //   so they are held from the first iteration and come apart by delta / 2 at rest.
 //   delta = 1e-3 x the ply thickness (forming/contact/surface_contact.cpp).
+//   Tail (optional, `tail: S_t` in a case, N/mm^3; `tail_reach: r`, mm): at the band's open
+//   end (t = -b/2) the rounded law has p = 0 AND dp = 0, a double root: a point resting
+//   there (a ply in a free span, touching nothing but its neighbour) is one Newton cannot
+//   place, and converges linearly at best. The tail adds a weak spring about the open end,
+//   with x = (t + b/2) / S_n (mm; > 0 inside the open end):
+//     p_t = S_t x,  energy S_t x^2 / 2                        (r = 0: linear),
+//     p_t = S_t r tanh(x / r),  energy S_t r^2 log cosh(x / r) (r > 0: tension and
+//                                                               pressure bounded by S_t r),
+//   so the stiffness is S_t > 0 (S_t sech^2(x / r)) at every gap within the search
+//   distance and the open end is a simple root. Beyond the open end p < 0: a weak tie
+//   (the tack of the molten resin) that holds a ply to its neighbour where nothing presses
+//   them together. Friction (Coulomb) and the augmented multiplier take the rounded
+//   penalty's part only (`bearing`), never the tie's.
 //
 // Tangential (Christie 1997; notes/forming-verification.md section 3.4): with v_T the
 // tangential slip rate (slave relative to master, projected on the master's tangent
@@ -32,6 +45,14 @@
 // unit area); both together = the combined (hydrodynamic) law. Rates come from the
 // velocities (dynamic runs) or from finite differences over the step (quasi-static runs
 // with a process time).
+// Coulomb regularised by slip DISTANCE instead (`stick_slip: d`, mm; quasi-static runs):
+// an elastic stick with a return map, rate- and step-independent. Each contact point keeps
+// its committed elastic slip e (tangential, mm); with du_T the step's tangential relative
+// displacement and s = P (e + du), the traction is
+//   t_T = -mu p s / max(|s|, d)   (stick while |s| <= d: a spring mu p / d; slip: mu p),
+// and at each commit e <- s d / max(|s|, d) (|e| <= d). The velocity form above instead
+// sticks below a slip of eps dt a step, which shrinks with every cut-back and restarts
+// from zero traction at every step.
 //
 // Units: mm, N, s, MPa.
 #include <string>
@@ -42,6 +63,8 @@ struct NormalLaw {
   double stiffness = 0.0;  // S_n, N/mm^3 (> 0)
   bool augmented = false;  // augmented Lagrangian (Uzawa) on top of the penalty
   double tolerance = 0.0;  // mm, augmented: largest penetration accepted (> 0)
+  double tail = 0.0;       // S_t, N/mm^3 (>= 0; 0: no tail, the plain rounded law)
+  double tail_reach = 0.0; // r, mm (>= 0; 0: the linear tail)
   // Throws sf::InputError naming the field ("contact normal stiffness: ...").
   void validate() const;
 };
@@ -49,7 +72,8 @@ struct NormalLaw {
 struct FrictionLaw {
   double viscous = 0.0;         // c_f, N s/mm^3 (>= 0)
   double coulomb = 0.0;         // mu (>= 0)
-  double stick_velocity = 0.0;  // eps, mm/s (> 0 when coulomb > 0)
+  double stick_velocity = 0.0;  // eps, mm/s (> 0 when coulomb > 0, unless stick_slip is given)
+  double stick_slip = 0.0;      // d, mm: > 0 regularises Coulomb by slip distance instead (below)
   double engage_gap = -1.0;     // g_v, mm; < 0: the default, 0.01 x the ply thickness
   bool active() const { return viscous > 0.0 || coulomb > 0.0; }
   void validate() const;
@@ -59,9 +83,11 @@ struct FrictionLaw {
 
 // What the normal law gives at a gap.
 struct NormalResponse {
-  double pressure = 0.0;   // p, MPa (>= 0)
+  double pressure = 0.0;   // p, MPa (>= 0 without a tail; < 0, a tie, beyond the open end with one)
   double energy = 0.0;     // per unit reference area, N/mm
-  double stiffness = 0.0;  // dp/d(-g), N/mm^3: S_n where closed, 0 where open, between in the band
+  double stiffness = 0.0;  // dp/d(-g), N/mm^3: S_n where closed, 0 where open, between in the band (+ the tail's)
+  double bearing = 0.0;    // the rounded penalty's part of p (>= 0; = p without a tail), MPa
+  double bearing_stiffness = 0.0;  // its d/d(-g), N/mm^3
 };
 
 // p, energy and stiffness at gap g (mm) with multiplier lambda (MPa; 0 for the plain

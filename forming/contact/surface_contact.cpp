@@ -103,6 +103,8 @@ SurfaceContact::SurfaceContact(std::string name, const Model& model, ContactSurf
   }
   lambda_.assign(weight_.size(), 0.0);
   slip_.assign(weight_.size(), Vec3::Zero());
+  elastic_.assign(weight_.size(), Vec3::Zero());
+  elastic_before_ = elastic_;
 }
 
 double SurfaceContact::engage_gap() const {
@@ -125,6 +127,15 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
     rates = &rate_storage;
   }
   const bool friction = options_.friction.active() && rates;
+  // Coulomb regularised by slip distance (contact_law.hpp): quasi-static rates only.
+  const bool distance = options_.friction.coulomb > 0.0 && options_.friction.stick_slip > 0.0;
+  if (distance && context.velocity)
+    throw InputError("contact " + name_ +
+                     ": stick_slip (Coulomb friction regularised by slip distance) needs a quasi-static run; give "
+                     "stick_velocity (mm/s) for a dynamic one");
+  // The elastic slip the evaluated step started from: a step already committed (its
+  // outputs are sampled after the commit) started from the e before that commit.
+  const std::vector<Vec3>& elastic = context.previous_time < committed_time_ ? elastic_before_ : elastic_;
   const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
   const double band = options_.band > 0.0 ? options_.band : kBand * slave_.thickness();
   const double engage = engage_gap();
@@ -195,16 +206,21 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
         pr.inv_dt = inv_dt;
         pr.master_d1 = partner.velocity_d1;
         pr.master_d2 = partner.velocity_d2;
+        if (distance) {  // in rate terms: eps = d / dt, the elastic slip as a rate e / dt
+          law.distance = true;
+          law.stick_velocity = options_.friction.stick_slip * inv_dt;
+          pr.coulomb_shift = elastic[id] * inv_dt;
+        }
       }
       rec.partner = true;
       rec.gap = k.gap;
       rec.normal = k.normal;
       if (tracing) {
-        status[id] = law.normal.pressure <= 0.0 ? 0 : law.normal.stiffness >= options_.normal.stiffness ? 2 : 1;
+        status[id] = law.normal.bearing <= 0.0 ? 0 : law.normal.bearing_stiffness >= options_.normal.stiffness ? 2 : 1;
         where[id] = Eigen::Vector4d(xs.x(), xs.y(), xs.z(), k.gap);
       }
-      const bool contributes = law.normal.pressure > 0.0 || law.normal.stiffness > 0.0 ||
-                               (pr.have && (law.viscous > 0.0 || (law.coulomb > 0.0 && law.normal.pressure > 0.0)));
+      const bool contributes = law.normal.pressure != 0.0 || law.normal.stiffness > 0.0 ||
+                               (pr.have && (law.viscous > 0.0 || (law.coulomb > 0.0 && law.normal.bearing > 0.0)));
       if (!contributes) {
         if (records) records->push_back(rec);
         continue;
@@ -240,6 +256,12 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
         rec.pressure = st.pressure;
         rec.slip_rate = st.slip_rate;
         rec.shear = st.shear;
+        // The elastic slip this state would commit: s d / max(|s|, d), s = v_T,c dt.
+        if (law.distance && law.normal.bearing > 0.0) {
+          const Vec3 sl = st.coulomb_slip_rate / inv_dt;
+          const double d = options_.friction.stick_slip;
+          rec.elastic_slip = sl * (d / std::max(sl.norm(), d));
+        }
         // The tangential relative displacement since the previous state (commit).
         if (context.previous) {
           const Vec3 d = dxs - partner.displacement;
@@ -346,9 +368,13 @@ void SurfaceContact::commit(const Eigen::Ref<const VecX>& x, const InteractionCo
       for (std::size_t i = 0; i < rec.size(); ++i) shear_[i] = rec[i].shear;
     }
   }
+  // A step committed twice (its e already moved on) keeps the e it started from.
+  if (!(context.previous_time < committed_time_)) elastic_before_ = elastic_;
+  committed_time_ = context.time;
   for (std::size_t i = 0; i < rec.size(); ++i) {
     const Vec3 traction = dynamic ? Vec3(0.5 * (shear_[i] + rec[i].shear)) : rec[i].shear;
     if (dynamic) shear_[i] = rec[i].shear;
+    elastic_[i] = rec[i].elastic_slip;
     if (!rec[i].partner) continue;
     slip_[i] += rec[i].slip;  // the increment over the step
     dissipated_ += (options_.half_pass ? 0.5 : 1.0) * rec[i].weight * (-traction).dot(rec[i].slip);

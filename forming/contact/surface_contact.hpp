@@ -25,8 +25,9 @@
 // penalty energy and half the friction dissipation, so the pair's sums are comparable
 // with one pass.
 //
-// State per contact point: the augmented-Lagrangian multiplier lambda (MPa) and the
-// accumulated slip (mm, a vector: the sum over committed steps of the tangential
+// State per contact point: the augmented-Lagrangian multiplier lambda (MPa), with
+// `stick_slip` the elastic slip e of the slip-distance Coulomb law (mm, contact_law.hpp;
+// zero where the point bears no pressure), and the accumulated slip (mm, a vector: the sum over committed steps of the tangential
 // relative displacement P J du over the step), and per pair the friction dissipation
 // (N mm: the sum over committed steps of w t . du_T, t the friction traction -c v_T:
 // in quasi-static runs the step's own traction, whose rate is the difference over the
@@ -82,6 +83,7 @@ struct ContactPointRecord {
   Vec3 slip_rate = Vec3::Zero();  // mm/s
   Vec3 shear = Vec3::Zero();      // friction traction on the slave, MPa
   Vec3 slip = Vec3::Zero();       // accumulated (committed), mm
+  Vec3 elastic_slip = Vec3::Zero();  // slip-distance Coulomb: the elastic slip e this state commits, mm
   double weight = 0.0;            // mm^2
 };
 
@@ -153,6 +155,11 @@ class SurfaceContact : public Interaction {
   std::vector<double> weight_;                             // per point: Gauss weight x reference area
   std::vector<double> lambda_;                             // per point, MPa
   std::vector<Vec3> slip_;                                 // per point, mm
+  std::vector<Vec3> elastic_;                              // per point: committed elastic slip e, mm (stick_slip)
+  // e before the last commit and that commit's time: a state of the committed step (its
+  // outputs, reactions, sampled after the commit) is evaluated from the e it started with.
+  std::vector<Vec3> elastic_before_;
+  double committed_time_ = -1e300;
   std::vector<Vec3> shear_;                                // per point at the last commit (dynamic runs), MPa
   bool shear_known_ = false;                               // shear_ holds the last committed state
   double dissipated_ = 0.0;

@@ -162,6 +162,20 @@ TEST(LaminateCase, BadContactInputIsReportedWithItsPlace) {
   p = only_problem("radius: 10}", "radius: 0}");
   EXPECT_EQ(p.kind, ProblemKind::kOutOfRange);
   EXPECT_EQ(p.place.line, 13);
+
+  // The normal law's tail and the slip-distance Coulomb form (contact_law.hpp).
+  p = only_problem("interface: {stiffness: 100", "interface: {tail: -0.1, stiffness: 100");
+  EXPECT_EQ(p.kind, ProblemKind::kOutOfRange);
+  EXPECT_NE(p.message.find("tail"), std::string::npos) << p.message;
+  p = only_problem("interface: {stiffness: 100", "interface: {tail: 0.1, tolerance: 0.001, stiffness: 100");
+  EXPECT_EQ(p.kind, ProblemKind::kUnsupported);
+  p = only_problem(", stick_velocity: 0.01", ", stick_velocity: 0.01, stick_slip: 0.001");
+  EXPECT_EQ(p.kind, ProblemKind::kConflict);
+  EXPECT_NE(p.message.find("stick_slip"), std::string::npos) << p.message;
+  const CaseCheck ok = check_case_text(
+      std::string(kGood).replace(std::string(kGood).find(", stick_velocity: 0.01"), 22, ", stick_slip: 0.001"),
+      "slip.yaml");
+  ASSERT_TRUE(ok.ok()) << ok.located(0);
 }
 
 TEST(LaminateCase, StlToolsMissingOrMalformed) {

@@ -7,6 +7,9 @@
 //    and stiffness S_n / 2 where the surfaces just touch (g = 0, lambda = 0);
 //  * the energy is continuous across the band's ends too (a potential, so the Newton
 //    tangent of a frictionless tool contact is symmetric).
+//  * the tail (a weak spring about the open end): its pressure and stiffness the
+//    derivatives of its energy, stiffness > 0 at every gap, p = 0 with stiffness S_t at
+//    the open end (a simple root), the bearing part the plain law's.
 // Why: the dome's Newton iterations were suspected to cycle through a jump of the law
 // at the band's ends (data/forming/processes/notes/studies.md); these pin the law's smoothness.
 #include <gtest/gtest.h>
@@ -14,6 +17,7 @@
 #include <cmath>
 #include <vector>
 
+#include "common/core/error.hpp"
 #include "forming/contact/contact_law.hpp"
 
 namespace sf::forming {
@@ -83,6 +87,64 @@ TEST(ContactLaw, C1AcrossTheBandsEnds) {
   const NormalResponse touch = normal_response(law, 0.0, 0.0, kBand);
   EXPECT_NEAR(touch.pressure, kS * kBand / 8.0, 1e-12);
   EXPECT_NEAR(touch.stiffness, kS / 2.0, 1e-12);
+}
+
+// The tail (contact_law.hpp): a weak spring about the band's open end, so that pressure and
+// stiffness no longer vanish together there (the double root behind the dome's
+// crawling Newton iterations, data/forming/processes/notes/dome_0_90s.md).
+NormalLaw with_tail(double tail, double reach) {
+  NormalLaw law = penalty();
+  law.tail = tail;
+  law.tail_reach = reach;
+  return law;
+}
+
+TEST(ContactLaw, TailIsTheDerivativeOfItsEnergyWithStiffnessEverywhere) {
+  constexpr double kTail = 0.05;  // N/mm^3 (1e-3 S_n)
+  for (double reach : {0.0, 0.02}) {
+    const NormalLaw law = with_tail(kTail, reach);
+    std::vector<double> gaps = gaps_across(0.0);
+    for (double g : {0.01, 0.05, 0.3}) gaps.push_back(g);  // well beyond the open end
+    for (double g : gaps) {
+      const NormalResponse r = normal_response(law, g, 0.0, kBand);
+      const NormalResponse rp = normal_response(law, g + kH, 0.0, kBand);
+      const NormalResponse rm = normal_response(law, g - kH, 0.0, kBand);
+      EXPECT_NEAR(r.pressure, -(rp.energy - rm.energy) / (2 * kH), kFdRel * kS * kBand) << "reach " << reach << " g " << g;
+      EXPECT_NEAR(r.stiffness, -(rp.pressure - rm.pressure) / (2 * kH), kFdRel * kS) << "reach " << reach << " g " << g;
+      // The bearing part is the plain law's, the tail's the rest.
+      const NormalResponse plain = normal_response(penalty(), g, 0.0, kBand);
+      EXPECT_EQ(r.bearing, plain.pressure);
+      EXPECT_EQ(r.bearing_stiffness, plain.stiffness);
+      EXPECT_GT(r.stiffness, 0.0) << "reach " << reach << " g " << g;  // never a flat spot
+      if (g > 0.5 * kBand) {
+        EXPECT_LT(r.pressure, 0.0) << "beyond the open end: a tie";
+      }
+    }
+    // The open end is a simple root: p = 0, stiffness S_t.
+    const NormalResponse open = normal_response(law, 0.5 * kBand, 0.0, kBand);
+    EXPECT_NEAR(open.pressure, 0.0, 1e-15);
+    EXPECT_NEAR(open.stiffness, kTail, 1e-12);
+    // The bounded tail: the tie never exceeds S_t r; the linear one grows with the gap.
+    if (reach > 0.0) {
+      EXPECT_GT(normal_response(law, 10.0, 0.0, kBand).pressure, -kTail * reach * (1 + 1e-12));
+      EXPECT_NEAR(normal_response(law, 10.0, 0.0, kBand).pressure, -kTail * reach, 1e-9);
+    } else {
+      EXPECT_NEAR(normal_response(law, 1.0, 0.0, kBand).pressure, -kTail * (1.0 - 0.5 * kBand), 1e-12);
+    }
+  }
+}
+
+TEST(ContactLaw, TailIsRejectedWhereItCannotWork) {
+  NormalLaw law = with_tail(-1.0, 0.0);
+  EXPECT_THROW(law.validate(), InputError);
+  law = with_tail(0.1, -0.01);
+  EXPECT_THROW(law.validate(), InputError);
+  law = with_tail(0.1, 0.0);
+  law.augmented = true;
+  law.tolerance = 1e-3;
+  EXPECT_THROW(law.validate(), InputError);
+  law.augmented = false;
+  EXPECT_NO_THROW(law.validate());
 }
 
 }  // namespace

@@ -112,12 +112,12 @@ struct TwoPlies {
   VecX x;
 };
 
-TwoPlies two_plies(unsigned seed) {
+TwoPlies two_plies(unsigned seed, double upper_z = 0.95) {
   TwoPlies t;
   const auto law = fixtures::neo_hookean(1.0, 1.0);
   t.model.add_ply(fixtures::rectangle_ply(10.0, 8.0, 1.0, 2, 2), law);
   t.model.add_ply(
-      PlyMesh(mesh::make_rectangle_mesh(Vec3(-0.5, -0.5, 0.95), Vec3::UnitX(), Vec3::UnitY(), 11.0, 9.0, 3, 3), 1.0,
+      PlyMesh(mesh::make_rectangle_mesh(Vec3(-0.5, -0.5, upper_z), Vec3::UnitX(), Vec3::UnitY(), 11.0, 9.0, 3, 3), 1.0,
               30.0),
       law);
   t.x = t.model.reference_positions();
@@ -192,6 +192,44 @@ TEST(ContactTangent, PlyPlyFrictionQuasiStatic) {
   }
 }
 
+// Coulomb regularised by slip distance (contact_law.hpp, stick_slip): sliding (d well
+// below the step's slip of ~0.05 mm) and sticking (d well above it), alone and with the
+// viscous layer, first from no elastic slip and then after a commit has left one at every
+// point (the shift e / dt of the kernel), so both the return map's branches and the state
+// are exercised.
+TEST(ContactTangent, PlyPlyCoulombBySlipDistance) {
+  TwoPlies t = two_plies(test::kSeed + 26);
+  VecX previous;
+  const InteractionContext ctx = quasi_static(t, previous, 0.05);
+  struct Case {
+    const char* name;
+    double viscous, d;
+  };
+  for (const Case& cs : {Case{"slip", 0.0, 0.005}, Case{"stick", 0.0, 0.5}, Case{"viscous + slip", 0.02, 0.005},
+                         Case{"viscous + stick", 0.02, 0.5}}) {
+    ContactOptions o = options(cs.viscous, 0.3, 0);
+    o.friction.stick_slip = cs.d;
+    const auto c = ply_contact(t.model, o);
+    const Errors e0 = finite_differences(*c, t.model.n_dofs(), t.x, ctx, false);
+    double largest = 0.0;
+    for (const ContactPointRecord& r : c->sample(t.x, ctx)) largest = std::max(largest, r.elastic_slip.norm());
+    EXPECT_GT(largest, 0.5 * std::min(cs.d, 0.04)) << cs.name;
+    EXPECT_LE(largest, cs.d * (1 + 1e-12)) << cs.name;
+    c->commit(t.x, ctx);  // e = s d / max(|s|, d) at every point
+    // The next step: the lower ply slides on by 0.02 mm across the first slip.
+    VecX next = t.x;
+    for (Index node = 0; node < t.model.ply(0).n_nodes(); ++node) {
+      next(t.model.dof(0, node, 0, 0)) -= 0.004;
+      next(t.model.dof(0, node, 0, 1)) += 0.02;
+    }
+    const Errors e1 = finite_differences(*c, t.model.n_dofs(), next, InteractionContext{1.1, nullptr, &t.x, 1.0}, false);
+    EXPECT_LT(e0.stiffness, kFdRel) << cs.name;
+    EXPECT_LT(e1.stiffness, kFdRel) << cs.name;
+    std::printf("ply-ply Coulomb by slip distance, %s: FD stiffness %.1e (no elastic slip), %.1e (after a commit)\n",
+                cs.name, e0.stiffness, e1.stiffness);
+  }
+}
+
 TEST(ContactTangent, PlyPlyFrictionDynamic) {
   TwoPlies t = two_plies(test::kSeed + 23);
   VecX v = VecX::Zero(t.x.size());
@@ -207,6 +245,43 @@ TEST(ContactTangent, PlyPlyFrictionDynamic) {
     EXPECT_LT(e.damping, kFdRel) << o.friction.describe();
     std::printf("ply-ply %s (dynamic): FD stiffness %.1e, FD damping %.1e\n", o.friction.describe().c_str(),
                 e.stiffness, e.damping);
+  }
+}
+
+// The normal law's tail (contact_law.hpp): the upper ply lifted so that the points
+// spread from penetrating through the rounded band to well beyond its open end (only
+// the tail acts there); frictionless (a potential: energy, force and a symmetric
+// tangent) and with Coulomb friction, which takes the bearing pressure only.
+TEST(ContactTangent, PlyPlyNormalLawTailAcrossTheBand) {
+  TwoPlies t = two_plies(test::kSeed + 25, 1.01);
+  VecX previous;
+  const InteractionContext ctx = quasi_static(t, previous, 0.05);
+  for (double reach : {0.0, 0.01}) {
+    ContactOptions o = options(0, 0, 0);
+    o.normal.tail = 2.0;
+    o.normal.tail_reach = reach;
+    o.band = 0.01;
+    const auto c = ply_contact(t.model, o);
+    int tie = 0, bearing = 0;
+    for (const ContactPointRecord& r : c->sample(t.x, {})) {
+      ASSERT_TRUE(r.partner);
+      tie += r.gap > 0.5 * o.band;
+      bearing += r.gap < 0.5 * o.band;
+    }
+    EXPECT_GT(tie, 20);  // both regimes well represented
+    EXPECT_GT(bearing, 20);
+    const Errors e = finite_differences(*c, t.model.n_dofs(), t.x, {}, true);
+    EXPECT_LT(e.stiffness, kFdRel) << "reach " << reach;
+    EXPECT_LT(e.energy, kFdRel) << "reach " << reach;
+    const MatX K = evaluate(*c, t.model.n_dofs(), t.x, {}, true).stiffness;
+    EXPECT_LT(max_abs(K - K.transpose()), 1e-12 * max_abs(K));
+    o.friction.coulomb = 0.3;
+    o.friction.stick_velocity = 0.05;
+    const auto f = ply_contact(t.model, o);
+    const Errors ef = finite_differences(*f, t.model.n_dofs(), t.x, ctx, false);
+    EXPECT_LT(ef.stiffness, kFdRel) << "reach " << reach;
+    std::printf("ply-ply tail (reach %g; %d tie, %d bearing points): FD stiffness %.1e, FD force %.1e, with "
+                "Coulomb %.1e\n", reach, tie, bearing, e.stiffness, e.energy, ef.stiffness);
   }
 }
 
@@ -322,6 +397,19 @@ TEST(ContactTangent, PlyToolNormalAndFriction) {
       EXPECT_LT(ed.damping, kFdRel) << tool.name << " " << o.friction.describe();
       std::printf("ply-tool %s %s: quasi-static FD stiffness %.1e; dynamic %.1e, damping %.1e\n", tool.name.c_str(),
                   o.friction.describe().c_str(), eq.stiffness, ed.stiffness, ed.damping);
+    }
+    for (double d : {1e-4, 0.1}) {  // slip (the step slides 0.01 mm), stick
+      ContactOptions o = options(0.02, 0.3, 0);
+      o.friction.stick_slip = d;
+      const auto c = std::make_shared<ToolContact>("f", t.model, ContactSurface::whole_face(t.model, 0, true), tool, o);
+      c->commit(t.x, qs);  // the next step from an elastic slip: the ply moved on by 0.005 mm along y
+      VecX next = t.x;
+      for (Index i = 1; i < next.size(); i += 3) next(i) += 0.005;
+      const Errors eq =
+          finite_differences(*c, t.model.n_dofs(), next, InteractionContext{1.05, nullptr, &t.x, 1.0}, false);
+      EXPECT_LT(eq.stiffness, kFdRel) << tool.name << " " << o.friction.describe();
+      std::printf("ply-tool %s %s: quasi-static FD stiffness %.1e\n", tool.name.c_str(), o.friction.describe().c_str(),
+                  eq.stiffness);
     }
   }
 }

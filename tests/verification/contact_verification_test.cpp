@@ -134,7 +134,8 @@ TEST(ContactPatch, TwoHalfPassesTransmitTheUniformPressureAcrossNonMatchingMeshe
 
 // A 10 x 10 x 1 block on a plane tool sliding at v = 2 mm/s along x under the block,
 // whose x0 edge is clamped; `loads` on it. Returns the tool's force at the end.
-Vec3 sliding_block_force(const std::string& law, const std::string& loads, CaseRun& r) {
+Vec3 sliding_block_force(const std::string& law, const std::string& loads, CaseRun& r, double speed = 2.0,
+                         int steps = 3) {
   run(R"(
 materials:
   block: {neo_hookean: {E: 10000, nu: 0.3}}
@@ -143,7 +144,8 @@ plies:
 tools:
   - name: table
     plane: {point: [0, 0, 0], normal: [0, 0, 1]}
-    motion: {velocity: [2, 0, 0]}
+    motion: {velocity: [)" +
+          std::to_string(speed) + R"(, 0, 0]}
 contact:
   - {ply: b, face: bottom, tool: table, stiffness: 1000, )" +
           law + R"(}
@@ -151,7 +153,8 @@ boundary_conditions:
   - clamp: {ply: b, edge: x0}
 )" + loads +
           R"(
-solver: {steps: 3, process_time: 0.3, tolerance: 1.0e-10}
+solver: {steps: )" + std::to_string(steps) +
+          R"(, process_time: 0.3, tolerance: 1.0e-10}
 )",
       r);
   const auto& c = dynamic_cast<const SurfaceContact&>(r.problem.model.interaction(0));
@@ -180,6 +183,36 @@ TEST(SlidingBlock, CoulombForceIsMuN) {
   EXPECT_NEAR(-F.x(), 0.3 * N, 1e-5 * 0.3 * N);
   std::printf("sliding block, Coulomb: F = %.8g N, mu N = %.8g N (N = %.6g N), relative error %.2e\n", -F.x(), 0.3 * N,
               N, std::abs(-F.x() - 0.3 * N) / (0.3 * N));
+}
+
+// Coulomb regularised by slip distance (stick_slip, contact_law.hpp): sliding, the drag is
+// mu N exactly (the return map's slip branch); sticking (the table creeps 3e-4 mm under
+// the block, d = 1e-3 mm), the drag is the elastic stick's and the same whatever the
+// number of steps (rate- and step-independent). The velocity form instead restarts each
+// step from no traction, so its drag depends on the step: printed for comparison.
+TEST(SlidingBlock, CoulombBySlipDistanceIsMuNSlidingAndStepIndependentSticking) {
+  const std::string load = "loads:\n  - pressure: {ply: b, face: top, value: 0.2}";
+  CaseRun r;
+  const Vec3 F = sliding_block_force("coulomb: 0.3, stick_slip: 0.001", load, r);
+  const double N = -F.z();
+  EXPECT_NEAR(-F.x(), 0.3 * N, 1e-9 * 0.3 * N);
+  std::printf("sliding block, Coulomb by slip distance: F = %.10g N, mu N = %.10g N, relative error %.2e\n", -F.x(),
+              0.3 * N, std::abs(-F.x() - 0.3 * N) / (0.3 * N));
+  double stick[2], velocity[2];
+  const int steps[2] = {3, 7};
+  for (int i = 0; i < 2; ++i) {
+    CaseRun a, b;
+    stick[i] = -sliding_block_force("coulomb: 0.3, stick_slip: 0.001", load, a, 0.001, steps[i]).x();
+    velocity[i] = -sliding_block_force("coulomb: 0.3, stick_velocity: 0.0033", load, b, 0.001, steps[i]).x();
+  }
+  // Sticking: a fraction of mu N (the slip 3e-4 mm against d = 1e-3 mm, less the block's
+  // own shear), the same in 3 and 7 steps.
+  EXPECT_GT(stick[0], 0.1 * 0.3 * N);
+  EXPECT_LT(stick[0], 0.35 * 0.3 * N);
+  EXPECT_NEAR(stick[1], stick[0], 1e-6 * stick[0]);
+  std::printf("creeping table (3e-4 mm): stick_slip 1e-3 mm: %.8g N (3 steps), %.8g N (7 steps); stick_velocity "
+              "3.3e-3 mm/s: %.8g N, %.8g N\n",
+              stick[0], stick[1], velocity[0], velocity[1]);
 }
 
 TEST(AugmentedLagrangian, DrivesThePenetrationUnderItsTolerance) {

@@ -792,11 +792,6 @@ void read_document(Reader& r, const YAML::Node& root, const std::string& case_di
   if (const YAML::Node o = root["output"]; o.IsDefined()) read_output(r, o, spec.output);
 }
 
-// Solver keys a --restart may change (forming/output/restart.hpp; docs/forming.md
-// "Commands"): how the steps are solved, not the problem, its steps or its process time.
-const std::set<std::string> kRestartSolverKeys = {"max_iterations", "tolerance", "min_increment", "line_search",
-                                                  "predictor", "linear", "branch_switch"};
-
 // The values of `node` under `path`, flattened in file order (see FormingCase::fingerprint).
 void flatten(const YAML::Node& node, const std::string& path, std::vector<std::pair<std::string, std::string>>& out) {
   if (case_yaml::is_map(node)) {
@@ -804,10 +799,9 @@ void flatten(const YAML::Node& node, const std::string& path, std::vector<std::p
       const std::string key = case_yaml::is_scalar(it->first) ? it->first.Scalar() : "?";
       if (path.empty() && key == "output") continue;  // output settings may change for a restart
       // and so may the solver keys that steer how a step is solved, not what is solved
-      // (kRestartSolverKeys: a run that stalled goes on with more iterations, a smaller
-      // min_increment or branch switching from the restart's step onwards)
-      if (path == "solver" && kRestartSolverKeys.count(key)) continue;
-      if (path == "solver.stabilise" && key == "warn_ratio") continue;
+      // (a run that stalled goes on with more iterations, a smaller min_increment or
+      // branch switching from the restart's step onwards)
+      if (restart_may_change(path.empty() ? key : path + "." + key)) continue;
       flatten(it->second, path.empty() ? key : path + "." + key, out);
     }
   } else if (case_yaml::is_sequence(node)) {
@@ -889,6 +883,16 @@ CaseCheck check_case_file(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return check_case_text(ss.str(), path);
+}
+
+bool restart_may_change(const std::string& key) {
+  static const std::set<std::string> solver = {"max_iterations", "tolerance", "min_increment", "line_search",
+                                               "predictor",      "linear",    "branch_switch"};
+  const std::string prefix = "solver.";
+  if (key.compare(0, prefix.size(), prefix) != 0) return false;
+  const std::string rest = key.substr(prefix.size());
+  if (rest == "stabilise.warn_ratio") return true;
+  return solver.count(rest.substr(0, rest.find('.'))) > 0;
 }
 
 FormingCase load_case(const std::string& path) {

@@ -26,7 +26,8 @@ std::string model_fingerprint(const FormingCase& spec, const Model& model) {
 // ("materials.carbon.E_T: 1000 -> 2000"), at most a few, or "" when nothing did.
 std::string case_changes(const nlohmann::json& then, const std::vector<std::pair<std::string, std::string>>& now) {
   std::map<std::string, std::string> before, after(now.begin(), now.end());
-  for (const auto& e : then) before[e.at(0).get<std::string>()] = e.at(1).get<std::string>();
+  for (const auto& e : then)
+    if (!restart_may_change(e.at(0).get<std::string>())) before[e.at(0).get<std::string>()] = e.at(1).get<std::string>();
   std::vector<std::string> changes;
   for (const auto& [key, value] : before) {
     const auto it = after.find(key);

@@ -26,8 +26,10 @@ std::string model_fingerprint(const FormingCase& spec, const Model& model) {
 // ("materials.carbon.E_T: 1000 -> 2000"), at most a few, or "" when nothing did.
 std::string case_changes(const nlohmann::json& then, const std::vector<std::pair<std::string, std::string>>& now) {
   std::map<std::string, std::string> before, after(now.begin(), now.end());
-  for (const auto& e : then)
-    if (!restart_may_change(e.at(0).get<std::string>())) before[e.at(0).get<std::string>()] = e.at(1).get<std::string>();
+  for (const auto& e : then) {
+    const std::string key = e.at(0).get<std::string>();
+    if (!restart_may_change(key)) before[key] = e.at(1).get<std::string>();
+  }
   std::vector<std::string> changes;
   for (const auto& [key, value] : before) {
     const auto it = after.find(key);
@@ -71,7 +73,8 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   j["stabilisation"] = {{"damping", s.stabilisation_damping}, {"energy", s.stabilisation_energy}};
   j["next_increment"] = s.next_increment;
   if (s.predictor_rate.size() > 0)
-    j["predictor_rate"] = std::vector<double>(s.predictor_rate.data(), s.predictor_rate.data() + s.predictor_rate.size());
+    j["predictor_rate"] =
+        std::vector<double>(s.predictor_rate.data(), s.predictor_rate.data() + s.predictor_rate.size());
   io::write_file_atomic(path, j.dump());
 }
 

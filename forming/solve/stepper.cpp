@@ -82,8 +82,6 @@ class LoadStepper final : public Stepper {
     out.nothing_left = first > n;
     const double lambda_start = state.load_factor;
     const double T = settings_.process_time;
-    // Branch switching: a restart's start state is checked as a step's end is (its rates
-    // at rest over one step's time).
     // A restart's first step starts with the sub-step the run would have taken next and,
     // with the extrapolating predictor, extrapolates with the rate the run had when it
     // stopped (increment per unit process time: the span is 1 s).
@@ -94,6 +92,8 @@ class LoadStepper final : public Stepper {
       ws.last_span = 1.0;
     }
     if (ws.next_increment == 0.0 && state.next_increment > 0.0) ws.next_increment = state.next_increment;
+    // Branch switching: a restart's start state is checked as a step's end is (its rates
+    // at rest over one step's time).
     std::vector<BranchSwitch> pending;
     if (settings_.branch_switch.active() && first > 1 && first <= n) {
       const double t0 = state.load_factor * T;
@@ -147,8 +147,8 @@ class LoadStepper final : public Stepper {
       // Branch switching: the failed step tried again from switched states.
       DampingBoost boost(stabilisation_);  // restores c when the step's solving is over
       if (!r.report.ok() && bs.active() && !needs_calibration())
-        r = retry_switched(std::move(r), k, lambda, lambda_prev, state.x, from_lambda, statics, targets, step_load, switches,
-                           boost, out);
+        r = retry_switched(std::move(r), k, lambda, lambda_prev, state.x, from_lambda, statics, targets, step_load,
+                           switches, boost, out);
       if (!r.report.ok()) {
         if (needs_calibration() && r.report.load_factor <= 0.0)
           r.report.message += "; stabilise fraction: no part of the step converged to calibrate the damping from: "
@@ -249,12 +249,12 @@ class LoadStepper final : public Stepper {
   };
 
   // Branch switching: the failed step k (result r; started from step_start at
-  // lambda_prev) once more from its last converged sub-step, moved along that state's nearest-zero mode, at most `retries` times; twice
-  // the amplitude when the last retry started from the same state (up to
-  // kMaxEscalation); the last retry cuts back to min_increment, with last_retry_damping
-  // times c if asked. from_lambda (which step_load reads) becomes where the retry starts.
-  // The result's counts include the failed attempts'; its message, when it fails too,
-  // every attempt's.
+  // lambda_prev) once more from its last converged sub-step, moved along that state's
+  // nearest-zero mode, at most `retries` times; twice the amplitude when the last retry
+  // started from the same state (up to kMaxEscalation); the last retry cuts back to
+  // min_increment, with last_retry_damping times c if asked. from_lambda (which
+  // step_load reads) becomes where the retry starts. The result's counts include the
+  // failed attempts'; its message, when it fails too, every attempt's.
   StaticResult retry_switched(StaticResult r, int k, double lambda, double lambda_prev, const VecX& step_start,
                               double& from_lambda,
                               const StaticOptions& statics, const std::vector<PrescribedDof>& targets,

@@ -798,8 +798,10 @@ void flatten(const YAML::Node& node, const std::string& path, std::vector<std::p
     for (auto it = node.begin(); it != node.end(); ++it) {
       const std::string key = case_yaml::is_scalar(it->first) ? it->first.Scalar() : "?";
       if (path.empty() && key == "output") continue;  // output settings may change for a restart
-      // and so may branch switching (switched on from the restart's step onwards)
-      if (path == "solver" && key == "branch_switch") continue;
+      // and so may the solver keys that steer how a step is solved, not what is solved
+      // (a run that stalled goes on with more iterations, a smaller min_increment or
+      // branch switching from the restart's step onwards)
+      if (restart_may_change(path.empty() ? key : path + "." + key)) continue;
       flatten(it->second, path.empty() ? key : path + "." + key, out);
     }
   } else if (case_yaml::is_sequence(node)) {
@@ -881,6 +883,16 @@ CaseCheck check_case_file(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return check_case_text(ss.str(), path);
+}
+
+bool restart_may_change(const std::string& key) {
+  static const std::set<std::string> solver = {"max_iterations", "tolerance", "min_increment", "line_search",
+                                               "predictor",      "linear",    "branch_switch"};
+  const std::string prefix = "solver.";
+  if (key.compare(0, prefix.size(), prefix) != 0) return false;
+  const std::string rest = key.substr(prefix.size());
+  if (rest == "stabilise.warn_ratio") return true;
+  return solver.count(rest.substr(0, rest.find('.'))) > 0;
 }
 
 FormingCase load_case(const std::string& path) {

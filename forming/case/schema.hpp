@@ -279,4 +279,11 @@ struct FormingCase {
   int find_ply(const std::string& name) const;  // -1 when absent
 };
 
+// True for a flattened case key a --restart may change (FormingCase::fingerprint leaves
+// them out, and a restart file written before they were left out is compared without
+// them): the solver keys that steer how a step is solved, not what is solved -
+// solver.max_iterations, tolerance, min_increment, line_search, predictor, linear,
+// branch_switch (and its fields) and stabilise.warn_ratio.
+bool restart_may_change(const std::string& key);
+
 }  // namespace sf::forming

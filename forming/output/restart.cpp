@@ -26,7 +26,10 @@ std::string model_fingerprint(const FormingCase& spec, const Model& model) {
 // ("materials.carbon.E_T: 1000 -> 2000"), at most a few, or "" when nothing did.
 std::string case_changes(const nlohmann::json& then, const std::vector<std::pair<std::string, std::string>>& now) {
   std::map<std::string, std::string> before, after(now.begin(), now.end());
-  for (const auto& e : then) before[e.at(0).get<std::string>()] = e.at(1).get<std::string>();
+  for (const auto& e : then) {
+    const std::string key = e.at(0).get<std::string>();
+    if (!restart_may_change(key)) before[key] = e.at(1).get<std::string>();
+  }
   std::vector<std::string> changes;
   for (const auto& [key, value] : before) {
     const auto it = after.find(key);
@@ -68,6 +71,10 @@ void write_restart(const std::string& path, const FormingCase& spec, const Model
   for (const io::PvdDataSet& p : s.parts) parts.push_back({p.time, p.file, p.part});
   j["parts"] = parts;
   j["stabilisation"] = {{"damping", s.stabilisation_damping}, {"energy", s.stabilisation_energy}};
+  j["next_increment"] = s.next_increment;
+  if (s.predictor_rate.size() > 0)
+    j["predictor_rate"] =
+        std::vector<double>(s.predictor_rate.data(), s.predictor_rate.data() + s.predictor_rate.size());
   io::write_file_atomic(path, j.dump());
 }
 
@@ -90,8 +97,9 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
     }
     if (!changes.empty())
       throw InputError(path + ": written for a different case; changed since: " + changes +
-                       " (only the output settings may change for a restart; run without --restart to start "
-                       "again)");
+                       " (a restart may change only the output settings and the solver's max_iterations, "
+                       "tolerance, min_increment, line_search, predictor, linear, branch_switch and stabilise "
+                       "warn_ratio; run without --restart to start again)");
   }
   if (j.value("fingerprint", "") != model_fingerprint(spec, model))
     throw InputError(path +
@@ -120,10 +128,18 @@ RestartState read_restart(const std::string& path, const FormingCase& spec, Mode
       s.stabilisation_damping = j.at("stabilisation").at("damping").get<double>();
       s.stabilisation_energy = j.at("stabilisation").at("energy").get<double>();
     }
+    s.next_increment = j.value("next_increment", 0.0);
+    if (j.contains("predictor_rate")) {
+      const std::vector<double> v = j.at("predictor_rate").get<std::vector<double>>();
+      s.predictor_rate = Eigen::Map<const VecX>(v.data(), static_cast<Index>(v.size()));
+    }
   } catch (const std::exception& e) {
     throw InputError(path + ": not a readable restart file (" + e.what() + ")");
   }
   if (s.positions.size() != model.n_dofs()) throw InputError(path + ": wrong number of positions");
+  if (s.predictor_rate.size() != 0 && s.predictor_rate.size() != model.n_dofs())
+    throw InputError(path + ": predictor_rate has " + std::to_string(s.predictor_rate.size()) + " entries, expected " +
+                     std::to_string(model.n_dofs()) + " (one a dof)");
   return s;
 }
 

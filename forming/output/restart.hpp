@@ -17,6 +17,10 @@
 //   frames         [load factor, file name] of every frame written so far
 //   parts          [load factor, file name, part] of the tool and contact parts so far
 //   stabilisation  {damping (N s/mm^4), energy (N mm)}: stabilised runs (optional)
+//   predictor_rate n_dofs (mm/s): load control with predictor: extrapolate, the rate the
+//                  next step extrapolates with (optional; absent: none yet)
+//   next_increment load control: the sub-step (fraction of a step) the next step starts with
+//                  (optional; 0 or absent: a whole step)
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,6 +44,10 @@ struct RestartState {
   // (N s/mm^4; 0: not yet calibrated) and the energy dissipated so far (N mm).
   double stabilisation_damping = 0.0;
   double stabilisation_energy = 0.0;
+  // Load control with the extrapolating predictor: the last step's increment of positions
+  // over its process time (n_dofs, mm/s; forming/solve/stepper.hpp SteppingState); empty: none.
+  VecX predictor_rate;
+  double next_increment = 0.0;  // load control: the next step's first sub-step, fraction of a step
 };
 
 // The multipliers come from `model`.

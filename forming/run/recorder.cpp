@@ -71,6 +71,8 @@ SteppingState RunRecorder::start() {
     restart_ = read_restart(restart_path_, spec_, problem_.model);
     state.x = restart_.positions;
     if (spec_.solver.dynamic && restart_.velocities.size() == problem_.model.n_dofs()) state.v = restart_.velocities;
+    if (restart_.predictor_rate.size() == problem_.model.n_dofs()) state.predictor_rate = restart_.predictor_rate;
+    state.next_increment = restart_.next_increment;
     state.load_factor = restart_.load_factor;
     // Earlier frames (and their tool and contact parts) of this run stay in the collection;
     // they lie in the same folder as the restart file, so they are this run's own.
@@ -220,6 +222,8 @@ void RunRecorder::write_step(int k, double load_factor) {
   restart_.load_factor = load_factor;
   restart_.positions = last_.x;
   restart_.velocities = spec_.solver.dynamic ? last_.v : VecX();
+  restart_.predictor_rate = last_.predictor_rate;
+  restart_.next_increment = last_.next_increment;
   restart_.history_rows = history_.rows();
   restart_.frames = frames_.frames();
   restart_.parts = frames_.parts();

@@ -82,6 +82,16 @@ class LoadStepper final : public Stepper {
     out.nothing_left = first > n;
     const double lambda_start = state.load_factor;
     const double T = settings_.process_time;
+    // A restart's first step starts with the sub-step the run would have taken next and,
+    // with the extrapolating predictor, extrapolates with the rate the run had when it
+    // stopped (increment per unit process time: the span is 1 s).
+    const Index n_dofs = problem_.model.n_dofs();
+    TangentWorkspace& ws = *settings_.statics.workspace;
+    if (settings_.statics.extrapolate && ws.last_increment.size() == 0 && state.predictor_rate.size() == n_dofs) {
+      ws.last_increment = state.predictor_rate;
+      ws.last_span = 1.0;
+    }
+    if (ws.next_increment == 0.0 && state.next_increment > 0.0) ws.next_increment = state.next_increment;
     // Branch switching: a restart's start state is checked as a step's end is (its rates
     // at rest over one step's time).
     std::vector<BranchSwitch> pending;
@@ -134,55 +144,12 @@ class LoadStepper final : public Stepper {
           out.total_iterations += r.report.total_iterations;
         }
       }
-      // Branch switching: the failed step once more from its last converged sub-step,
-      // moved along that state's nearest-zero mode; twice the amplitude when the last
-      // retry started from the same state (up to kMaxEscalation); the last retry cuts
-      // back to min_increment.
-      double last_reached = -1.0, scale = 1.0;
-      double boosted_from = 0.0;  // the damping before the last retry raised it (0: not raised)
-      for (int retry = 0; !r.report.ok() && bs.active() && !needs_calibration() && retry < bs.retries; ++retry) {
-        const double reached = from_lambda + r.report.load_factor * (lambda - from_lambda);
-        scale = std::abs(reached - last_reached) <= 1e-12 * std::max(1.0, std::abs(reached))
-                    ? std::min(2.0 * scale, kMaxEscalation)
-                    : 1.0;
-        last_reached = reached;
-        const double t_reached = reached * T;
-        const InteractionContext at_reached =
-            t_reached > lambda_prev * T ? InteractionContext{t_reached, nullptr, &state.x, lambda_prev * T}
-                                        : InteractionContext{t_reached, nullptr, &r.positions, t_reached - T / n};
-        const VecX x_reached = r.positions;
-        VecX moved = switch_branch(x_reached, reached, k, true, at_reached, switches, scale);
-        if (moved.size() == 0) break;
-        from_lambda = reached;
-        StaticOptions again = statics;
-        again.clock = {reached * T, lambda * T, nullptr, 0.0};
-        if (retry + 1 == bs.retries) {
-          again.give_up_after = 0;
-          // The last retry, if asked, with raised damping for the rest of this step (a snap
-          // of a ply that no switch passes is damped through, as a dynamic step would); its
-          // energy counted with that c, the step's earlier sub-steps too.
-          if (bs.last_retry_damping > 1.0 && stabilisation_ && stabilisation_->damping() > 0.0 &&
-              boosted_from == 0.0) {
-            boosted_from = stabilisation_->damping();
-            stabilisation_->set_damping(bs.last_retry_damping * boosted_from);
-          }
-        }
-        again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
-        const std::string before = r.report.message;
-        const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
-        r = solve_static_constrained(problem_.model, moved, targets, step_load, problem_.loads.follower, again,
-                                     settings_.uzawa, &uzawa);
-        out.multiplier_updates += uzawa.updates;
-        out.total_iterations += r.report.total_iterations;
-        // The step's counts: its failed attempts' too.
-        r.report.total_iterations += spent;
-        r.report.n_cutbacks += cut;
-        if (!r.report.ok())
-          r.report.message = before + "; after a branch switch at load factor " + std::to_string(reached) + ": " +
-                             r.report.message;
-      }
+      // Branch switching: the failed step tried again from switched states.
+      DampingBoost boost(stabilisation_);  // restores c when the step's solving is over
+      if (!r.report.ok() && bs.active() && !needs_calibration())
+        r = retry_switched(std::move(r), k, lambda, lambda_prev, state.x, from_lambda, statics, targets, step_load,
+                           switches, boost, out);
       if (!r.report.ok()) {
-        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
         if (needs_calibration() && r.report.load_factor <= 0.0)
           r.report.message += "; stabilise fraction: no part of the step converged to calibrate the damping from: "
                               "give solver stabilise damping (N s/mm^4) instead";
@@ -219,12 +186,17 @@ class LoadStepper final : public Stepper {
         if (!substeps.empty()) substeps.back().to = r.positions;
         for (const SubStep& s : substeps) dissipated_ += stabilisation_->dissipation(s.from, s.to, s.dt);
         if (needs_calibration()) calibrate(state.x, r.positions, (lambda - lambda_prev) * T);
-        if (boosted_from > 0.0) stabilisation_->set_damping(boosted_from);
       }
+      boost.restore();
       commit_interactions(problem_.model, r.positions, at_end);
       const VecX step_start = state.x;
       state.x = r.positions;
       state.load_factor = lambda;
+      state.next_increment = ws.next_increment;
+      if (settings_.statics.extrapolate)
+        state.predictor_rate = ws.last_span > 0.0 && ws.last_increment.size() == n_dofs
+                                   ? VecX(ws.last_increment / ws.last_span)
+                                   : VecX();
       StepInfo info{
           Control::kLoad,          k, n, lambda, lambda * T, r.report.total_iterations, r.report.n_cutbacks,
           r.report.last_residual()};
@@ -250,6 +222,89 @@ class LoadStepper final : public Stepper {
   }
 
  private:
+  // The damping factor raised for the rest of a step (the last retry's
+  // last_retry_damping) and put back when the step's solving is over: by restore(),
+  // or on leaving the scope (a failed step).
+  class DampingBoost {
+   public:
+    explicit DampingBoost(ViscousStabilisation* s) : s_(s) {}
+    DampingBoost(const DampingBoost&) = delete;
+    DampingBoost& operator=(const DampingBoost&) = delete;
+    ~DampingBoost() { restore(); }
+    // c times `factor` when there is a calibrated or given c and it is not raised yet.
+    void raise(double factor) {
+      if (factor > 1.0 && s_ && s_->damping() > 0.0 && from_ == 0.0) {
+        from_ = s_->damping();
+        s_->set_damping(factor * from_);
+      }
+    }
+    void restore() {
+      if (from_ > 0.0) s_->set_damping(from_);
+      from_ = 0.0;
+    }
+
+   private:
+    ViscousStabilisation* s_;
+    double from_ = 0.0;  // c before it was raised (0: not raised)
+  };
+
+  // Branch switching: the failed step k (result r; started from step_start at
+  // lambda_prev) once more from its last converged sub-step, moved along that state's
+  // nearest-zero mode, at most `retries` times; twice the amplitude when the last retry
+  // started from the same state (up to kMaxEscalation); the last retry cuts back to
+  // min_increment, with last_retry_damping times c if asked. from_lambda (which
+  // step_load reads) becomes where the retry starts. The result's counts include the
+  // failed attempts'; its message, when it fails too, every attempt's.
+  StaticResult retry_switched(StaticResult r, int k, double lambda, double lambda_prev, const VecX& step_start,
+                              double& from_lambda,
+                              const StaticOptions& statics, const std::vector<PrescribedDof>& targets,
+                              const LoadFunction& step_load, std::vector<BranchSwitch>& switches, DampingBoost& boost,
+                              SteppingReport& out) {
+    const BranchSwitchOptions& bs = settings_.branch_switch;
+    const double T = settings_.process_time;
+    const int n = settings_.steps;
+    double last_reached = -1.0, scale = 1.0;
+    for (int retry = 0; !r.report.ok() && retry < bs.retries; ++retry) {
+      const double reached = from_lambda + r.report.load_factor * (lambda - from_lambda);
+      scale = std::abs(reached - last_reached) <= 1e-12 * std::max(1.0, std::abs(reached))
+                  ? std::min(2.0 * scale, kMaxEscalation)
+                  : 1.0;
+      last_reached = reached;
+      const double t_reached = reached * T;
+      const InteractionContext at_reached =
+          t_reached > lambda_prev * T ? InteractionContext{t_reached, nullptr, &step_start, lambda_prev * T}
+                                      : InteractionContext{t_reached, nullptr, &r.positions, t_reached - T / n};
+      const VecX x_reached = r.positions;
+      VecX moved = switch_branch(x_reached, reached, k, true, at_reached, switches, scale);
+      if (moved.size() == 0) break;
+      from_lambda = reached;
+      StaticOptions again = statics;
+      again.clock = {reached * T, lambda * T, nullptr, 0.0};
+      if (retry + 1 == bs.retries) {
+        again.give_up_after = 0;
+        // The last retry, if asked, with raised damping for the rest of this step (a snap
+        // of a ply that no switch passes is damped through, as a dynamic step would); its
+        // energy counted with that c, the step's earlier sub-steps too.
+        boost.raise(bs.last_retry_damping);
+      }
+      again.workspace->next_increment = 0.0;  // a fresh start: the cut-backs were the old branch's
+      const std::string before = r.report.message;
+      const int spent = r.report.total_iterations, cut = r.report.n_cutbacks;
+      UzawaReport uzawa;
+      r = solve_static_constrained(problem_.model, moved, targets, step_load, problem_.loads.follower, again,
+                                   settings_.uzawa, &uzawa);
+      out.multiplier_updates += uzawa.updates;
+      out.total_iterations += r.report.total_iterations;
+      // The step's counts: its failed attempts' too.
+      r.report.total_iterations += spent;
+      r.report.n_cutbacks += cut;
+      if (!r.report.ok())
+        r.report.message = before + "; after a branch switch at load factor " + std::to_string(reached) + ": " +
+                           r.report.message;
+    }
+    return r;
+  }
+
   // Branch switching (forming/solve/branch_switch.hpp) at the converged state x (load
   // factor lambda) of step k: when its tangent under `context` is unstable (det K < 0 or
   // negative pivots), or always after a failure, x moved along the nearest-zero mode,

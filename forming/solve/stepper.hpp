@@ -77,6 +77,16 @@ struct SteppingState {
   VecX x;                    // positions (n_dofs, mm)
   VecX v;                    // velocities (n_dofs, mm/s); used by dynamic runs
   double load_factor = 0.0;  // of x
+  // Load control with the extrapolating predictor (StaticOptions::extrapolate): the rate
+  // the next step's first iterate extrapolates with, the last step's increment of
+  // positions over its process time (n_dofs, mm/s); empty: none (the first step). A
+  // restart keeps it (restart.json `predictor_rate`), so a restarted step starts as it
+  // would have in the uninterrupted run.
+  VecX predictor_rate{};
+  // Load control: the sub-step (fraction of a step) the next step starts with, the one
+  // the last step's solve ended with (cut back, or regrown); 0: a whole step. A restart
+  // keeps it too (restart.json `next_increment`).
+  double next_increment = 0.0;
 };
 
 // A branch switch (forming/solve/branch_switch.hpp): where, and along which mode.

@@ -169,6 +169,47 @@ TEST(BranchSwitch, BendStallIsLeftAfterAFewFailedSubSteps) {
   fs::remove_all(dir);
 }
 
+// The last retry's raised damping (last_retry_damping) holds for the rest of that step
+// and is put back after it: the 70 mm/s bend's step 7 from its step 6 with one retry
+// (so the first retry is the last, at 10 c, cutting back to min_increment) converges in
+// 578 Newton iterations (21 cut-backs), as before the retry loop became
+// LoadStepper::retry_switched and the two restores one, and the run goes on with the
+// restart's c (2.306e-7 N s/mm^4), not ten times it.
+TEST(BranchSwitch, LastRetryDampingIsPutBackAfterTheStep) {
+  namespace fs = std::filesystem;
+  const fs::path source = fs::path(SF_SOURCE_DIR);
+  std::string text = fixtures::read_text(source / "data/forming/processes/matched_die_bend_70mms.yaml");
+  const std::string key = "branch_switch: {amplitude: 0.05}";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.replace(text.find(key), key.size(), "branch_switch: {amplitude: 0.05, retries: 1, last_retry_damping: 10}");
+  const CaseCheck c = check_case_text(text, "bend70.yaml");
+  ASSERT_TRUE(c.ok()) << c.located(0);
+  const fs::path dir = fs::temp_directory_path() / "sf_branch_switch_bend_boost";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(source / "tests/forming/cases/bend70_step6_restart.json", dir / "restart.json");
+  const nlohmann::json restart = nlohmann::json::parse(fixtures::read_text(dir / "restart.json"));
+  const double c0 = restart["stabilisation"]["damping"].get<double>();
+  RunOptions o;
+  o.out_dir = dir.string();
+  o.quiet = true;
+  o.restart = true;
+  o.stop_after = 1;
+  const RunReport report = run_case(c.spec, o);
+  ASSERT_EQ(report.status, RunReport::Status::kStopped) << report.message;
+  const nlohmann::json summary = nlohmann::json::parse(fixtures::read_text(dir / "summary.json"));
+  const double c1 = summary["stabilisation"]["damping"].get<double>();
+  std::printf("[ measured ] step 7 with one retry at 10 c: %d Newton iterations, c %.6g -> %.6g N s/mm^4, "
+              "dissipated %.6g N mm\n",
+              report.total_iterations, c0, c1, summary["stabilisation"]["energy"].get<double>());
+  EXPECT_GT(c0, 0.0);
+  EXPECT_EQ(c1, c0);
+  EXPECT_EQ(report.total_iterations, 578);
+  ASSERT_EQ(summary["branch_switches"].size(), 1u);
+  EXPECT_TRUE(summary["branch_switches"][0]["after_failure"].get<bool>());
+  fs::remove_all(dir);
+}
+
 TEST(BranchSwitch, CaseKeyIsCheckedAndMayChangeForARestart) {
   std::string text = strip_case(0.05);
   text.replace(text.find("amplitude: 0.05"), 19, "amplitude: -1");

@@ -305,9 +305,8 @@ void rows_times(const RowMatrix& phi, const MatX& params, MatX& out, bool subtra
   double* o = out.data();
   const Index ld = out.rows();
   using Kernel = void (*)(const int*, const double*, int, int, const double*, Index, double*, Index, bool);
-  static constexpr Kernel kernels[kGroup + 1] = {nullptr,         row_times<1>, row_times<2>, row_times<3>,
-                                                 row_times<4>,    row_times<5>, row_times<6>, row_times<7>,
-                                                 row_times<8>};
+  static constexpr Kernel kernels[kGroup + 1] = {nullptr,      row_times<1>, row_times<2>, row_times<3>, row_times<4>,
+                                                 row_times<5>, row_times<6>, row_times<7>, row_times<8>};
   parallel_for((n + kRows - 1) / kRows,
                [&](Index b) {
                  const Index first = b * kRows, last = std::min(n, first + kRows);

@@ -351,6 +351,35 @@ MatX transpose_times(const RowMatrix& phi, const MatX& values, const VecX* w) {
   return out;
 }
 
+// add + pen x as Eigen forms it (a copy of add, and the product's terms added to it in
+// the product's order: over pen's columns in turn), so the same bits, with pen read once
+// for up to 8 columns of x instead of once per column. A zero x (the probes' and
+// pilots' zero reference) adds zeros only, which change no entry but a -0 (none in
+// practice; then the terms are added as before): add, without the product.
+MatX plus_product(const MatX& add, const linalg::SparseMatrix& pen, const Eigen::Ref<const MatX>& x) {
+  MatX out = add;
+  if ((x.array() == 0.0).all() && !(add.array() == 0.0 && add.array().unaryExpr([](double v) {
+                                      return std::signbit(v);
+                                    })).any())
+    return out;
+  constexpr Index kGroup = 8;
+  const Index ld = out.rows();
+  for (Index c0 = 0; c0 < x.cols(); c0 += kGroup) {
+    const Index nc = std::min(kGroup, x.cols() - c0);
+    double* o = out.data() + c0 * ld;
+    double xj[kGroup];
+    for (Index j = 0; j < pen.outerSize(); ++j) {
+      for (Index c = 0; c < nc; ++c) xj[c] = 1.0 * x(j, c0 + c);
+      for (linalg::SparseMatrix::InnerIterator it(pen, j); it; ++it) {
+        const double v = it.value();
+        double* oi = o + it.row();
+        for (Index c = 0; c < nc; ++c) oi[c * ld] += v * xj[c];
+      }
+    }
+  }
+  return out;
+}
+
 // pen = sum over t of weight[t] * values[t] (in that order, from the first term: no zero
 // added first) and k = normal + pen, entry by entry in one pass; the term count is fixed
 // at compile time so that the loop is vectorised.
@@ -590,7 +619,7 @@ MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const
   weighted_sum(terms, term_weight, term_values, normal_values.data(), ws.pen.valuePtr(), ws.k.valuePtr(),
                ws.k.nonZeros());
   Eigen::Map<VecX> k_values(ws.k.valuePtr(), ws.k.nonZeros());
-  MatX rhs = rhs_data + ws.pen * reference;
+  MatX rhs = plus_product(rhs_data, ws.pen, reference);
   // Pin dofs nothing determines (unused by every element, or with an empty row).
   pinned.clear();
   for (Index i = 0; i < n; ++i)
@@ -614,7 +643,7 @@ MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const
   MatX parameters = ws.solver.solve(rhs);
   // Further passes penalise the deviation from the previous pass (same matrix).
   for (int pass = 1; pass < passes; ++pass) {
-    MatX r = rhs_data + ws.pen * parameters;
+    MatX r = plus_product(rhs_data, ws.pen, parameters);
     for (Index i : pinned) r.row(i) = reference.row(i);
     parameters = ws.solver.solve(r);
   }
@@ -634,7 +663,7 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
     for (Index i : pinned) b.row(i).setZero();
     MatX hb = ws.solver.solve(b);
     for (int pass = 1; pass < passes; ++pass) {
-      MatX r = b + ws.pen * hb;
+      MatX r = plus_product(b, ws.pen, hb);
       for (Index i : pinned) r.row(i).setZero();
       hb = ws.solver.solve(r);
     }

@@ -358,9 +358,8 @@ MatX transpose_times(const RowMatrix& phi, const MatX& values, const VecX* w) {
 // practice; then the terms are added as before): add, without the product.
 MatX plus_product(const MatX& add, const linalg::SparseMatrix& pen, const Eigen::Ref<const MatX>& x) {
   MatX out = add;
-  if ((x.array() == 0.0).all() && !(add.array() == 0.0 && add.array().unaryExpr([](double v) {
-                                      return std::signbit(v);
-                                    })).any())
+  if ((x.array() == 0.0).all() &&
+      !(add.array() == 0.0 && add.array().unaryExpr([](double v) { return std::signbit(v); })).any())
     return out;
   constexpr Index kGroup = 8;
   const Index ld = out.rows();

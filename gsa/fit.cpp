@@ -321,34 +321,42 @@ void rows_times(const RowMatrix& phi, const MatX& params, MatX& out, bool subtra
                1);
 }
 
-// phi^T values (n_dofs x k), or with `w` phi^T (diag(w) values): the operations of
-// Eigen's product of the transposed sparse matrix with a dense one in its order (each
-// entry summed over the points in turn from 0, of value x (w_d z_d)), so the same bits,
-// but Phi read once for a group of columns instead of once per column; the groups on
-// all cores (the probes of the trace estimates: 6 to 12 columns, twice per system).
-MatX transpose_times(const RowMatrix& phi, const MatX& values, const VecX* w) {
-  constexpr Index kGroup = 8;
-  const Index cols = values.cols(), groups = (cols + kGroup - 1) / kGroup;
+// out = Phi^T (...) (n_dofs x values.cols()) in groups of up to 8 columns, the groups on all
+// cores: `point(d, z, o, nc)` adds point d's terms to the group's output columns o[c] from
+// its value columns z[c]. Each entry sums over the points in their order whatever the
+// threads; Phi is read once per group instead of once per column.
+constexpr Index kColumnGroup = 8;
+template <class Point>
+MatX by_column_groups(const RowMatrix& phi, const Eigen::Ref<const MatX>& values, const Point& point) {
+  const Index cols = values.cols(), groups = (cols + kColumnGroup - 1) / kColumnGroup;
   MatX out = MatX::Zero(phi.cols(), cols);
   parallel_for(
       groups,
       [&](Index g) {
-        const Index c0 = g * kGroup, nc = std::min(kGroup, cols - c0);
-        const double* z[kGroup];
-        double* o[kGroup];
+        const Index c0 = g * kColumnGroup, nc = std::min(kColumnGroup, cols - c0);
+        const double* z[kColumnGroup];
+        double* o[kColumnGroup];
         for (Index c = 0; c < nc; ++c) z[c] = values.col(c0 + c).data(), o[c] = out.col(c0 + c).data();
-        double zd[kGroup];
-        for (Index d = 0; d < phi.rows(); ++d) {
-          for (Index c = 0; c < nc; ++c) zd[c] = 1.0 * (w ? (*w)[d] * z[c][d] : z[c][d]);
-          for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
-            const double a = it.value();
-            const Index j = it.col();
-            for (Index c = 0; c < nc; ++c) o[c][j] += a * zd[c];
-          }
-        }
+        for (Index d = 0; d < phi.rows(); ++d) point(d, z, o, nc);
       },
       1);
   return out;
+}
+
+// phi^T values, or with `w` phi^T (diag(w) values): the operations of Eigen's product of
+// the transposed sparse matrix with a dense one in its order (each entry summed over the
+// points in turn from 0, of value x (w_d z_d)), so the same bits (the probes of the trace
+// estimates: 6 to 12 columns, twice per system).
+MatX transpose_times(const RowMatrix& phi, const MatX& values, const VecX* w) {
+  return by_column_groups(phi, values, [&](Index d, const double* const* z, double* const* o, Index nc) {
+    double zd[kColumnGroup];
+    for (Index c = 0; c < nc; ++c) zd[c] = 1.0 * (w ? (*w)[d] * z[c][d] : z[c][d]);
+    for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
+      const double a = it.value();
+      const Index j = it.col();
+      for (Index c = 0; c < nc; ++c) o[c][j] += a * zd[c];
+    }
+  });
 }
 
 // add + pen x as Eigen forms it (a copy of add, and the product's terms added to it in
@@ -503,31 +511,17 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penal
 FitSystem::~FitSystem() = default;
 
 MatX FitSystem::Impl::weighted_rhs(const Eigen::Ref<const MatX>& values) const {
-  // Groups of up to kGroup columns on all cores; a group's columns are summed together,
-  // a block of points at a time (the block's rows of Phi are read once for the group,
-  // from cache). Each entry still sums over the points in their order, the same
-  // products in the same order as one column at a time, whatever the threads.
-  constexpr Index kGroup = 8;
-  const Index cols = values.cols(), groups = (cols + kGroup - 1) / kGroup;
-  MatX out = MatX::Zero(phi.cols(), cols);
-  parallel_for(
-      groups,
-      [&](Index g) {
-        const Index c0 = g * kGroup, nc = std::min(kGroup, cols - c0);
-        const double* z[kGroup];
-        double* o[kGroup];
-        for (Index c = 0; c < nc; ++c) z[c] = values.col(c0 + c).data(), o[c] = out.col(c0 + c).data();
-        for (Index d = 0; d < phi.rows(); ++d) {
-          if (!(w[d] > 0.0)) continue;
-          for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
-            const double a = w[d] * it.value();
-            const Index j = it.col();
-            for (Index c = 0; c < nc; ++c) o[c][j] += a * z[c][d];
-          }
-        }
-      },
-      1);
-  return out;
+  // Groups of up to 8 columns on all cores, a group's columns summed together: each entry
+  // still sums over the points in their order, the same products in the same order as
+  // one column at a time, whatever the threads.
+  return by_column_groups(phi, values, [&](Index d, const double* const* zc, double* const* o, Index nc) {
+    if (!(w[d] > 0.0)) return;
+    for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
+      const double a = w[d] * it.value();
+      const Index j = it.col();
+      for (Index c = 0; c < nc; ++c) o[c][j] += a * zc[c][d];
+    }
+  });
 }
 
 void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/core/error.hpp"
+#include "common/core/parallel.hpp"
 #include "common/fe/surface_field.hpp"
 
 namespace sf::gsa {
@@ -79,18 +80,22 @@ DeformedProblem::~DeformedProblem() = default;
 void DeformedProblem::carry_residuals(const MatX* deformed) {
   std::optional<fe::SurfaceField> fd;
   if (deformed) fd.emplace(setup_.mesh, *deformed);
-  for (Index k = 0; k < marks_.size(); ++k) {
-    Mat3 q = rigid_.rotation;
-    if (fd && weight_[k] > 0) {
-      const MeshLocation& loc = undeformed_.location[static_cast<std::size_t>(k)];
-      const fe::SurfacePoint pd = fd->evaluate3(loc.element, loc.xi, basis::kValues | basis::kFirst);
-      Mat3 frame_d;
-      frame_d << pd.dx, pd.dx.col(0).cross(pd.dx.col(1)).normalized();
-      const std::optional<Mat3> polar = polar_rotation(frame_d * frame_u_[k].inverse());
-      if (polar) q = *polar;
-    }
-    data_.row(k) = deformed_.position.row(k) - (q * residual_u_[k]).transpose();
-  }
+  // The marks on all cores: each row is its own (the same bits whatever the threads).
+  parallel_for(
+      marks_.size(),
+      [&](Index k) {
+        Mat3 q = rigid_.rotation;
+        if (fd && weight_[k] > 0) {
+          const MeshLocation& loc = undeformed_.location[static_cast<std::size_t>(k)];
+          const fe::SurfacePoint pd = fd->evaluate3(loc.element, loc.xi, basis::kValues | basis::kFirst);
+          Mat3 frame_d;
+          frame_d << pd.dx, pd.dx.col(0).cross(pd.dx.col(1)).normalized();
+          const std::optional<Mat3> polar = polar_rotation(frame_d * frame_u_[k].inverse());
+          if (polar) q = *polar;
+        }
+        data_.row(k) = deformed_.position.row(k) - (q * residual_u_[k]).transpose();
+      },
+      2048);
   if (system_) system_->set_values(data_);
 }
 

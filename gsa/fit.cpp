@@ -267,23 +267,124 @@ RowMatrix collocation(const std::vector<fe::ElementDofMap>& maps, Index n_dofs,
   return rows;
 }
 
-// out = phi * params (subtract: out -= phi * params), rows in blocks on all cores.
-// Each block is Eigen's own sparse-dense product of those rows: every entry is the same
-// sum in the same order as the whole product's, to the last bit, whatever the threads
-// (1e5 points x 42 probe columns is 70 M multiply-adds, at every pilot fit).
-void rows_times(const RowMatrix& phi, const MatX& params, MatX& out, bool subtract) {
+// out = phi * params (subtract: out -= phi * params); with `rows`, row i of out is row
+// rows[i] of phi's. The same operations in the same order as Eigen's sparse x dense
+// product (per column and row: a sum from 0 over the row's stored entries in order, then
+// added to the zeroed or given entry with alpha = 1 or -1), so every entry is the same
+// bits, but each row of Phi is read once for all the columns instead of once per column,
+// from parameters laid out a dof per row: 1e5 points x 42 probe columns, at every pilot
+// fit, used to stream Phi's 19 MB 42 times. Rows in blocks on all cores.
+template <int kCols>
+void row_times(const int* inner, const double* value, int p0, int p1, const double* by_dof, Index stride, double* o,
+               Index ld, bool subtract) {
+  double tmp[kCols];
+  for (int c = 0; c < kCols; ++c) tmp[c] = 0.0;
+  for (int p = p0; p < p1; ++p) {
+    const double v = value[p];
+    const double* at = by_dof + static_cast<Index>(inner[p]) * stride;
+    for (int c = 0; c < kCols; ++c) tmp[c] += v * at[c];
+  }
+  for (int c = 0; c < kCols; ++c) {
+    double& dst = o[c * ld];
+    dst = subtract ? dst + -1.0 * tmp[c] : 0.0 + 1.0 * tmp[c];
+  }
+}
+
+void rows_times(const RowMatrix& phi, const MatX& params, MatX& out, bool subtract,
+                const std::vector<Index>* rows = nullptr) {
   constexpr Index kRows = 2048;
-  const Index n = phi.rows();
-  if (!subtract) out.resize(n, params.cols());
+  constexpr Index kGroup = 8;  // columns summed together (their partial sums in registers)
+  const Index n = rows ? static_cast<Index>(rows->size()) : phi.rows();
+  const Index cols = params.cols();
+  if (!subtract) out.resize(n, cols);
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> by_dof = params;
+  const double* pd = by_dof.data();
+  const int* outer = phi.outerIndexPtr();
+  const int* inner = phi.innerIndexPtr();
+  const double* value = phi.valuePtr();
+  double* o = out.data();
+  const Index ld = out.rows();
+  using Kernel = void (*)(const int*, const double*, int, int, const double*, Index, double*, Index, bool);
+  static constexpr Kernel kernels[kGroup + 1] = {nullptr,      row_times<1>, row_times<2>, row_times<3>, row_times<4>,
+                                                 row_times<5>, row_times<6>, row_times<7>, row_times<8>};
   parallel_for((n + kRows - 1) / kRows,
                [&](Index b) {
-                 const Index first = b * kRows, count = std::min(kRows, n - first);
-                 if (subtract)
-                   out.middleRows(first, count).noalias() -= phi.middleRows(first, count) * params;
-                 else
-                   out.middleRows(first, count).noalias() = phi.middleRows(first, count) * params;
+                 const Index first = b * kRows, last = std::min(n, first + kRows);
+                 for (Index i = first; i < last; ++i) {
+                   const Index r = rows ? (*rows)[static_cast<std::size_t>(i)] : i;
+                   for (Index c0 = 0; c0 < cols; c0 += kGroup) {
+                     const Index nc = std::min(kGroup, cols - c0);
+                     kernels[nc](inner, value, outer[r], outer[r + 1], pd + c0, cols, o + c0 * ld + i, ld, subtract);
+                   }
+                 }
                },
                1);
+}
+
+// out = Phi^T (...) (n_dofs x values.cols()) in groups of up to 8 columns, the groups on all
+// cores: `point(d, z, o, nc)` adds point d's terms to the group's output columns o[c] from
+// its value columns z[c]. Each entry sums over the points in their order whatever the
+// threads; Phi is read once per group instead of once per column.
+constexpr Index kColumnGroup = 8;
+template <class Point>
+MatX by_column_groups(const RowMatrix& phi, const Eigen::Ref<const MatX>& values, const Point& point) {
+  const Index cols = values.cols(), groups = (cols + kColumnGroup - 1) / kColumnGroup;
+  MatX out = MatX::Zero(phi.cols(), cols);
+  parallel_for(
+      groups,
+      [&](Index g) {
+        const Index c0 = g * kColumnGroup, nc = std::min(kColumnGroup, cols - c0);
+        const double* z[kColumnGroup];
+        double* o[kColumnGroup];
+        for (Index c = 0; c < nc; ++c) z[c] = values.col(c0 + c).data(), o[c] = out.col(c0 + c).data();
+        for (Index d = 0; d < phi.rows(); ++d) point(d, z, o, nc);
+      },
+      1);
+  return out;
+}
+
+// phi^T values, or with `w` phi^T (diag(w) values): the operations of Eigen's product of
+// the transposed sparse matrix with a dense one in its order (each entry summed over the
+// points in turn from 0, of value x (w_d z_d)), so the same bits (the probes of the trace
+// estimates: 6 to 12 columns, twice per system).
+MatX transpose_times(const RowMatrix& phi, const MatX& values, const VecX* w) {
+  return by_column_groups(phi, values, [&](Index d, const double* const* z, double* const* o, Index nc) {
+    double zd[kColumnGroup];
+    for (Index c = 0; c < nc; ++c) zd[c] = 1.0 * (w ? (*w)[d] * z[c][d] : z[c][d]);
+    for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
+      const double a = it.value();
+      const Index j = it.col();
+      for (Index c = 0; c < nc; ++c) o[c][j] += a * zd[c];
+    }
+  });
+}
+
+// add + pen x as Eigen forms it (a copy of add, and the product's terms added to it in
+// the product's order: over pen's columns in turn), so the same bits, with pen read once
+// for up to 8 columns of x instead of once per column. A zero x (the probes' and
+// pilots' zero reference) adds zeros only, which change no entry but a -0 (none in
+// practice; then the terms are added as before): add, without the product.
+MatX plus_product(const MatX& add, const linalg::SparseMatrix& pen, const Eigen::Ref<const MatX>& x) {
+  MatX out = add;
+  if ((x.array() == 0.0).all() &&
+      !(add.array() == 0.0 && add.array().unaryExpr([](double v) { return std::signbit(v); })).any())
+    return out;
+  constexpr Index kGroup = 8;
+  const Index ld = out.rows();
+  for (Index c0 = 0; c0 < x.cols(); c0 += kGroup) {
+    const Index nc = std::min(kGroup, x.cols() - c0);
+    double* o = out.data() + c0 * ld;
+    double xj[kGroup];
+    for (Index j = 0; j < pen.outerSize(); ++j) {
+      for (Index c = 0; c < nc; ++c) xj[c] = 1.0 * x(j, c0 + c);
+      for (linalg::SparseMatrix::InnerIterator it(pen, j); it; ++it) {
+        const double v = it.value();
+        double* oi = o + it.row();
+        for (Index c = 0; c < nc; ++c) oi[c * ld] += v * xj[c];
+      }
+    }
+  }
+  return out;
 }
 
 // pen = sum over t of weight[t] * values[t] (in that order, from the first term: no zero
@@ -318,26 +419,6 @@ void weighted_sum(int terms, const std::array<double, 5>& weight, const std::arr
     default:
       return weighted_sum_of<5>(weight, values, normal, pen, k, n);
   }
-}
-
-// The rows `rows` of `phi`, in that order.
-RowMatrix rows_of(const RowMatrix& phi, const std::vector<Index>& rows) {
-  const Index n = static_cast<Index>(rows.size());
-  RowMatrix out(n, phi.cols());
-  int* outer = out.outerIndexPtr();
-  outer[0] = 0;
-  for (Index i = 0; i < n; ++i) {
-    const Index r = rows[static_cast<std::size_t>(i)];
-    outer[i + 1] = outer[i] + (phi.outerIndexPtr()[r + 1] - phi.outerIndexPtr()[r]);
-  }
-  out.resizeNonZeros(outer[n]);
-  for (Index i = 0; i < n; ++i) {
-    const int from = phi.outerIndexPtr()[rows[static_cast<std::size_t>(i)]];
-    const int count = outer[i + 1] - outer[i];
-    std::copy(phi.innerIndexPtr() + from, phi.innerIndexPtr() + from + count, out.innerIndexPtr() + outer[i]);
-    std::copy(phi.valuePtr() + from, phi.valuePtr() + from + count, out.valuePtr() + outer[i]);
-  }
-  return out;
 }
 
 }  // namespace
@@ -430,31 +511,17 @@ FitSystem::FitSystem(const mesh::SurfaceMesh& mesh, const PenaltyMatrices& penal
 FitSystem::~FitSystem() = default;
 
 MatX FitSystem::Impl::weighted_rhs(const Eigen::Ref<const MatX>& values) const {
-  // Groups of up to kGroup columns on all cores; a group's columns are summed together,
-  // a block of points at a time (the block's rows of Phi are read once for the group,
-  // from cache). Each entry still sums over the points in their order, the same
-  // products in the same order as one column at a time, whatever the threads.
-  constexpr Index kGroup = 8;
-  const Index cols = values.cols(), groups = (cols + kGroup - 1) / kGroup;
-  MatX out = MatX::Zero(phi.cols(), cols);
-  parallel_for(
-      groups,
-      [&](Index g) {
-        const Index c0 = g * kGroup, nc = std::min(kGroup, cols - c0);
-        const double* z[kGroup];
-        double* o[kGroup];
-        for (Index c = 0; c < nc; ++c) z[c] = values.col(c0 + c).data(), o[c] = out.col(c0 + c).data();
-        for (Index d = 0; d < phi.rows(); ++d) {
-          if (!(w[d] > 0.0)) continue;
-          for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
-            const double a = w[d] * it.value();
-            const Index j = it.col();
-            for (Index c = 0; c < nc; ++c) o[c][j] += a * z[c][d];
-          }
-        }
-      },
-      1);
-  return out;
+  // Groups of up to 8 columns on all cores, a group's columns summed together: each entry
+  // still sums over the points in their order, the same products in the same order as
+  // one column at a time, whatever the threads.
+  return by_column_groups(phi, values, [&](Index d, const double* const* zc, double* const* o, Index nc) {
+    if (!(w[d] > 0.0)) return;
+    for (RowMatrix::InnerIterator it(phi, d); it; ++it) {
+      const double a = w[d] * it.value();
+      const Index j = it.col();
+      for (Index c = 0; c < nc; ++c) o[c][j] += a * zc[c][d];
+    }
+  });
 }
 
 void FitSystem::set_values(const Eigen::Ref<const MatX>& values) {
@@ -480,9 +547,9 @@ std::optional<MatX> FitSystem::smoothing_residual(const Eigen::Ref<const MatX>& 
   const MatX params = s.parameters(impl_->workspace(slot), penalty, zero, weighted, passes, pinned, message);
   if (params.size() == 0) return std::nullopt;
   if (rows) {
-    // The rows of Phi asked for, gathered: each row's product is the same sum as in the whole.
+    // The rows asked for: each row's product is the same sum as in the whole.
     MatX out(static_cast<Index>(rows->size()), values.cols());
-    // Gathered a column at a time (the values are column-major: a row is one entry per
+    // The values gathered a column at a time (the values are column-major: a row is one entry per
     // column, each in another cache line), the columns on all cores.
     const Index n_rows = static_cast<Index>(rows->size());
     parallel_for(
@@ -493,7 +560,7 @@ std::optional<MatX> FitSystem::smoothing_residual(const Eigen::Ref<const MatX>& 
           for (Index i = 0; i < n_rows; ++i) to[i] = from[(*rows)[static_cast<std::size_t>(i)]];
         },
         4);
-    rows_times(rows_of(s.phi, *rows), params, out, true);
+    rows_times(s.phi, params, out, true, rows);
     return out;
   }
   MatX out = values;
@@ -506,8 +573,8 @@ void FitSystem::set_probes(const MatX& p) {
   s.probes = p;
   for (Index r = 0; r < p.rows(); ++r)
     if (!(s.w[r] > 0.0)) s.probes.row(r).setZero();
-  s.probes_plain = s.phi.transpose() * s.probes;
-  s.probes_weighted = s.phi.transpose() * (s.w.asDiagonal() * s.probes);
+  s.probes_plain = transpose_times(s.phi, s.probes, nullptr);
+  s.probes_weighted = transpose_times(s.phi, s.probes, &s.w);
 }
 
 void FitSystem::Impl::draw_probes(int count) {
@@ -521,8 +588,8 @@ void FitSystem::Impl::draw_probes(int count) {
       probes(r, c) = (w[r] > 0.0) ? (((bits >> (c % 64)) & 1U) ? 1.0 : -1.0) : 0.0;
     }
   }
-  probes_plain = phi.transpose() * probes;
-  probes_weighted = phi.transpose() * (w.asDiagonal() * probes);
+  probes_plain = transpose_times(phi, probes, nullptr);
+  probes_weighted = transpose_times(phi, probes, &w);
 }
 
 MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const Eigen::Ref<const MatX>& reference,
@@ -545,7 +612,7 @@ MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const
   weighted_sum(terms, term_weight, term_values, normal_values.data(), ws.pen.valuePtr(), ws.k.valuePtr(),
                ws.k.nonZeros());
   Eigen::Map<VecX> k_values(ws.k.valuePtr(), ws.k.nonZeros());
-  MatX rhs = rhs_data + ws.pen * reference;
+  MatX rhs = plus_product(rhs_data, ws.pen, reference);
   // Pin dofs nothing determines (unused by every element, or with an empty row).
   pinned.clear();
   for (Index i = 0; i < n; ++i)
@@ -569,7 +636,7 @@ MatX FitSystem::Impl::parameters(FitWorkspace& ws, const Penalty& penalty, const
   MatX parameters = ws.solver.solve(rhs);
   // Further passes penalise the deviation from the previous pass (same matrix).
   for (int pass = 1; pass < passes; ++pass) {
-    MatX r = rhs_data + ws.pen * parameters;
+    MatX r = plus_product(rhs_data, ws.pen, parameters);
     for (Index i : pinned) r.row(i) = reference.row(i);
     parameters = ws.solver.solve(r);
   }
@@ -589,7 +656,7 @@ FitResult FitSystem::Impl::solve(FitWorkspace& ws, const Penalty& penalty, const
     for (Index i : pinned) b.row(i).setZero();
     MatX hb = ws.solver.solve(b);
     for (int pass = 1; pass < passes; ++pass) {
-      MatX r = b + ws.pen * hb;
+      MatX r = plus_product(b, ws.pen, hb);
       for (Index i : pinned) r.row(i).setZero();
       hb = ws.solver.solve(r);
     }

@@ -50,7 +50,12 @@ std::vector<double> strain_misfit_scores(const MatX& residual, const VecX& weigh
   if (static_cast<Index>(used.size()) < kStrainWindow) return score;
   Points3 at(static_cast<Index>(used.size()), 3);
   for (std::size_t i = 0; i < used.size(); ++i) at.row(static_cast<Index>(i)) = marks.undeformed.row(used[i]);
-  const auto nbs = mesh::nearest_neighbours(at, kStrainWindow - 1);
+  // At most kStrainMarks marks judged (evenly picked): enough per element, and the cost
+  // stays small on large parts. Their neighbours only are searched.
+  const std::size_t stride = (used.size() + kStrainMarks - 1) / kStrainMarks;
+  std::vector<Index> judged;
+  for (std::size_t i = 0; i < used.size(); i += stride) judged.push_back(static_cast<Index>(i));
+  const auto nbs = mesh::nearest_neighbours(at, kStrainWindow - 1, judged);
   const Vec3 a1 = setup.frame.a1, a2 = setup.frame.a2;
   // Per-component variance of the noise: two levels (in-plane, normal) where estimated.
   const bool two = noise.sigma_tangent > 0.0 && noise.sigma_normal > 0.0;
@@ -61,11 +66,9 @@ std::vector<double> strain_misfit_scores(const MatX& residual, const VecX& weigh
   std::vector<int> count(static_cast<std::size_t>(n_el), 0);
   std::vector<std::array<double, 4>> marks_z2;
   std::vector<Index> marks_element;
-  // At most kStrainMarks marks judged (evenly picked): enough per element, and the cost
-  // stays small on large parts.
-  const std::size_t stride = (used.size() + kStrainMarks - 1) / kStrainMarks;
-  for (std::size_t i = 0; i < used.size(); i += stride) {
-    const auto& nb = nbs[i];
+  for (std::size_t j = 0; j < judged.size(); ++j) {
+    const std::size_t i = static_cast<std::size_t>(judged[j]);
+    const auto& nb = nbs[j];
     if (static_cast<int>(nb.size()) < kStrainWindow - 1) continue;
     const Index kw = static_cast<Index>(nb.size()) + 1;
     std::vector<Index> w(1, static_cast<Index>(i));

@@ -413,7 +413,8 @@ MarkStrains assessed_strains(const AnalysisResult& r, const std::vector<std::opt
   return m;
 }
 
-io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv, const MidSurfaceOptions& mid) {
+io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv, const MidSurfaceOptions& mid,
+                              const std::vector<bool>* measured_given) {
   io::PolyMesh pm;
   const fe::SurfaceField fu(r.mesh, r.undeformed_parameters), fd(r.mesh, r.deformed_parameters);
   const Index ne = r.mesh.n_elements();
@@ -430,7 +431,7 @@ io::PolyMesh surface_polymesh(const AnalysisResult& r, bool deformed, int subdiv
   const unsigned updates = basis::kValues | basis::kFirst | (mid.enabled() ? basis::kSecond : 0u);
   // Only the cells where the marks are (gsa/measured_region.hpp); every point is kept, so
   // element e's points stay at e (subdiv + 1)^2 onwards.
-  const std::vector<bool> measured = measured_cells(r, subdiv);
+  const std::vector<bool> measured = measured_given ? *measured_given : measured_cells(r, subdiv);
   std::vector<double> kept_element;
   Index pt = 0;
   for (Index e = 0; e < ne; ++e) {
@@ -641,8 +642,10 @@ WrittenResults write_results(io::AtomicOutputDir& out, const GridData& grid, Ana
                         [&] { write_strains_csv(out.path("strains.csv"), grid, result, options, margins, press); });
   try {
     if (result.method == Method::kSurface) {
+      const std::vector<bool> measured = measured_cells(result, 8);  // made once for both surfaces
       for (const bool deformed : {false, true}) {
-        io::PolyMesh surface = surface_polymesh(result, deformed, 8, mid ? options.mid : MidSurfaceOptions{});
+        io::PolyMesh surface =
+            surface_polymesh(result, deformed, 8, mid ? options.mid : MidSurfaceOptions{}, &measured);
         io::write_vtp(out.path(deformed ? "deformed.vtp" : "undeformed.vtp"), surface);
         if (options.keep_surfaces) (deformed ? written.deformed : written.undeformed) = std::move(surface);
       }

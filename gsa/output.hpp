@@ -80,8 +80,10 @@ nlohmann::json make_summary(const GridData& grid, const AnalysisResult& result, 
 // A fitted surface tessellated (subdiv x subdiv quads per element) with the strain fields
 // as point data, as undeformed.vtp and deformed.vtp hold it; `deformed` selects the surface.
 // With `mid` enabled also mid_lambda1, mid_lambda2 and thickness (current, length unit).
+// `measured`: measured_cells(result, subdiv) when already made (gsa/measured_region.hpp; a
+// Delaunay triangulation of the marks: both surfaces of one result share it).
 io::PolyMesh surface_polymesh(const AnalysisResult& result, bool deformed, int subdiv = 8,
-                              const MidSurfaceOptions& mid = {});
+                              const MidSurfaceOptions& mid = {}, const std::vector<bool>* measured = nullptr);
 void write_samples_csv(const std::string& path, const AnalysisResult& result, const OutputOptions& options);
 
 // What write_results() computed on the way.

@@ -49,6 +49,15 @@ auto keep_others(std::vector<Index>& nb, Index self) {
   return boost::make_function_output_iterator(KeepOthers{&nb, self});
 }
 
+// The k nearest points to `at` other than `self`, nearest first, into `nb`.
+void nearest_others(const Tree& tree, const Point& at, Index self, int k, std::vector<Index>& nb) {
+  // k + 1: the query point finds itself first.
+  Search search(tree, at, static_cast<unsigned>(k) + 1);
+  nb.reserve(static_cast<std::size_t>(k));
+  for (auto it = search.begin(); it != search.end(); ++it)
+    if (it->first.second != self && static_cast<int>(nb.size()) < k) nb.push_back(it->first.second);
+}
+
 }  // namespace
 
 std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k) {
@@ -59,12 +68,21 @@ std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k)
   tree.build();  // before the queries: a built tree is searched from several threads
   parallel_for(static_cast<Index>(samples.size()), [&](Index i) {
     const Sample& s = samples[static_cast<std::size_t>(i)];
-    // k + 1: the query point finds itself first.
-    Search search(tree, s.first, static_cast<unsigned>(k) + 1);
-    std::vector<Index>& nb = out[static_cast<std::size_t>(s.second)];
-    nb.reserve(static_cast<std::size_t>(k));
-    for (auto it = search.begin(); it != search.end(); ++it)
-      if (it->first.second != s.second && static_cast<int>(nb.size()) < k) nb.push_back(it->first.second);
+    nearest_others(tree, s.first, s.second, k, out[static_cast<std::size_t>(s.second)]);
+  });
+  return out;
+}
+
+std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k, const std::vector<Index>& query) {
+  std::vector<std::vector<Index>> out(query.size());
+  const std::vector<Sample> samples = finite_samples(points);
+  if (samples.size() < 2 || k <= 0) return out;
+  Tree tree(samples.begin(), samples.end());
+  tree.build();
+  parallel_for(static_cast<Index>(query.size()), [&](Index i) {
+    const Index p = query[static_cast<std::size_t>(i)];
+    if (points.row(p).allFinite())
+      nearest_others(tree, Point(points(p, 0), points(p, 1), points(p, 2)), p, k, out[static_cast<std::size_t>(i)]);
   });
   return out;
 }

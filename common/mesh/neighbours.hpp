@@ -16,6 +16,8 @@ namespace sf::mesh {
 // nearest first (fewer when n - 1 < k). Rows with a non-finite coordinate get no
 // neighbours and are never anyone's neighbour.
 std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k);
+// The same for the rows `query` only (out[i] for query[i]; the same lists as in the whole).
+std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k, const std::vector<Index>& query);
 
 // For every row p of `points`, the indices of the other points within `radius`
 // (unsorted). Non-finite rows as above.

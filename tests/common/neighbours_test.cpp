@@ -88,5 +88,22 @@ TEST(Neighbours, NearestAreNearestFirstAndMatchBruteForce) {
   }
 }
 
+// The same lists, in the same order (ties on the lattice included), for queried rows as
+// for all: gsa's strain test searches the marks it judges only.
+TEST(Neighbours, NearestForQueriedRowsAreTheSameListsAsForAll) {
+  const Points3 p = sheet_points();
+  const auto all = nearest_neighbours(p, 8);
+  std::vector<Index> query;
+  for (Index i = 0; i < p.rows(); i += 3) query.push_back(i);
+  query.push_back(17);
+  query.push_back(44);
+  const auto some = nearest_neighbours(p, 8, query);
+  ASSERT_EQ(some.size(), query.size());
+  for (std::size_t k = 0; k < query.size(); ++k)
+    EXPECT_EQ(some[k], all[static_cast<std::size_t>(query[k])]) << "query " << k;
+  EXPECT_TRUE(some[query.size() - 2].empty());
+  EXPECT_EQ(some.back().size(), 8u);
+}
+
 }  // namespace
 }  // namespace sf::mesh

@@ -120,9 +120,16 @@ nlohmann::json summary_json(const FormingCase& spec, const Model& model, const R
   j["command_line"] = run.command_line;
   j["inputs"] = {{"case", spec.file}};
   j["parameters"] = parameters_json(spec, model);
-  j["analysis"] = dynamic              ? "dynamic (" + spec.solver.integrator + ", no contact)"
-                  : run.follower_loads ? "quasi-static, follower loads (no contact)"
-                                       : "quasi-static (no contact)";
+  // spec.contacts holds every pair, the laminates' and the diaphragms' included.
+  bool with_tools = false, between_plies = false;
+  for (const CaseContact& c : spec.contacts) (c.tool >= 0 ? with_tools : between_plies) = true;
+  const std::string contact = with_tools && between_plies ? "contact between plies and with tools"
+                              : with_tools                ? "contact with tools"
+                              : between_plies             ? "contact between plies"
+                                                          : "no contact";
+  j["analysis"] = dynamic              ? "dynamic (" + spec.solver.integrator + ", " + contact + ")"
+                  : run.follower_loads ? "quasi-static, follower loads (" + contact + ")"
+                                       : "quasi-static (" + contact + ")";
   if (dynamic) j["time"] = {{"end_time_s", spec.solver.end_time}, {"time_s", run.load_factor * spec.solver.end_time}};
   j["multiplier_updates"] = run.multiplier_updates;
   j["status"] = run.status;

@@ -6,7 +6,9 @@
 //                moduli), plies (with fibre directions), boundary conditions, solver,
 //                output, model (dofs, element, quadrature)
 //   loads        each load with its ramp
-//   analysis     "quasi-static (no contact)", "... follower loads ..." or "dynamic (...)"
+//   analysis     "quasi-static (...)", "quasi-static, follower loads (...)" or "dynamic
+//                (integrator, ...)", the brackets saying "no contact", "contact between
+//                plies", "contact with tools" or "contact between plies and with tools"
 //   time         dynamic runs: end_time_s and the time reached, time_s
 //   status       "converged" | "stopped" | "not_converged", message
 //   restart      {file, restarted, from_load_factor}

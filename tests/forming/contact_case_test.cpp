@@ -249,6 +249,7 @@ solver: {steps: 2}
   const double up = cell(2, "punch_fz"), down = cell(2, "table_fz");
   EXPECT_GT(up, 0.1);
   EXPECT_NEAR(up, -down, 1e-6 * up);
+  EXPECT_EQ(out.summary.at("analysis"), "quasi-static (contact with tools)");
   const std::string pvd = fixtures::read_text(dir / "result.pvd");
   for (const char* part : {"steps/tool_table_0002.vtu", "steps/tool_punch_0002.vtu", "steps/contact_0002.vtu"}) {
     EXPECT_NE(pvd.find(part), std::string::npos) << part;

@@ -11,6 +11,7 @@
 #include <boost/iterator/function_output_iterator.hpp>
 
 #include <iterator>
+#include <numeric>
 #include <utility>
 
 #include "common/core/parallel.hpp"
@@ -61,16 +62,9 @@ void nearest_others(const Tree& tree, const Point& at, Index self, int k, std::v
 }  // namespace
 
 std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k) {
-  std::vector<std::vector<Index>> out(static_cast<std::size_t>(points.rows()));
-  const std::vector<Sample> samples = finite_samples(points);
-  if (samples.size() < 2 || k <= 0) return out;
-  Tree tree(samples.begin(), samples.end());
-  tree.build();  // before the queries: a built tree is searched from several threads
-  parallel_for(static_cast<Index>(samples.size()), [&](Index i) {
-    const Sample& s = samples[static_cast<std::size_t>(i)];
-    nearest_others(tree, s.first, s.second, k, out[static_cast<std::size_t>(s.second)]);
-  });
-  return out;
+  std::vector<Index> all(static_cast<std::size_t>(points.rows()));
+  std::iota(all.begin(), all.end(), Index{0});
+  return nearest_neighbours(points, k, all);
 }
 
 std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k, const std::vector<Index>& query) {
@@ -78,7 +72,7 @@ std::vector<std::vector<Index>> nearest_neighbours(const Points3& points, int k,
   const std::vector<Sample> samples = finite_samples(points);
   if (samples.size() < 2 || k <= 0) return out;
   Tree tree(samples.begin(), samples.end());
-  tree.build();
+  tree.build();  // before the queries: a built tree is searched from several threads
   parallel_for(static_cast<Index>(query.size()), [&](Index i) {
     const Index p = query[static_cast<std::size_t>(i)];
     if (points.row(p).allFinite())

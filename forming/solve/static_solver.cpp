@@ -599,8 +599,17 @@ StaticResult solve_static(const Model& model, const Eigen::Ref<const VecX>& x_st
   }
   if (options.workspace) options.workspace->next_increment = increment;
   if (options.workspace && options.extrapolate && lambda >= 1.0) {
-    options.workspace->last_increment = x - x_start;
-    options.workspace->last_span = span;
+    TangentWorkspace& w = *options.workspace;
+    if (span > 0.0) {
+      w.last_increment = x - x_start;
+      w.last_span = span;
+    } else if (w.last_span > 0.0 && w.last_increment.size() == n) {
+      // A solve with the time standing still (a step repeated for multiplier updates)
+      // belongs to the step before it: its correction joins that step's increment, over
+      // that step's span (overwriting the span with 0 turned the next step's
+      // extrapolation off).
+      w.last_increment += x - x_start;
+    }
   }
   if (lambda >= 1.0) {
     report.status = SolveStatus::kConverged;

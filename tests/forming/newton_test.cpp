@@ -18,6 +18,7 @@
 #include "forming/case/reader.hpp"
 #include "forming/solve/static_solver.hpp"
 #include "forming/solve/stepper.hpp"
+#include "forming/solve/tangent_solver.hpp"
 #include "tests/forming/fixtures.hpp"
 
 namespace sf::forming {
@@ -78,6 +79,51 @@ Stepped run_stepper(const char* name, bool watchdog) {
 // 0.5 um taper and converge; 73 with the watchdog (no cut-back). The pull force is the
 // same to the Newton tolerance and the sub-stepping (the viscous rates are taken over
 // each converged sub-step).
+// StaticOptions::extrapolate across a repeated step: a solve whose clock stands still (the
+// stepper's repeats for multiplier updates) keeps the last step's span and adds its own
+// correction to that step's increment. It set the span to 0, which turned the next step's
+// extrapolation off. A neo-Hookean block (2 x 1 x 0.5 mm), one end held, the other
+// stretched 0.2 mm over a step of 1 s; the repeat is solved from a nudged end state.
+TEST(NewtonIterations, RepeatedStepKeepsTheExtrapolatingPredictorsSpan) {
+  const Model model = fixtures::one_ply_model(fixtures::rectangle_ply(2.0, 1.0, 0.5, 2, 1),
+                                              fixtures::neo_hookean(1.0, 2.0));
+  const PlyMesh& ply = model.ply(0);
+  const VecX X = model.reference_positions();
+  std::vector<PrescribedDof> held, pulled;
+  for (Index node = 0; node < ply.n_nodes(); ++node) {
+    const Index dx = model.dof(0, node, 0, 0);
+    if (X(dx) < 1e-12)
+      for (int c = 0; c < 3; ++c) held.push_back({model.dof(0, node, 0, c), X(model.dof(0, node, 0, c))});
+    else if (X(dx) > 2.0 - 1e-12)
+      pulled.push_back({dx, X(dx) + 0.2});
+  }
+  ASSERT_FALSE(held.empty());
+  ASSERT_FALSE(pulled.empty());
+  std::vector<PrescribedDof> fixed = held;
+  fixed.insert(fixed.end(), pulled.begin(), pulled.end());
+  StaticOptions so;
+  so.extrapolate = true;
+  so.workspace = std::make_shared<TangentWorkspace>();
+  so.clock = {0.0, 1.0, nullptr, 0.0};
+  const StaticResult step = solve_static(model, X, fixed, VecX(), so);
+  ASSERT_TRUE(step.report.ok()) << step.report.brief();
+  const VecX increment = so.workspace->last_increment;
+  ASSERT_EQ(so.workspace->last_span, 1.0);
+  // The repeat: the time standing at the step's end, from a state off the equilibrium.
+  VecX nudged = step.positions;
+  for (Index i = 0; i < nudged.size(); ++i) nudged(i) += 1e-4 * std::sin(0.9 * double(i));
+  for (const PrescribedDof& p : fixed) nudged(p.dof) = p.value;
+  StaticOptions repeat = so;
+  repeat.clock = {1.0, 1.0, &X, 0.0};
+  const StaticResult again = solve_static(model, nudged, fixed, VecX(), repeat);
+  ASSERT_TRUE(again.report.ok()) << again.report.brief();
+  EXPECT_EQ(so.workspace->last_span, 1.0);  // 0 before: the next step would not extrapolate
+  ASSERT_EQ(so.workspace->last_increment.size(), X.size());
+  const VecX expected = increment + (again.positions - nudged);
+  EXPECT_LT((so.workspace->last_increment - expected).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_LT((so.workspace->last_increment - (again.positions - X)).lpNorm<Eigen::Infinity>(), 2e-4);
+}
+
 TEST(NewtonIterations, WatchdogTakesThePulloutThroughTheViscousTaper) {
   const Stepped with = run_stepper("ply_pullout.yaml", true);
   const Stepped without = run_stepper("ply_pullout.yaml", false);

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <cstring>
+#include <stdexcept>
 
 #include "common/linalg/simd.hpp"
 
@@ -112,6 +113,63 @@ template <int W, bool kAdd>
   atb_lower_scalar<kAdd>(n, depth, a, lda, b, ldb, c, ldc);
 }
 
+// Packed operands (set_atb_lower_packed): A(p, i) at a[depth 8 (i / 8) + 8 p + i % 8], so
+// each strip of 8 rows is one contiguous stream over the depth. A block of MV vectors x
+// NR columns (NR within one strip of B) reads MV + 1 sequential streams.
+template <int W, int MV, int NR>
+[[gnu::always_inline]] inline void atb_block_packed(int depth, const double* a, int i0, const double* b, int j0,
+                                                    double* c, int ldc) {
+  using V = simd::Vec<W>;
+  const long strip = 8L * depth;
+  const double* ap[MV];
+  for (int v = 0; v < MV; ++v) ap[v] = a + strip * ((i0 + v * W) / 8) + (i0 + v * W) % 8;
+  const double* bp = b + strip * (j0 / 8) + j0 % 8;
+  V acc[NR][MV];
+  for (int j = 0; j < NR; ++j)
+    for (int v = 0; v < MV; ++v) acc[j][v] = V{};
+  for (long p = 0; p < 8L * depth; p += 8) {
+    V av[MV];
+    for (int v = 0; v < MV; ++v) av[v] = simd::at<W>(ap[v] + p);
+    for (int j = 0; j < NR; ++j) {
+      const double bj = bp[p + j];
+      for (int v = 0; v < MV; ++v) acc[j][v] += av[v] * bj;
+    }
+  }
+  for (int j = 0; j < NR; ++j) {
+    double* cp = c + static_cast<long>(j0 + j) * ldc + i0;
+    for (int v = 0; v < MV; ++v) simd::at<W>(cp + v * W) = acc[j][v];
+  }
+}
+
+template <int W>
+[[gnu::always_inline]] inline void atb_lower_packed(int n, int depth, const double* a, const double* b, double* c,
+                                                    int ldc) {
+  // MV W rows a block, NR columns (NR divides 8: the columns stay in one strip of B).
+  constexpr int kMv = W == 8 ? 3 : 2, kNr = W == 8 ? 8 : 4;
+  for (int j0 = 0; j0 < n; j0 += kNr) {
+    int i0 = (j0 / W) * W;
+    const int lead = ((n - i0) / W) % kMv;
+    if (kMv > 2 && lead == 2) {
+      atb_block_packed<W, (kMv > 2 ? 2 : 1), kNr>(depth, a, i0, b, j0, c, ldc);
+      i0 += 2 * W;
+    } else if (lead == 1) {
+      atb_block_packed<W, 1, kNr>(depth, a, i0, b, j0, c, ldc);
+      i0 += W;
+    }
+    for (; i0 < n; i0 += kMv * W) atb_block_packed<W, kMv, kNr>(depth, a, i0, b, j0, c, ldc);
+  }
+}
+
+SF_SIMD_AVX512 void atb_lower_packed_avx512(int n, int depth, const double* a, const double* b, double* c, int ldc) {
+  atb_lower_packed<8>(n, depth, a, b, c, ldc);
+}
+SF_SIMD_AVX2 void atb_lower_packed_avx2(int n, int depth, const double* a, const double* b, double* c, int ldc) {
+  atb_lower_packed<4>(n, depth, a, b, c, ldc);
+}
+void atb_lower_packed_generic(int n, int depth, const double* a, const double* b, double* c, int ldc) {
+  atb_lower_packed<2>(n, depth, a, b, c, ldc);
+}
+
 #define SF_ATB_VARIANTS(attr, suffix, W)                                                                     \
   attr void atb_lower_##suffix(bool add, int n, int depth, const double* a, int lda, const double* b, int ldb, \
                                double* c, int ldc) {                                                           \
@@ -209,6 +267,19 @@ void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, 
 
 void set_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc) {
   atb_lower_dispatch(false, n, depth, a, lda, b, ldb, c, ldc);
+}
+
+void set_atb_lower_packed(int n, int depth, const double* a, const double* b, double* c, int ldc) {
+  if (n % 8 != 0) throw std::invalid_argument("set_atb_lower_packed: n must be a multiple of 8");
+  switch (kernel_isa()) {
+    case KernelIsa::kAvx512:
+      return atb_lower_packed_avx512(n, depth, a, b, c, ldc);
+    case KernelIsa::kAvx2:
+      return atb_lower_packed_avx2(n, depth, a, b, c, ldc);
+    case KernelIsa::kGeneric:
+      break;
+  }
+  atb_lower_packed_generic(n, depth, a, b, c, ldc);
 }
 
 double fma_peak_gflops(double seconds) {

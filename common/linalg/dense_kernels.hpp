@@ -42,6 +42,11 @@ int vector_width(KernelIsa isa);
 void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc);
 // C(i, j) = sum_p A(p, i) B(p, j) for n > i >= j >= 0 (same layout as add_atb_lower).
 void set_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc);
+// The same from packed operands: A(p, i) = a[depth 8 (i / 8) + 8 p + i % 8] (each strip
+// of 8 columns of A stored depth-major, so a block reads contiguous memory), B likewise;
+// n a multiple of 8 (std::invalid_argument otherwise). packed_index() gives the position.
+void set_atb_lower_packed(int n, int depth, const double* a, const double* b, double* c, int ldc);
+inline long packed_index(int depth, int p, int i) { return 8L * depth * (i / 8) + 8L * p + i % 8; }
 inline double add_atb_lower_flops(int n, int depth) { return double(n) * (n + 1) * depth; }
 
 // The calling thread's attainable double-precision rate with the vector set in use,

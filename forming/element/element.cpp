@@ -295,14 +295,16 @@ template <int W>
 // Force (in the header's order, f[3 k + i] += dV sum_A P_iA dN_k/dX_A, P = F S) and, with
 // `tangent`, the point's rows of the two products: b (6 x 96, B in Voigt rows, columns in
 // the header's order 3 k + i), d (6 x 96, dV CC B), ga (3 x 32, dN/dX) and gb (3 x 32,
-// dV S dN/dX). g3 is dN/dX in the header's order (3 x 96, g3[96 A + 3 k + i] = dN_k/dX_A).
+// dV S dN/dX), point q's rows 6 q .. 6 q + 5 (3 q .. 3 q + 2) of the products' operands of
+// depth 6 nq (3 nq), stored packed (linalg::packed_index). g3 is dN/dX in the header's
+// order (3 x 96, g3[96 A + 3 k + i] = dN_k/dX_A).
 // F, S, P row-major; CC row-major 6 x 6. Along the header's order the coordinate i of a
 // column repeats with period 3, so F's and P's entries per lane repeat every 24 columns
 // (a whole number of vectors for every width).
 template <int W>
 [[gnu::always_inline]] inline void point_rows(const double* gt, const double* g3, const double* F, const double* S,
-                                              const double* CC, double dv, bool tangent, double* f, double* b,
-                                              double* d, double* ga, double* gb) {
+                                              const double* CC, double dv, bool tangent, int q, int nq, double* f,
+                                              double* b, double* d, double* ga, double* gb) {
   using V = linalg::simd::Vec<W>;
   using linalg::simd::at;
   constexpr int kPeriod = 24;
@@ -337,17 +339,19 @@ template <int W>
     bv[4] = g2 * f1 + g1 * f2;
     bv[5] = g2 * f0 + g0 * f2;
     for (int I = 0; I < 6; ++I) {
-      at<W>(b + kNd * I + c) = bv[I];
+      const long at_p = linalg::packed_index(6 * nq, 6 * q + I, c);
+      at<W>(b + at_p) = bv[I];
       V s = bv[0] * cc[6 * I];
       for (int J = 1; J < 6; ++J) s += bv[J] * cc[6 * I + J];
-      at<W>(d + kNd * I + c) = s;
+      at<W>(d + at_p) = s;
     }
   }
   for (int k = 0; k < kNf; k += W) {
     const V g0 = at<W>(gt + k), g1 = at<W>(gt + kNf + k), g2 = at<W>(gt + 2 * kNf + k);
     for (int A = 0; A < 3; ++A) {
-      at<W>(ga + kNf * A + k) = A == 0 ? g0 : (A == 1 ? g1 : g2);
-      at<W>(gb + kNf * A + k) = (g0 * S[3 * A] + g1 * S[3 * A + 1] + g2 * S[3 * A + 2]) * dv;
+      const long at_p = linalg::packed_index(3 * nq, 3 * q + A, k);
+      at<W>(ga + at_p) = A == 0 ? g0 : (A == 1 ? g1 : g2);
+      at<W>(gb + at_p) = (g0 * S[3 * A] + g1 * S[3 * A + 1] + g2 * S[3 * A + 2]) * dv;
     }
   }
 }
@@ -362,9 +366,9 @@ template <int W>
     return point_kinematics<W>(dxi, dxi3, gh, ld, gt, g3, F);                                                  \
   }                                                                                                            \
   attr void point_rows_##suffix(const double* gt, const double* g3, const double* F, const double* S,          \
-                                const double* CC, double dv, bool tangent, double* f, double* b, double* d,    \
-                                double* ga, double* gb) {                                                       \
-    point_rows<W>(gt, g3, F, S, CC, dv, tangent, f, b, d, ga, gb);                                              \
+                                const double* CC, double dv, bool tangent, int q, int nq, double* f,          \
+                                double* b, double* d, double* ga, double* gb) {                                 \
+    point_rows<W>(gt, g3, F, S, CC, dv, tangent, q, nq, f, b, d, ga, gb);                                       \
   }
 SF_BRICK_KERNEL_VARIANTS(SF_SIMD_AVX512, avx512, 8)
 SF_BRICK_KERNEL_VARIANTS(SF_SIMD_AVX2, avx2, 4)
@@ -373,8 +377,8 @@ SF_BRICK_KERNEL_VARIANTS(, generic, 2)
 
 using JacobiansFn = void (*)(const double*, int, const double*, const double*, double*);
 using KinematicsFn = double (*)(const double*, const double*, const double*, int, double*, double*, double*);
-using RowsFn = void (*)(const double*, const double*, const double*, const double*, const double*, double, bool,
-                        double*, double*, double*, double*, double*);
+using RowsFn = void (*)(const double*, const double*, const double*, const double*, const double*, double, bool, int,
+                        int, double*, double*, double*, double*, double*);
 
 void pick_variants(JacobiansFn& jac, KinematicsFn& kin, RowsFn& rows) {
   switch (linalg::kernel_isa()) {
@@ -502,9 +506,7 @@ void BrickKernel::evaluate(const BrickParams& X_e, const BrickParams& x_e, const
     if (want_tangent)
       for (int I = 0; I < 6; ++I)
         for (int J = 0; J < 6; ++J) CC[6 * I + J] = resp.tangent(I, J);
-    const std::size_t q6 = static_cast<std::size_t>(6 * q) * kNd, q3 = static_cast<std::size_t>(3 * q) * kNf;
-    rows(gt, g3, F, S, CC, dv, want_tangent, f, want_tangent ? b + q6 : nullptr, want_tangent ? d + q6 : nullptr,
-         want_tangent ? ga + q3 : nullptr, want_tangent ? gb + q3 : nullptr);
+    rows(gt, g3, F, S, CC, dv, want_tangent, q, nq, f, b, d, ga, gb);
     if (constrained) {
       for (int A = 0; A < 3; ++A)
         for (int k = 0; k < kNf; ++k) dn_dX(k, A) = gt[kNf * A + k];
@@ -519,8 +521,8 @@ void BrickKernel::evaluate(const BrickParams& X_e, const BrickParams& x_e, const
     double* kg = aligned(scratch.k_geo, static_cast<std::size_t>(kNf * kNf));
     // The material part straight into the result's lower triangle (the rows of b and d
     // are in the header's order already), the initial-stress part into its own 32 x 32.
-    linalg::set_atb_lower(kNd, 6 * nq, b, kNd, d, kNd, t, kNd);
-    linalg::set_atb_lower(kNf, 3 * nq, ga, kNf, gb, kNf, kg, kNf);
+    linalg::set_atb_lower_packed(kNd, 6 * nq, b, d, t, kNd);
+    linalg::set_atb_lower_packed(kNf, 3 * nq, ga, gb, kg, kNf);
     // Initial stress on the diagonal coordinate blocks: K(3 k + i, 3 l + i) += kg(k, l),
     // k >= l (lower triangle).
     for (int l = 0; l < kNf; ++l)
@@ -529,11 +531,19 @@ void BrickKernel::evaluate(const BrickParams& X_e, const BrickParams& x_e, const
         const double* kgl = kg + kNf * l;
         for (int k = l; k < kNf; ++k) col[3 * k] += kgl[k];
       }
-    // Lower triangle to the upper one, in 8 x 8 tiles (both tiles stay in the L1 cache).
-    for (int cb = 0; cb < kNd; cb += 8)
-      for (int rb = cb; rb < kNd; rb += 8)
-        for (int c = cb; c < cb + 8; ++c)
-          for (int r = std::max(rb, c + 1); r < rb + 8; ++r) t[kNd * r + c] = t[kNd * c + r];
+    // Lower triangle to the upper one, in 8 x 8 tiles (both tiles stay in the L1 cache;
+    // fixed bounds off the diagonal, so the copies unroll).
+    static_assert(kNd % 8 == 0, "whole tiles");
+    for (int cb = 0; cb < kNd; cb += 8) {
+      for (int c = cb; c < cb + 8; ++c)
+        for (int r = c + 1; r < cb + 8; ++r) t[kNd * r + c] = t[kNd * c + r];
+      for (int rb = cb + 8; rb < kNd; rb += 8) {
+        const double* src = t + kNd * cb + rb;  // column cb, rows rb ..
+        double* dst = t + kNd * rb + cb;        // column rb, rows cb ..
+        for (int c = 0; c < 8; ++c)
+          for (int r = 0; r < 8; ++r) dst[kNd * r + c] = src[kNd * c + r];
+      }
+    }
   }
   if (constrained) {
     acc.finish(constraints, out);

@@ -5,6 +5,7 @@
 //   build/bin/simform_bench [max_elements_per_side=40] [repeats=3]
 //   build/bin/simform_bench --factorisation N PLIES [repeats]   (orderings, CHOLMOD variants)
 //   build/bin/simform_bench --case N PLIES [repeats]            (one line of the table)
+//   build/bin/simform_bench --kernel N PLIES [rounds]           (the brick kernel alone, one thread)
 //   build/bin/simform_bench --shear-stretch CASE.yaml [N]   (N: N x N elements instead of the file's)
 //   --lu KIND (with any of the above): the tangent stored with both triangles and factorised
 //   as an unsymmetric tangent is (forming/solve/tangent_solver.hpp): auto (MUMPS's LU, checked,
@@ -354,6 +355,48 @@ int run_case(int n, int plies, int repeats, bool study = false) {
   return 0;
 }
 
+// --kernel N PLIES [rounds]: the brick kernel alone (force and tangent of every brick of
+// the stretched plies, `rounds` times) on this thread: seconds per brick on the thread's
+// processor clock, GFLOP/s (BrickKernel::tangent_flops) and the share of this thread's
+// fused multiply-add peak. A steady loop for a profiler (perf record) to split by part.
+int run_kernel(int n, int plies, int rounds) {
+  Setup setup;
+  make_setup(n, plies, setup);
+  const Model& model = setup.model;
+  std::vector<const Material*> materials;
+  std::vector<BrickParams> X_e, x_e;
+  const std::vector<linalg::ElementEntries>& entries = model.element_entries();
+  for (int b = 0; b < model.n_bodies(); ++b)
+    for (Index e = 0; e < model.ply(b).n_elements(); ++e) {
+      const linalg::ElementEntries& en = entries[X_e.size()];
+      BrickParams xe = BrickParams::Zero();
+      for (std::size_t a = 0; a < en.dofs.size(); ++a)
+        xe(en.local[a] / 3, en.local[a] % 3) += en.coefs[a] * setup.x(en.dofs[a]);
+      X_e.push_back(model.ply(b).element_parameters(e, model.ply(b).reference()));
+      x_e.push_back(xe);
+      materials.push_back(&model.material(b));
+    }
+  BrickScratch scratch;
+  ElementResult result;
+  double checksum = 0.0;
+  auto sweep = [&] {
+    for (std::size_t g = 0; g < X_e.size(); ++g) {
+      model.kernel().evaluate(X_e[g], x_e[g], *materials[g], true, {}, scratch, result);
+      checksum += result.tangent(95, 0) + result.force(0);
+    }
+  };
+  sweep();  // warm-up
+  const double t0 = thread_seconds();
+  for (int r = 0; r < rounds; ++r) sweep();
+  const double per_brick = (thread_seconds() - t0) / (static_cast<double>(rounds) * X_e.size());
+  const double peak = linalg::fma_peak_gflops(0.2);
+  const double gf = model.kernel().tangent_flops() / per_brick / 1e9;
+  std::printf("kernel %dx%d x %d plies, %s: %.2f us a brick (%.3f MFLOP), %.1f GFLOP/s, %.0f%% of %.1f (checksum %.6e)\n",
+              n, n, plies, linalg::to_string(linalg::kernel_isa()).c_str(), 1e6 * per_brick,
+              model.kernel().tangent_flops() / 1e6, gf, 100.0 * gf / peak, peak, checksum);
+  return 0;
+}
+
 // --memory N PLIES: where the memory of one case goes, stage by stage. Each stage
 // reports its own peak resident memory (the kernel's high-water mark, reset before the
 // stage), the resident memory and malloc's bytes in use after it, MB, and its wall time.
@@ -486,6 +529,8 @@ int main(int argc, char** argv) {
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3);
     if (argc >= 4 && std::strcmp(argv[1], "--factorisation") == 0)
       return run_case(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 3, true);
+    if (argc >= 4 && std::strcmp(argv[1], "--kernel") == 0)
+      return run_kernel(std::atoi(argv[2]), std::atoi(argv[3]), argc > 4 ? std::atoi(argv[4]) : 20);
     if (argc >= 4 && std::strcmp(argv[1], "--memory") == 0) return run_memory(std::atoi(argv[2]), std::atoi(argv[3]));
     if (argc >= 3 && std::strcmp(argv[1], "--shear-stretch") == 0)
       return run_shear_stretch(argv[2], argc > 3 ? std::atoi(argv[3]) : 0);

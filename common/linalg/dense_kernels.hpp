@@ -15,6 +15,8 @@
 //   a + p * lda). For an element tangent K = sum_q B_q^T (D_q B_q) this is the whole sum
 //   over Gauss points in one call: the rows of A are the B_q, those of B the D_q B_q.
 //   Entries above the diagonal may receive partial sums (ignore them).
+//   set_atb_lower: the same with C = A^T B on the lower triangle (C need not be zeroed;
+//   entries above the diagonal may be overwritten).
 //
 // Flops: n (n + 1) depth for the lower triangle (what add_atb_lower_flops() returns).
 
@@ -38,6 +40,13 @@ int vector_width(KernelIsa isa);
 // C(i, j) += sum_p A(p, i) B(p, j) for n > i >= j >= 0; A(p, i) = a[p * lda + i],
 // B(p, j) = b[p * ldb + j], C(i, j) = c[j * ldc + i].
 void add_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc);
+// C(i, j) = sum_p A(p, i) B(p, j) for n > i >= j >= 0 (same layout as add_atb_lower).
+void set_atb_lower(int n, int depth, const double* a, int lda, const double* b, int ldb, double* c, int ldc);
+// The same from packed operands: A(p, i) = a[depth 8 (i / 8) + 8 p + i % 8] (each strip
+// of 8 columns of A stored depth-major, so a block reads contiguous memory), B likewise;
+// n a multiple of 8 (std::invalid_argument otherwise). packed_index() gives the position.
+void set_atb_lower_packed(int n, int depth, const double* a, const double* b, double* c, int ldc);
+inline long packed_index(int depth, int p, int i) { return 8L * depth * (i / 8) + 8L * p + i % 8; }
 inline double add_atb_lower_flops(int n, int depth) { return double(n) * (n + 1) * depth; }
 
 // The calling thread's attainable double-precision rate with the vector set in use,

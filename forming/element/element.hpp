@@ -161,17 +161,18 @@ ElementResult plane_element(const PlaneParams& X_e, const PlaneParams& x_e, cons
 // once `out` and `scratch` have their sizes). Same results as brick_element() up to
 // rounding.
 //
-// How the tangent is computed (and why it is fast): in the coordinate-major local order
-// c = 32 i + k (coordinate i, function k) the material part is
-//   K_mat = sum_q B_q^T (dV_q CC_q B_q),  B_q: 6 x 96 (the header's B, columns permuted),
-// one product A^T B with A = [B_1; ...; B_Q] and B = [dV CC B_1; ...] of depth 6 Q,
-// of which only the lower triangle is formed (linalg::add_atb_lower, register-blocked and
-// compiled for AVX-512, AVX2 + FMA and SSE2, chosen at run time: linalg::kernel_isa()).
-// The initial-stress part is one 32 x 32 product of depth 3 Q added to the three
-// diagonal coordinate blocks. B and dV CC B are formed together in vector registers. The
-// symmetric result is then written to out.tangent in the header's order D k + i.
+// How the tangent is computed (and why it is fast): the material part is
+//   K_mat = sum_q B_q^T (dV_q CC_q B_q),  B_q: 6 x 96 (the header's B, columns in the
+// header's order D k + i), one product A^T B with A = [B_1; ...; B_Q] and
+// B = [dV CC B_1; ...] of depth 6 Q, of which only the lower triangle is formed, straight
+// into out.tangent (linalg::set_atb_lower, register-blocked and compiled for AVX-512,
+// AVX2 + FMA and SSE2, chosen at run time: linalg::kernel_isa()). B and dV CC B are formed
+// together in vector registers, along the header's order (the coordinate of a column
+// repeats with period 3, so F's entries per lane repeat every 24 columns). The
+// initial-stress part is one 32 x 32 product of depth 3 Q added to the three diagonal
+// coordinate blocks; the lower triangle is then copied to the upper one in 8 x 8 tiles.
 struct BrickScratch {
-  std::vector<double> b, d, ga, gb, k_mat, k_geo;
+  std::vector<double> b, d, ga, gb, k_mat, k_geo, gh;
 };
 
 class BrickKernel {
@@ -189,7 +190,10 @@ class BrickKernel {
 
  private:
   std::vector<double> weights_;
-  std::vector<double> dxi_;  // per point 3 x 32: dN_k/dxi_a at [96 q + 32 a + k]
+  std::vector<double> dxi_;   // per point 3 x 32: dN_k/dxi_a at [96 q + 32 a + k]
+  std::vector<double> dxi3_;  // the same in the header's order: dN_k/dxi_a at [288 q + 96 a + 3 k + i]
+  std::vector<double> dxit_;  // all points' as 32 rows: dN_k/dxi_a at [ld_ k + 3 q + a]
+  int ld_ = 0;                // 3 n_points rounded up to a multiple of 32
 };
 
 // The straightforward per-point implementation (B^T CC B over the full 96 x 96 at each

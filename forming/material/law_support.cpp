@@ -62,7 +62,19 @@ bool is_symmetric(const Mat3& C) {
 void add_volumetric(const Mat3& Ci, double ln_j, double mu, double lambda, bool want_tangent, MaterialResponse& r) {
   r.energy += -mu * ln_j + 0.5 * lambda * ln_j * ln_j;
   r.stress += (lambda * ln_j - mu) * Ci;
-  if (want_tangent) r.tangent += lambda * outer(Ci, Ci) + 2.0 * (mu - lambda * ln_j) * sym_product(Ci);
+  if (!want_tangent) return;
+  // lambda outer(Ci, Ci) + 2 (mu - lambda ln J) sym_product(Ci), entry by entry with the
+  // same operations (no Mat6 temporaries).
+  const double s = 2.0 * (mu - lambda * ln_j);
+  double v[6];
+  for (int I = 0; I < 6; ++I) v[I] = Ci(kVoigtPair[I][0], kVoigtPair[I][1]);
+  for (int K = 0; K < 6; ++K) {
+    const int k = kVoigtPair[K][0], l = kVoigtPair[K][1];
+    for (int I = 0; I < 6; ++I) {
+      const int i = kVoigtPair[I][0], j = kVoigtPair[I][1];
+      r.tangent(I, K) += lambda * (v[I] * v[K]) + s * (0.5 * (Ci(i, k) * Ci(j, l) + Ci(i, l) * Ci(j, k)));
+    }
+  }
 }
 
 bool add_isotropic_volumetric(const char* law, const Mat3& C, double m, double lambda, bool want_tangent,

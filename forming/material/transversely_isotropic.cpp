@@ -155,6 +155,8 @@ TransverselyIsotropic::TransverselyIsotropic(const TransverselyIsotropicParams& 
   const double n = a0.norm();
   if (!std::isfinite(n) || !(n > 0.0)) bad_parameter(kTi, "fibre direction", "a nonzero vector", n);
   a0_ = a0 / n;
+  const Mat3 A = a0_ * a0_.transpose();
+  fibre_tangent_ = 2.0 * params_.kappa_f * outer(A, A) + 2.0 * (params_.mu_L - params_.mu_T) * d2_i5(a0_);
 }
 
 std::string TransverselyIsotropic::name() const {
@@ -176,7 +178,7 @@ MaterialResponse TransverselyIsotropic::evaluate(const Mat3& C, bool want_tangen
   r.energy =
       0.5 * p.mu_T * (C.trace() - 3.0) + 0.5 * c * (i5 - 2.0 * i4 + 1.0) + 0.25 * p.kappa_f * (i4 - 1.0) * (i4 - 1.0);
   r.stress = p.mu_T * Mat3::Identity() + c * (ab + ab.transpose() - 2.0 * A) + p.kappa_f * (i4 - 1.0) * A;
-  if (want_tangent) r.tangent = 2.0 * p.kappa_f * outer(A, A) + 2.0 * c * d2_i5(a);
+  if (want_tangent) r.tangent = fibre_tangent_;
 
   if (!p.incompressible) {
     const double det = C.determinant();

@@ -129,6 +129,7 @@ class TransverselyIsotropic final : public Material {
  private:
   TransverselyIsotropicParams params_;
   Vec3 a0_;
+  Mat6 fibre_tangent_;  // 2 kappa_f A (x) A + 2 (mu_L - mu_T) d2 I5/dCdC: constant, made once
 };
 
 }  // namespace sf::forming

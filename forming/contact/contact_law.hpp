@@ -30,7 +30,7 @@
 //   the search distance): with d = -x the parting beyond the open end, the tie S_t d is
 //   unchanged up to d = R / 2 and tapers to nothing over [R / 2, R],
 //     p_t = -S_t d h(s),  s = (d - R/2) / (R/2),  h = 1 - 3 s^2 + 2 s^3,
-//     stiffness S_t (h + d dh/dd) (S_t at R / 2, 0 at R: C1; down to about -1.75 S_t in
+//     stiffness S_t (h + d dh/dd) (S_t at R / 2, 0 at R: C1; down to about -1.97 S_t in
 //     the taper, a cohesive law's softening), tie at most about 1.08 S_t R / 2,
 //   so a point leaving the search distance carries nothing and the residual has no jump
 //   there (the plain linear tie grew with the parting and then dropped to 0). The energy

@@ -51,6 +51,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -71,6 +72,7 @@
 #include "common/linalg/solver.hpp"
 #include "forming/case/build.hpp"
 #include "forming/case/reader.hpp"
+#include "forming/contact/surface_contact.hpp"
 #include "forming/solve/tangent_solver.hpp"
 #include "forming/model/solve_profile.hpp"
 #include "forming/run/run.hpp"
@@ -463,6 +465,8 @@ int main(int argc, char** argv) {
         std::printf("time limit %.0f s reached before the run ended; figures so far (%ld factorisations):\n",
                     time_limit, snapshot.factorizations);
         print_split(snapshot, wall, cpu_seconds() - cpu0, snapshot.factorizations);
+        std::printf("contact state changes: %ld (points whose state changed between tangent assemblies)\n",
+                    contact_state_flips());
         std::fflush(stdout);
         std::_Exit(3);
       }).detach();
@@ -494,6 +498,11 @@ int main(int argc, char** argv) {
                 r.ok() ? "ok" : "not converged", r.steps_converged, r.total_iterations, p.assemblies, p.factorizations,
                 p.solves);
     if (!r.ok()) std::printf("message: %s\n", r.message.c_str());
+    // Contact points whose state (normal: open / band / closed / out of reach; the viscous
+    // layer) changed between consecutive tangent assemblies: Newton converges quadratically
+    // only once these stop (SF_NEWTON_TRACE=1 lists where, forming/contact/surface_contact.hpp).
+    std::printf("contact state changes: %ld, %.1f a factorisation\n", contact_state_flips(),
+                static_cast<double>(contact_state_flips()) / std::max<long>(1, p.factorizations));
     std::printf("largest displacement (x, y, z) %.12g %.12g %.12g mm\n", r.max_displacement.x(), r.max_displacement.y(),
                 r.max_displacement.z());
     print_split(p, total, cpu, r.total_iterations);

@@ -32,6 +32,7 @@ class BodyContact final : public SurfaceContact {
 
   bool symmetric() const override { return !options().friction.active() && !options().half_pass; }
   std::string describe() const override;
+  double search_reach() const override { return reach_; }
   const ContactSurface& master() const { return master_; }
 
  private:

@@ -191,47 +191,30 @@ PointState add_contact_point(const PointKinematics& k, const PointLaw& law, cons
   if (law.coulomb > 0.0 || law.viscous_slope != 0.0)
     for (int cc = 0; cc < k.n; ++cc)
       dg.segment<3>(3 * cc) = k.phi[static_cast<std::size_t>(cc)] * k.gap_gradient.transpose();
-  if (distance) {
-    // Viscous on v_T, Coulomb on v_T,c = P (v_rel + shift) (the shift is state: constant):
-    //   Phi [w (c_v dv_T + v_T c_v' dg + c_c dv_T,c + v_T,c dc_c)] - R [w dzeta],
-    //   R = rho_a,l (c_v v_T + c_c v_T,c)_i,
-    //   dc_c = -(mu S_b / s) dg - [sliding] (mu p / s^3) v_T,c^T dv_T,c.
-    const LocalRows<3> dvtc = -n.dot(wc) * dn - n * (wc.transpose() * dn) + P * dw;
+  // Friction stiffness w [ (J^T v_T) dc/du + c J^T dv_T/du + c (dJ^T/du) v_T ], viscous on
+  // v_T and Coulomb on v_T,c (the velocity form: v_T,c = v_T, always sliding; the
+  // slip-distance form: P (v_rel + shift), the shift state, so constant):
+  //   Phi [w (c_v dv_T + v_T c_v' dg + c_c dv_T,c + v_T,c dc_c)] - R [w dzeta],
+  //   R = rho_a,l (c_v v_T + c_c v_T,c)_i   (body only),
+  //   dc_c = -(mu S_b / s) dg - [sliding] (mu p / s^3) v_T,c^T dv_T,c,  dp/du = -S dg/du.
+  LocalRows<3> dvtc_distance;
+  if (distance) dvtc_distance = -n.dot(wc) * dn - n * (wc.transpose() * dn) + P * dw;
+  const LocalRows<3>& dvtc = distance ? dvtc_distance : dvt;
+  LocalRows<3> phi_part = law.viscous * dvt + c_c * dvtc;
+  if (law.coulomb > 0.0) {
     LocalRows<1> dc = (-law.coulomb * law.normal.bearing_stiffness / s) * dg;
     if (sliding) dc -= (mu_p / (s * s * s)) * (vtc.transpose() * dvtc);
-    LocalRows<3> phi_part = law.viscous * dvt + c_c * dvtc;
     phi_part.noalias() += vtc * dc;
-    if (law.viscous_slope != 0.0) phi_part.noalias() += vt * (law.viscous_slope * dg);
-    V.leftCols<3>() += w * phi_part.transpose();
-    if (!k.tool) {
-      const Vec3 r = law.viscous * vt + c_c * vtc;
-      for (int a = 0; a < k.n; ++a) {
-        const auto ia = static_cast<std::size_t>(a);
-        U.block<3, 2>(3 * a, 5) = r * Vec2(k.rho1[ia], k.rho2[ia]).transpose();
-      }
-      V.middleCols<2>(5) -= w * dzeta.transpose();
-    }
-    stiff = true;
-    finish();
-    return state;
   }
-  // Friction stiffness w [ (J^T v_T) dc/du + c J^T dv_T/du + c (dJ^T/du) v_T ]
-  //   = Phi [w (v_T dc + c dv_T)] - R [w c dzeta]   (R = rho_a,l (v_T)_i: body only).
-  LocalRows<3> phi_part = c * dvt;
-  if (law.coulomb > 0.0 || law.viscous_slope != 0.0) {
-    // dc/du = c_v' dg/du + (mu / s) dp/du - (mu p / s^3) v_T^T dv_T/du, dp/du = -S dg/du.
-    LocalRows<1> dc = law.viscous_slope * dg;
-    if (law.coulomb > 0.0)
-      dc += (-law.coulomb * law.normal.bearing_stiffness / s) * dg - (mu_p / (s * s * s)) * (vt.transpose() * dvt);
-    phi_part.noalias() += vt * dc;
-  }
+  if (law.viscous_slope != 0.0) phi_part.noalias() += vt * (law.viscous_slope * dg);
   V.leftCols<3>() += w * phi_part.transpose();
   if (!k.tool) {
+    const Vec3 r = law.viscous * vt + c_c * vtc;
     for (int a = 0; a < k.n; ++a) {
       const auto ia = static_cast<std::size_t>(a);
-      U.block<3, 2>(3 * a, 5) = vt * Vec2(k.rho1[ia], k.rho2[ia]).transpose();
+      U.block<3, 2>(3 * a, 5) = r * Vec2(k.rho1[ia], k.rho2[ia]).transpose();
     }
-    V.middleCols<2>(5) -= (w * c) * dzeta.transpose();
+    V.middleCols<2>(5) -= w * dzeta.transpose();
   }
   stiff = true;
   finish();

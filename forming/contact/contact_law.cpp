@@ -16,6 +16,13 @@ namespace {
   throw InputError(os.str());
 }
 
+// The released tail's energy per S_t at s = (d - L) / L in [0, 1] of the taper (d the
+// parting beyond the open end, L = R / 2): L^2 / 2 + integral from L to d of d' h(d') dd'.
+double tail_release_energy(double L, double s) {
+  const double s2 = s * s, s3 = s2 * s, s4 = s3 * s;
+  return 0.5 * L * L + L * (L * (s - s3 + 0.5 * s4) + L * (0.5 * s2 - 0.75 * s4 + 0.4 * s4 * s));
+}
+
 }  // namespace
 
 void NormalLaw::validate() const {
@@ -26,6 +33,8 @@ void NormalLaw::validate() const {
   if (augmented && tail > 0.0)
     bad("normal tail", "no tail with the augmented Lagrangian (its multiplier is the bearing pressure alone)", tail);
   if (!(std::isfinite(tail_reach) && tail_reach >= 0.0)) bad("normal tail_reach", "a length >= 0 (mm)", tail_reach);
+  if (!(std::isfinite(tail_release) && tail_release >= 0.0))
+    bad("normal tail release", "a length >= 0 (mm) over which the linear tail's tie falls to nothing", tail_release);
 }
 
 void FrictionLaw::validate() const {
@@ -82,9 +91,24 @@ NormalResponse normal_response(const NormalLaw& law, double gap, double lambda, 
       // log cosh y = |y| + log(1 + e^(-2|y|)) - log 2, without overflow.
       r.energy += st * reach * reach * (ay + std::log1p(std::exp(-2.0 * ay)) - std::log(2.0));
     } else {
-      r.pressure += st * x;
-      r.stiffness += st;
-      r.energy += 0.5 * st * x * x;
+      // Linear; released (contact_law.hpp): the tie S_t d tapers to nothing over the
+      // second half of the parting d in [R / 2, R] by h(s) = 1 - 3 s^2 + 2 s^3.
+      const double R = law.tail_release;
+      const double d = -x;
+      if (R > 0.0 && d > 0.5 * R) {
+        const double L = 0.5 * R;
+        const double s1 = std::min((d - L) / L, 1.0);
+        const double h = 1.0 - s1 * s1 * (3.0 - 2.0 * s1);
+        const double dh = -6.0 * s1 * (1.0 - s1) / L;  // dh/dd
+        r.pressure -= st * d * h;
+        r.stiffness += st * (h + d * dh);
+        r.energy += st * (tail_release_energy(L, s1) - tail_release_energy(L, 1.0));
+      } else {
+        r.pressure += st * x;
+        r.stiffness += st;
+        r.energy += 0.5 * st * x * x;
+        if (R > 0.0) r.energy -= st * tail_release_energy(0.5 * R, 1.0);
+      }
     }
   }
   return r;

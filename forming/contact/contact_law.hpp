@@ -25,8 +25,19 @@
 //     p_t = S_t x,  energy S_t x^2 / 2                        (r = 0: linear),
 //     p_t = S_t r tanh(x / r),  energy S_t r^2 log cosh(x / r) (r > 0: tension and
 //                                                               pressure bounded by S_t r),
-//   so the stiffness is S_t > 0 (S_t sech^2(x / r)) at every gap within the search
-//   distance and the open end is a simple root. Beyond the open end p < 0: a weak tie
+//   so the stiffness is S_t > 0 (S_t sech^2(x / r)) at the open end, a simple root.
+//   Released (the linear tail, R = tail_release > 0, mm; SurfaceContact sets R to 0.9 x
+//   the search distance): with d = -x the parting beyond the open end, the tie S_t d is
+//   unchanged up to d = R / 2 and tapers to nothing over [R / 2, R],
+//     p_t = -S_t d h(s),  s = (d - R/2) / (R/2),  h = 1 - 3 s^2 + 2 s^3,
+//     stiffness S_t (h + d dh/dd) (S_t at R / 2, 0 at R: C1; down to about -1.97 S_t in
+//     the taper, a cohesive law's softening), tie at most about 1.08 S_t R / 2,
+//   so a point leaving the search distance carries nothing and the residual has no jump
+//   there (the plain linear tie grew with the parting and then dropped to 0). The energy
+//   is the integral of p, shifted so that it is 0 from d = R on.
+//   The bounded tanh tail (r > 0) is not released: its tie, at most S_t r, still drops
+//   to nothing where a point leaves the search distance.
+//   Beyond the open end p < 0: a weak tie
 //   (the tack of the molten resin) that holds a ply to its neighbour where nothing presses
 //   them together. Friction (Coulomb) and the augmented multiplier take the rounded
 //   penalty's part only (`bearing`), never the tie's.
@@ -65,6 +76,7 @@ struct NormalLaw {
   double tolerance = 0.0;  // mm, augmented: largest penetration accepted (> 0)
   double tail = 0.0;       // S_t, N/mm^3 (>= 0; 0: no tail, the plain rounded law)
   double tail_reach = 0.0; // r, mm (>= 0; 0: the linear tail)
+  double tail_release = 0.0;  // R, mm (>= 0; 0: not released): the linear tie falls to 0 at a parting R
   // Throws sf::InputError naming the field ("contact normal stiffness: ...").
   void validate() const;
 };

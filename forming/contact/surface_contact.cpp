@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -107,8 +108,70 @@ SurfaceContact::SurfaceContact(std::string name, const Model& model, ContactSurf
   elastic_before_ = elastic_;
 }
 
+NormalLaw SurfaceContact::normal_law() const {
+  NormalLaw law = options_.normal;
+  if (law.tail > 0.0 && law.tail_reach == 0.0 && law.tail_release == 0.0) law.tail_release = 0.9 * search_reach();
+  return law;
+}
+
 double SurfaceContact::engage_gap() const {
   return options_.friction.engage_gap >= 0.0 ? options_.friction.engage_gap : kEngage * slave_.thickness();
+}
+
+namespace {
+std::atomic<long> g_flips{0};
+}  // namespace
+
+long contact_state_flips() { return g_flips.load(std::memory_order_relaxed); }
+
+void SurfaceContact::report_flips(std::vector<signed char>& status,
+                                  const std::vector<Eigen::Matrix<double, 5, 1>>& where, bool tracing) const {
+  // Status: -1 no partner; else normal (0 open, 1 band, 2 closed) + 4 x viscous (0 off,
+  // 1 taper, 2 engaged). Kinds of change: 0 the search edge (a partner found or lost),
+  // 1 the band's open end (bearing on or off: pressing against the tail's tie or nothing),
+  // 2 the band's closed end, 3 across the whole band in one iteration, 4 the viscous layer.
+  static const char* const kKind[] = {"search edge", "open end", "closed end", "across band", "viscous"};
+  const bool known = flip_status_.size() == status.size();
+  int count[4] = {0, 0, 0, 0}, kinds[5] = {0, 0, 0, 0, 0}, changed = 0;
+  std::ostringstream os;
+  os.precision(4);
+  for (std::size_t i = 0; i < status.size(); ++i) {
+    const int now = status[i];
+    ++count[now < 0 ? 0 : (now % 4) + 1];
+    if (!known || flip_status_[i] == now) continue;
+    const int before = flip_status_[i];
+    const int nb = before < 0 ? -1 : before % 4, nn = now < 0 ? -1 : now % 4;
+    const int vb = before < 0 ? 0 : before / 4, vn = now < 0 ? 0 : now / 4;
+    int kind = 4;
+    if (nb != nn) {
+      // Without a tail an open point carries nothing, whether it has a partner or not.
+      if ((nb < 0 || nn < 0) && options_.normal.tail == 0.0 && std::max(before, now) == 0) continue;
+      if (nb < 0 || nn < 0)
+        kind = 0;
+      else if (std::min(nb, nn) == 0 && std::max(nb, nn) == 1)
+        kind = 1;
+      else if (std::min(nb, nn) == 1)
+        kind = 2;
+      else
+        kind = 3;
+    } else if (vb == vn) {
+      continue;
+    }
+    ++kinds[kind];
+    ++changed;
+    if (tracing && changed <= 8)
+      os << " [" << kKind[kind] << " " << before << ">" << now << " x " << where[i][0] << " y " << where[i][1]
+         << " z " << where[i][2] << " g " << where[i][3] << " p " << where[i][4] << "]";
+  }
+  g_flips.fetch_add(changed, std::memory_order_relaxed);
+  if (tracing) {
+    std::fprintf(stderr,
+                 "contact %s: none %d open %d band %d closed %d; changed %d (search edge %d, open end %d, closed end %d, "
+                 "across band %d, viscous %d)%s\n",
+                 name_.c_str(), count[0], count[1], count[2], count[3], changed, kinds[0], kinds[1], kinds[2], kinds[3],
+                 kinds[4], os.str().c_str());
+  }
+  flip_status_ = std::move(status);
 }
 
 void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const InteractionContext& context, InteractionSums* sums,
@@ -139,16 +202,17 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
   const std::unique_ptr<Prepared> prepared = prepare(x, context, rates, context.previous);
   const double band = options_.band > 0.0 ? options_.band : kBand * slave_.thickness();
   const double engage = engage_gap();
-  // SF_CONTACT_TRACE=1: at every tangent assembly (once per Newton iteration) the
-  // points whose normal status changed since the last one, on stderr.
-  static const bool trace = std::getenv("SF_CONTACT_TRACE") != nullptr;
+  const NormalLaw normal_law = this->normal_law();
+  // Each point's state at this tangent assembly (once per Newton iteration), against the
+  // last one: the points that changed are counted (contact_state_flips()) and, with
+  // SF_NEWTON_TRACE=1 or SF_CONTACT_TRACE=1, listed on stderr with where they are.
+  static const bool trace = std::getenv("SF_CONTACT_TRACE") != nullptr || std::getenv("SF_NEWTON_TRACE") != nullptr;
+  const bool tracking = tangent;
   const bool tracing = trace && tangent;
   std::vector<signed char> status;
-  std::vector<Eigen::Vector4d> where;  // x, y, z, gap of each point
-  if (tracing) {
-    status.assign(static_cast<std::size_t>(n_points()), -1);
-    where.assign(static_cast<std::size_t>(n_points()), Eigen::Vector4d::Zero());
-  }
+  std::vector<Eigen::Matrix<double, 5, 1>> where;  // x, y, z, gap, pressure of each point
+  if (tracking) status.assign(static_cast<std::size_t>(n_points()), -1);
+  if (tracing) where.assign(static_cast<std::size_t>(n_points()), Eigen::Matrix<double, 5, 1>::Zero());
   std::vector<PairBlock> blocks;
   for (Index f = 0; f < slave_.n_faces(); ++f) {
     const SurfaceFace& sf = slave_.face(f);
@@ -183,7 +247,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
         continue;
       }
       PointLaw law;
-      law.normal = normal_response(options_.normal, k.gap, lambda_[id], band);
+      law.normal = normal_response(normal_law, k.gap, lambda_[id], band);
       // The viscous layer: engaged up to the engage gap g_v, tapering smoothly (C1) to
       // nothing over one band width beyond it, so a point whose gap crosses g_v does
       // not switch its friction on and off between Newton iterates (a jump in the
@@ -215,9 +279,12 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
       rec.partner = true;
       rec.gap = k.gap;
       rec.normal = k.normal;
-      if (tracing) {
-        status[id] = law.normal.bearing <= 0.0 ? 0 : law.normal.bearing_stiffness >= options_.normal.stiffness ? 2 : 1;
-        where[id] = Eigen::Vector4d(xs.x(), xs.y(), xs.z(), k.gap);
+      if (tracking) {
+        const int normal =
+            law.normal.bearing <= 0.0 ? 0 : law.normal.bearing_stiffness >= options_.normal.stiffness ? 2 : 1;
+        const int viscous = law.viscous <= 0.0 ? 0 : law.viscous_slope != 0.0 ? 1 : 2;
+        status[id] = static_cast<signed char>(normal + 4 * viscous);
+        if (tracing) where[id] << xs.x(), xs.y(), xs.z(), k.gap, law.normal.pressure;
       }
       const bool contributes = law.normal.pressure != 0.0 || law.normal.stiffness > 0.0 ||
                                (pr.have && (law.viscous > 0.0 || (law.coulomb > 0.0 && law.normal.bearing > 0.0)));
@@ -278,24 +345,7 @@ void SurfaceContact::evaluate(const Eigen::Ref<const VecX>& x, const Interaction
         scatter(sf.dofs, b.master_dofs, 3 * ns, b.local, options_.half_pass, *sums);
       }
   }
-  if (tracing) {
-    int count[4] = {0, 0, 0, 0}, changed = 0;
-    std::ostringstream os;
-    os.precision(4);
-    for (std::size_t i = 0; i < status.size(); ++i) {
-      ++count[status[i] + 1];
-      // No partner and open carry no force alike: a point between them has not changed.
-      if (trace_status_.size() != status.size() ||
-          std::max<signed char>(trace_status_[i], 0) == std::max<signed char>(status[i], 0))
-        continue;
-      if (++changed <= 6)
-        os << " [" << static_cast<int>(trace_status_[i]) << ">" << static_cast<int>(status[i]) << " x " << where[i][0]
-           << " y " << where[i][1] << " z " << where[i][2] << " g " << where[i][3] << "]";
-    }
-    std::fprintf(stderr, "contact %s: none %d open %d band %d closed %d; changed %d%s\n", name_.c_str(), count[0],
-                 count[1], count[2], count[3], changed, os.str().c_str());
-    trace_status_ = std::move(status);
-  }
+  if (tracking) report_flips(status, where, tracing);
 }
 
 void SurfaceContact::pattern_blocks(

@@ -114,6 +114,12 @@ class SurfaceContact : public Interaction {
   int multiplier_updates() const { return updates_; }
   // One line for summary.json, e.g. "body 0 top against tool 'punch'".
   virtual std::string describe() const = 0;
+  // The search distance (mm): points farther from the partner have none.
+  virtual double search_reach() const = 0;
+  // The normal law the points use: the options' with the linear tail released at 0.9 x
+  // the search distance (NormalLaw::tail_release; contact_law.hpp), so its tie has
+  // fallen smoothly to nothing before a point leaves the search.
+  NormalLaw normal_law() const;
 
  protected:
   // What the partner side prepares once per evaluation (search trees, tool position).
@@ -164,9 +170,25 @@ class SurfaceContact : public Interaction {
   bool shear_known_ = false;                               // shear_ holds the last committed state
   double dissipated_ = 0.0;
   int updates_ = 0;
-  // SF_CONTACT_TRACE=1: each point's normal status (-1 no partner, 0 open, 1 in the
-  // band, 2 closed) at the last tangent assembly, to report the points that changed.
-  mutable std::vector<signed char> trace_status_;
+  // Each point's state at the last tangent assembly (once per Newton iteration): its
+  // normal status (-1 no partner within the search distance, 0 open (no bearing
+  // pressure; the tail's tie alone), 1 in the rounded band, 2 closed) and its viscous
+  // layer (0 off, 1 tapering, 2 engaged), to count the points that changed
+  // (contact_state_flips()) and, with SF_NEWTON_TRACE=1 or SF_CONTACT_TRACE=1, to say
+  // where (surface_contact.cpp).
+  mutable std::vector<signed char> flip_status_;
+  // Counts the points whose state changed since the last tangent assembly and, tracing,
+  // lists where (x, y, z, gap, pressure of each point in `where`); keeps `status`.
+  void report_flips(std::vector<signed char>& status, const std::vector<Eigen::Matrix<double, 5, 1>>& where,
+                    bool tracing) const;
 };
+
+// Contact points whose state changed between two consecutive tangent assemblies of the
+// same interaction, summed over every SurfaceContact of the process since it started:
+// the normal status (above) and the viscous layer's engagement. A state change is where
+// the law's second derivative jumps (the band's ends, the taper's ends) or, at the search
+// distance, where the point drops out: Newton's quadratic convergence is lost while points
+// keep changing. Thread-safe (an atomic); the benchmark prints it per step.
+long contact_state_flips();
 
 }  // namespace sf::forming

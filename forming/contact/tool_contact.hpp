@@ -27,6 +27,7 @@ class ToolContact final : public SurfaceContact {
   std::vector<ToolReaction> reactions(const Eigen::Ref<const VecX>& x,
                                       const InteractionContext& context) const override;
   std::string describe() const override;
+  double search_reach() const override { return reach_; }
   const RigidTool& tool() const { return tool_; }
 
  private:

@@ -9,11 +9,15 @@
 //    tangent of a frictionless tool contact is symmetric).
 //  * the tail (a weak spring about the open end): its pressure and stiffness the
 //    derivatives of its energy, stiffness > 0 at every gap, p = 0 with stiffness S_t at
-//    the open end (a simple root), the bearing part the plain law's.
+//    the open end (a simple root), the bearing part the plain law's;
+//  * the released linear tail (tail_release R): the same derivative checks, the linear
+//    tail up to a parting R / 2, its tie falling to nothing with zero slope at R (C1: no
+//    jump where a point leaves the search distance), energy 0 from there on.
 // Why: the dome's Newton iterations were suspected to cycle through a jump of the law
 // at the band's ends (data/forming/processes/notes/studies.md); these pin the law's smoothness.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -132,6 +136,69 @@ TEST(ContactLaw, TailIsTheDerivativeOfItsEnergyWithStiffnessEverywhere) {
       EXPECT_NEAR(normal_response(law, 1.0, 0.0, kBand).pressure, -kTail * (1.0 - 0.5 * kBand), 1e-12);
     }
   }
+}
+
+// The released tail: the linear tie of the dome's interface grew with the parting and
+// dropped to nothing where a point left the search distance, a jump Newton cannot see;
+// released, it is unchanged up to a parting R / 2 and falls smoothly (C1) to nothing at R.
+TEST(ContactLaw, ReleasedTailFallsSmoothlyToNothing) {
+  constexpr double kTail = 0.05;
+  constexpr double kRelease = 0.4;  // mm
+  NormalLaw law = with_tail(kTail, 0.0);
+  law.tail_release = kRelease;
+  EXPECT_NO_THROW(law.validate());
+  const NormalLaw linear = with_tail(kTail, 0.0);
+  const double open_end = 0.5 * kBand;  // the gap of the band's open end (x = 0)
+  std::vector<double> gaps = gaps_across(0.0);
+  for (double d : {0.01, 0.1, 0.2 - 1e-6, 0.2 + 1e-6, 0.25, 0.3, 0.35, 0.39, kRelease - 1e-6, kRelease + 1e-6, 0.6})
+    gaps.push_back(open_end + d);
+  double smallest = 0.0, largest_tie = 0.0;
+  for (double g : gaps) {
+    const NormalResponse r = normal_response(law, g, 0.0, kBand);
+    const NormalResponse rp = normal_response(law, g + kH, 0.0, kBand);
+    const NormalResponse rm = normal_response(law, g - kH, 0.0, kBand);
+    EXPECT_NEAR(r.pressure, -(rp.energy - rm.energy) / (2 * kH), kFdRel * kS * kBand) << "g " << g;
+    EXPECT_NEAR(r.stiffness, -(rp.pressure - rm.pressure) / (2 * kH), kFdRel * kS) << "g " << g;
+    const NormalResponse plain = normal_response(penalty(), g, 0.0, kBand);
+    EXPECT_EQ(r.bearing, plain.pressure);
+    const double d = g - open_end;
+    if (d < 0.5 * kRelease) {  // up to R / 2 the linear tail's pressure and stiffness
+      const NormalResponse lin = normal_response(linear, g, 0.0, kBand);
+      EXPECT_EQ(r.pressure, lin.pressure) << "g " << g;
+      EXPECT_EQ(r.stiffness, lin.stiffness) << "g " << g;
+    }
+    if (d > 0.0 && d < kRelease) {
+      EXPECT_LT(r.pressure, 0.0) << "a tie within the release";
+    }
+    smallest = std::min(smallest, r.stiffness);
+    largest_tie = std::max(largest_tie, -r.pressure);
+  }
+  EXPECT_GT(smallest, -1.98 * kTail);  // the taper's softening, at most (1 - 6s - 3s^2 + 8s^3) S_t = -1.97 S_t
+  EXPECT_LT(largest_tie, 0.55 * kTail * kRelease);  // at most about 1.08 S_t R / 2
+  // The open end unchanged (p = 0, stiffness S_t).
+  const NormalResponse open = normal_response(law, open_end, 0.0, kBand);
+  EXPECT_NEAR(open.pressure, 0.0, 1e-15);
+  EXPECT_NEAR(open.stiffness, kTail, 1e-12);
+  // Pressure, stiffness and energy all reach 0 at d = R and stay there: nothing to drop.
+  for (double d : {kRelease, kRelease + 1e-9, 0.7, 5.0}) {
+    const NormalResponse r = normal_response(law, open_end + d, 0.0, kBand);
+    EXPECT_NEAR(r.pressure, 0.0, 1e-15) << "d " << d;
+    EXPECT_NEAR(r.stiffness, 0.0, 1e-12) << "d " << d;
+    EXPECT_NEAR(r.energy, 0.0, 1e-15) << "d " << d;
+  }
+  // Just inside the release the values are within O(h^2) of 0 (C1, not a jump).
+  const double h = 1e-4;
+  const NormalResponse near = normal_response(law, open_end + kRelease - h, 0.0, kBand);
+  EXPECT_LT(std::abs(near.pressure), 3.0 * kTail * kRelease * (h / (0.5 * kRelease)) * (h / (0.5 * kRelease)));
+  EXPECT_LT(std::abs(near.stiffness), 13.0 * kTail * h / (0.5 * kRelease));  // slope 12 S_t / L
+  // Continuous at d = R / 2 (value and slope; the energy too).
+  const NormalResponse a = normal_response(law, open_end + 0.5 * kRelease - 1e-9, 0.0, kBand);
+  const NormalResponse b = normal_response(law, open_end + 0.5 * kRelease + 1e-9, 0.0, kBand);
+  EXPECT_NEAR(a.pressure, b.pressure, 3e-9 * kTail);  // 2e-9 x the slope S_t
+  EXPECT_NEAR(a.stiffness, b.stiffness, 1e-7);
+  EXPECT_NEAR(a.energy, b.energy, 1e-10);
+  law.tail_release = -0.1;
+  EXPECT_THROW(law.validate(), InputError);
 }
 
 TEST(ContactLaw, TailIsRejectedWhereItCannotWork) {

@@ -285,6 +285,50 @@ TEST(ContactTangent, PlyPlyNormalLawTailAcrossTheBand) {
   }
 }
 
+// The released linear tail (contact_law.hpp, NormalLaw::tail_release: 0.9 x the search
+// distance): a search distance of 0.06 mm puts the tie's taper at partings 0.027-0.054 mm,
+// inside the spread of the lifted ply's gaps, so points sit in the bearing band, on the
+// linear tie, in the taper and beyond it (where they carry nothing before leaving the search).
+TEST(ContactTangent, PlyPlyReleasedTailAcrossItsRelease) {
+  TwoPlies t = two_plies(test::kSeed + 26, 1.01);
+  VecX previous;
+  const InteractionContext ctx = quasi_static(t, previous, 0.05);
+  ContactOptions o = options(0, 0, 0);
+  o.normal.tail = 2.0;
+  o.band = 0.01;
+  o.search_distance = 0.06;
+  const auto c = ply_contact(t.model, o);
+  const double release = c->normal_law().tail_release;
+  EXPECT_DOUBLE_EQ(release, 0.054);
+  int bearing = 0, rising = 0, softening = 0, released = 0;
+  for (const ContactPointRecord& r : c->sample(t.x, {})) {
+    if (!r.partner) continue;
+    const double x = r.gap - 0.5 * o.band;  // the parting beyond the open end
+    bearing += x < 0.0;
+    rising += x > 0.0 && x < release / 2.0;
+    softening += x > release / 2.0 && x < release;
+    released += x > release;
+  }
+  EXPECT_GT(bearing, 10);
+  EXPECT_GT(rising, 5);
+  EXPECT_GT(softening, 3);
+  EXPECT_GE(released, 0);  // (few: from R + band / 2 to the search distance)
+  const Errors e = finite_differences(*c, t.model.n_dofs(), t.x, {}, true);
+  EXPECT_LT(e.stiffness, kFdRel);
+  EXPECT_LT(e.energy, kFdRel);
+  const MatX K = evaluate(*c, t.model.n_dofs(), t.x, {}, true).stiffness;
+  EXPECT_LT(max_abs(K - K.transpose()), 1e-12 * max_abs(K));
+  o.friction.viscous = 0.02;
+  o.friction.coulomb = 0.3;
+  o.friction.stick_velocity = 0.05;
+  const auto f = ply_contact(t.model, o);
+  const Errors ef = finite_differences(*f, t.model.n_dofs(), t.x, ctx, false);
+  EXPECT_LT(ef.stiffness, kFdRel);
+  std::printf("ply-ply released tail (R %g mm; %d bearing, %d linear, %d taper, %d released points): FD "
+              "stiffness %.1e, FD force %.1e, with friction %.1e\n",
+              release, bearing, rising, softening, released, e.stiffness, e.energy, ef.stiffness);
+}
+
 // A ply under a large sphere that overlaps its whole top face.
 struct UnderTool {
   Model model;

@@ -8,6 +8,10 @@
 // neckn*: necks narrower than an element (refined there, docs/theory/strain.md); band3*:
 // a band narrower than an element along a narrow strip, as the ARAMIS crack band; bandn6*:
 // the same opening in a sharper band (neither is relaxed yet, docs/theory/strain.md).
+// sc/t, L/h, sw/t: the deformed noise estimate's correlated level over the true one (where
+// the noise has no correlated part, over the true independent level: the correlated level
+// the estimate makes up), its correlation length in spacings, its independent level over
+// the true one (both states' noise, hence the sqrt(2)).
 // Environment: NOORACLE, NOLOCAL, NOREFINE, GCV, SCALE=s (the automatic weights x s),
 // ELEM1/ELEM2, PERSEED, PEAKDIAG.
 //   build/bin/gsa_realdata_bench [seeds=2] [filter]
@@ -27,6 +31,13 @@ using namespace sf;
 using namespace sf::gsa;
 
 namespace {
+
+// An estimated level over the true one; where the true one is 0, over `otherwise` (a
+// level of the same noise that is not 0), so the ratio says how much was made up.
+double level_ratio(double estimate, double truth, double otherwise) {
+  const double d = truth > 0 ? truth : otherwise;
+  return d > 0 ? estimate / d : 0.0;
+}
 
 struct Study {
   std::string name;
@@ -214,7 +225,8 @@ int main(int argc, char** argv) {
       o += best;
       lg += best_lg;
       po += best_peak;
-      est_sc += ra.noise.sigma_correlated / std::max(1e-12, opt.deformed_noise.sigma_correlated * std::sqrt(2.0));
+      est_sc += level_ratio(ra.noise.sigma_correlated, opt.deformed_noise.sigma_correlated * std::sqrt(2.0),
+                            opt.deformed_noise.sigma_white * std::sqrt(2.0));
       est_L += ra.noise.correlation_length / h;
       est_sw += ra.noise.sigma_white / (opt.deformed_noise.sigma_white * std::sqrt(2.0));
       relaxed += static_cast<double>(ra.relaxed_elements);
@@ -252,12 +264,15 @@ int main(int argc, char** argv) {
             "  seed %d: lg %.2f gauge %.2f auto %.2e peak %.3f/%.3f sc/t %.2f L/h %.2f sw/t %.2f relaxed %ld mesh %s "
             "rounds %d; blank sc/t %.2f L/h %.2f sw/t %.2f\n",
             seed, ra.log10_delta_optimum, ra.gauge_length / h, ea.interior, ea.peak, ea.peak_exact,
-            ra.noise.sigma_correlated / std::max(1e-12, opt.deformed_noise.sigma_correlated * std::sqrt(2.0)),
+            level_ratio(ra.noise.sigma_correlated, opt.deformed_noise.sigma_correlated * std::sqrt(2.0),
+                        opt.deformed_noise.sigma_white * std::sqrt(2.0)),
             ra.noise.correlation_length / h, ra.noise.sigma_white / (opt.deformed_noise.sigma_white * std::sqrt(2.0)),
             static_cast<long>(ra.relaxed_elements), mesh.c_str(), ra.refinement_rounds,
-            ra.noise_undeformed.sigma_correlated / std::max(1e-12, opt.undeformed_noise.sigma_correlated),
+            level_ratio(ra.noise_undeformed.sigma_correlated, opt.undeformed_noise.sigma_correlated,
+                        opt.undeformed_noise.sigma_white),
             ra.noise_undeformed.correlation_length / h,
-            ra.noise_undeformed.sigma_white / std::max(1e-12, opt.undeformed_noise.sigma_white));
+            level_ratio(ra.noise_undeformed.sigma_white, opt.undeformed_noise.sigma_white,
+                        opt.undeformed_noise.sigma_correlated));
     }
     const double k = 1.0 / seeds;
     std::printf(

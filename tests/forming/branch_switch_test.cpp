@@ -172,8 +172,9 @@ TEST(BranchSwitch, BendStallIsLeftAfterAFewFailedSubSteps) {
 // The last retry's raised damping (last_retry_damping) holds for the rest of that step
 // and is put back after it: the 70 mm/s bend's step 7 from its step 6 with one retry
 // (so the first retry is the last, at 10 c, cutting back to min_increment) converges in
-// 578 Newton iterations (21 cut-backs), as before the retry loop became
-// LoadStepper::retry_switched and the two restores one, and the run goes on with the
+// 580 Newton iterations (578 before the brick kernel's all-points kinematics changed the
+// round-off of this chaotic step; 578 also before the retry loop became
+// LoadStepper::retry_switched and the two restores one), and the run goes on with the
 // restart's c (2.306e-7 N s/mm^4), not ten times it.
 TEST(BranchSwitch, LastRetryDampingIsPutBackAfterTheStep) {
   namespace fs = std::filesystem;
@@ -204,7 +205,7 @@ TEST(BranchSwitch, LastRetryDampingIsPutBackAfterTheStep) {
               report.total_iterations, c0, c1, summary["stabilisation"]["energy"].get<double>());
   EXPECT_GT(c0, 0.0);
   EXPECT_EQ(c1, c0);
-  EXPECT_EQ(report.total_iterations, 578);
+  EXPECT_EQ(report.total_iterations, 580);
   ASSERT_EQ(summary["branch_switches"].size(), 1u);
   EXPECT_TRUE(summary["branch_switches"][0]["after_failure"].get<bool>());
   fs::remove_all(dir);
